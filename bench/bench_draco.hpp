@@ -1,0 +1,32 @@
+// Draco, run in the same process as tsm, for the comparisons in `tsm bench`.
+// Draco is optional at build time: without it draco_available() is false and
+// every call reports that Draco is not built in.
+#pragma once
+#include <string>
+
+#include "tsm/mesh.hpp"
+
+namespace tsm::bench {
+
+bool draco_available();
+const char* draco_version();
+
+struct DracoRun {
+  bool ok = false;
+  std::string error;
+  size_t bytes = 0;
+  double encode_ms = 0;       // median over runs
+  double decode_ms = 0;       // median over runs
+  Mesh decoded;               // Draco's decoded mesh (its vertex order; polygons as triangles)
+};
+
+// Encodes `mesh` with Draco's edgebreaker/sequential choice at compression
+// level `level` (0..10, speed = 10 - level) and `qbits` position bits, then
+// decodes it; `runs` timed repetitions each. Polygons are fan-triangulated
+// for Draco (it takes triangles only).
+DracoRun draco_roundtrip(const Mesh& mesh, int qbits, int level, int runs);
+
+// Loads a file with Draco's own reader (for the reader-speed comparison).
+bool draco_read(const std::string& path, double& ms, size_t& vertices, size_t& faces, std::string& error);
+
+}  // namespace tsm::bench

@@ -1,0 +1,229 @@
+// `tsm bench`: tsm beside Draco (cl7, cl10) on each mesh, in one process:
+// sizes, bits per vertex, encode/decode medians, maximum error, exactness of
+// the round trip (the oracle), and reader speed (tsm's reader vs Draco's).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench_draco.hpp"
+#include "cli_util.hpp"
+#include "tsm/tsm.hpp"
+
+namespace tsm::cli {
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// Draco takes triangles only: the same fan triangulation it is given, for its oracle check.
+Mesh fan_triangulated(const Mesh& m) {
+  Mesh t;
+  t.positions = m.positions;
+  for (size_t f = 0; f < m.face_count(); ++f)
+    for (uint32_t i = 1; i + 1 < m.face_size(f); ++i) t.add_triangle(m.face(f)[0], m.face(f)[i], m.face(f)[i + 1]);
+  return t;
+}
+
+struct Row {
+  std::string mesh;
+  size_t vertices = 0, faces = 0;
+  int q = 0;
+  size_t tsm_bytes = 0;
+  double tsm_enc = 0, tsm_dec = 0, tsm_err = 0;
+  bool tsm_exact = false;
+  std::string tsm_diff;
+  bench::DracoRun cl10, cl7;
+  bool draco_exact = false;
+};
+
+struct ReadRow {
+  std::string mesh;
+  double tsm_ms = 0, draco_ms = -1;
+  std::string draco_error;
+};
+
+std::vector<std::string> default_meshes() {
+  std::vector<std::string> out;
+  std::string dir = default_corpus_dir();
+  if (!dir.empty()) {
+    for (const char* name : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply",
+                             "dragon_vrip.ply"})
+      if (std::filesystem::exists(dir + "/" + name)) out.push_back(dir + "/" + name);
+  }
+  if (out.empty()) {
+    std::string m = default_mesh_path();
+    if (!m.empty()) out.push_back(m);
+  }
+  return out;
+}
+
+// A generated mesh (UV sphere) when no file is at hand.
+Mesh generated_sphere(int rings, int segments) {
+  Mesh m;
+  m.add_vertex(0, 0, 1);
+  for (int r = 1; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      double th = 3.141592653589793 * r / rings, ph = 2 * 3.141592653589793 * s / segments;
+      m.add_vertex(static_cast<float>(std::sin(th) * std::cos(ph)), static_cast<float>(std::sin(th) * std::sin(ph)),
+                   static_cast<float>(std::cos(th)));
+    }
+  m.add_vertex(0, 0, -1);
+  auto id = [&](int r, int s) { return static_cast<uint32_t>(1 + (r - 1) * segments + (s % segments)); };
+  uint32_t south = static_cast<uint32_t>(m.vertex_count() - 1);
+  for (int s = 0; s < segments; ++s) m.add_triangle(0, id(1, s), id(1, s + 1));
+  for (int r = 1; r + 1 < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      m.add_triangle(id(r, s), id(r + 1, s), id(r + 1, s + 1));
+      m.add_triangle(id(r, s), id(r + 1, s + 1), id(r, s + 1));
+    }
+  for (int s = 0; s < segments; ++s) m.add_triangle(south, id(rings - 1, s + 1), id(rings - 1, s));
+  return m;
+}
+
+}  // namespace
+
+int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::vector<int>& qbits, int runs,
+              int level, bool quiet) {
+  std::vector<std::string> meshes = meshes_in.empty() ? default_meshes() : meshes_in;
+  std::vector<Row> rows;
+  std::vector<ReadRow> reads;
+  std::vector<std::string> failures;
+  const bool have_draco = bench::draco_available();
+  if (meshes.empty() && !quiet)
+    std::fprintf(stderr, "tsm bench: no corpus and no default mesh found; using a generated sphere\n");
+  std::vector<std::string> names = meshes.empty() ? std::vector<std::string>{"(generated sphere)"} : meshes;
+
+  for (const std::string& path : names) {
+    Mesh mesh;
+    ReadRow rr;
+    rr.mesh = std::filesystem::path(path).filename().string();
+    if (meshes.empty()) {
+      mesh = generated_sphere(200, 400);
+    } else {
+      if (!quiet) std::fprintf(stderr, "tsm bench: reading %s\n", path.c_str());
+      Stopwatch sw;
+      Status s = read_mesh(path, mesh);
+      rr.tsm_ms = sw.ms();
+      if (!s.ok()) {
+        failures.push_back(s.message());
+        std::fprintf(stderr, "tsm bench: skipped: %s\n", s.message().c_str());
+        continue;
+      }
+      if (have_draco) {
+        size_t v = 0, f = 0;
+        if (!bench::draco_read(path, rr.draco_ms, v, f, rr.draco_error)) rr.draco_ms = -1;
+      }
+      reads.push_back(rr);
+    }
+    for (int q : qbits) {
+      Row row;
+      row.mesh = rr.mesh;
+      row.vertices = mesh.vertex_count();
+      row.faces = mesh.face_count();
+      row.q = q;
+      if (!quiet) std::fprintf(stderr, "tsm bench: %s q=%d: tsm\n", rr.mesh.c_str(), q);
+      EncodeOptions eo;
+      eo.quantization_bits = q;
+      eo.level = level;
+      std::string bytes;
+      std::vector<double> et, dt;
+      Status s;
+      for (int i = 0; i < runs && s.ok(); ++i) {
+        Stopwatch sw;
+        s = encode(mesh, eo, bytes);
+        et.push_back(sw.ms());
+      }
+      if (!s.ok()) {
+        failures.push_back(rr.mesh + ": encode: " + s.message());
+        continue;
+      }
+      Mesh back;
+      for (int i = 0; i < runs && s.ok(); ++i) {
+        Stopwatch sw;
+        s = decode(bytes, back);
+        dt.push_back(sw.ms());
+      }
+      if (!s.ok()) {
+        failures.push_back(rr.mesh + ": decode: " + s.message());
+        continue;
+      }
+      row.tsm_bytes = bytes.size();
+      row.tsm_enc = median(et);
+      row.tsm_dec = median(dt);
+      CompareResult cr = compare_meshes(mesh, back, q);
+      row.tsm_exact = cr.equal;
+      row.tsm_diff = cr.difference;
+      row.tsm_err = cr.max_position_error;
+      if (have_draco) {
+        if (!quiet) std::fprintf(stderr, "tsm bench: %s q=%d: Draco cl10, cl7\n", rr.mesh.c_str(), q);
+        row.cl10 = bench::draco_roundtrip(mesh, q, 10, runs);
+        row.cl7 = bench::draco_roundtrip(mesh, q, 7, runs);
+        if (row.cl10.ok) row.draco_exact = compare_meshes(fan_triangulated(mesh), row.cl10.decoded, q).equal;
+        row.cl10.decoded = Mesh();
+        row.cl7.decoded = Mesh();
+      }
+      rows.push_back(std::move(row));
+    }
+  }
+
+  auto bpv = [](size_t bytes, size_t v) { return v ? 8.0 * static_cast<double>(bytes) / static_cast<double>(v) : 0.0; };
+  if (json) {
+    std::printf("{\"draco\": %s, \"rows\": [", have_draco ? "true" : "false");
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      std::printf("%s\n  {\"mesh\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"q\": %d, \"tsm_bytes\": %zu, "
+                  "\"tsm_bpv\": %.4f, \"tsm_encode_ms\": %.3f, \"tsm_decode_ms\": %.3f, \"tsm_exact\": %s, "
+                  "\"tsm_max_error_steps\": %.4f",
+                  i ? "," : "", json_escape(r.mesh).c_str(), r.vertices, r.faces, r.q, r.tsm_bytes,
+                  bpv(r.tsm_bytes, r.vertices), r.tsm_enc, r.tsm_dec, r.tsm_exact ? "true" : "false", r.tsm_err);
+      for (const auto& [name, d] : {std::pair<const char*, const bench::DracoRun*>{"draco_cl10", &r.cl10},
+                                    {"draco_cl7", &r.cl7}})
+        if (d->ok)
+          std::printf(", \"%s_bytes\": %zu, \"%s_bpv\": %.4f, \"%s_encode_ms\": %.3f, \"%s_decode_ms\": %.3f", name,
+                      d->bytes, name, bpv(d->bytes, r.vertices), name, d->encode_ms, name, d->decode_ms);
+      if (have_draco) std::printf(", \"draco_cl10_exact\": %s", r.draco_exact ? "true" : "false");
+      std::printf("}");
+    }
+    std::printf("\n], \"reads\": [");
+    for (size_t i = 0; i < reads.size(); ++i)
+      std::printf("%s{\"mesh\": \"%s\", \"tsm_ms\": %.3f, \"draco_ms\": %.3f}", i ? ", " : "",
+                  json_escape(reads[i].mesh).c_str(), reads[i].tsm_ms, reads[i].draco_ms);
+    std::printf("], \"failures\": %zu}\n", failures.size());
+    return failures.empty() ? kExitOk : kExitBadInput;
+  }
+
+  std::printf("| mesh | V | q | tsm bytes | tsm bits/v | Draco cl10 bytes | cl10 bits/v | Draco cl7 bytes | tsm/cl10 "
+              "| tsm enc ms | tsm dec ms | cl10 enc ms | cl10 dec ms | max err (steps) | exact: tsm | exact: Draco |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+  for (const Row& r : rows) {
+    auto dbytes = [](const bench::DracoRun& d) { return d.ok ? thousands(d.bytes) : std::string("-"); };
+    std::printf("| %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.mesh.c_str(),
+                thousands(r.vertices).c_str(), r.q, thousands(r.tsm_bytes).c_str(),
+                fixed(bpv(r.tsm_bytes, r.vertices), 2).c_str(), dbytes(r.cl10).c_str(),
+                r.cl10.ok ? fixed(bpv(r.cl10.bytes, r.vertices), 2).c_str() : "-", dbytes(r.cl7).c_str(),
+                r.cl10.ok ? fixed(static_cast<double>(r.tsm_bytes) / static_cast<double>(r.cl10.bytes), 3).c_str() : "-",
+                fixed(r.tsm_enc, 1).c_str(), fixed(r.tsm_dec, 1).c_str(),
+                r.cl10.ok ? fixed(r.cl10.encode_ms, 1).c_str() : "-", r.cl10.ok ? fixed(r.cl10.decode_ms, 1).c_str() : "-",
+                fixed(r.tsm_err, 3).c_str(), r.tsm_exact ? "yes" : "NO", have_draco ? (r.draco_exact ? "yes" : "no") : "-");
+  }
+  if (!reads.empty()) {
+    std::printf("\n| mesh | tsm read ms | Draco read ms | Draco/tsm |\n|---|---:|---:|---:|\n");
+    for (const ReadRow& r : reads)
+      std::printf("| %s | %s | %s | %s |\n", r.mesh.c_str(), fixed(r.tsm_ms, 1).c_str(),
+                  r.draco_ms >= 0 ? fixed(r.draco_ms, 1).c_str() : "-",
+                  r.draco_ms >= 0 && r.tsm_ms > 0 ? fixed(r.draco_ms / r.tsm_ms, 2).c_str() : "-");
+  }
+  if (!have_draco) std::printf("\nDraco is not built in: install libdraco-dev and reconfigure for its columns.\n");
+  for (const Row& r : rows)
+    if (!r.tsm_exact) std::printf("\n%s q=%d: round trip NOT exact: %s\n", r.mesh.c_str(), r.q, r.tsm_diff.c_str());
+  for (const std::string& f : failures) std::printf("\nfailed: %s\n", f.c_str());
+  return failures.empty() ? kExitOk : kExitBadInput;
+}
+
+}  // namespace tsm::cli

@@ -1,0 +1,73 @@
+/* tsm: Topological Surgery mesh compression, C API for bindings.
+ *
+ *   tsm_mesh* m = NULL; char err[256];
+ *   if (tsm_decode(bytes, size, NULL, &m, err, sizeof err) != TSM_OK) puts(err);
+ *   ... tsm_mesh_positions(m), tsm_mesh_indices(m) ...
+ *   tsm_mesh_free(m);
+ *
+ * Return codes are the values of tsm::ErrorCode (0 = ok). Error messages are
+ * written NUL-terminated into err (truncated to err_size) when err is non-NULL.
+ */
+#ifndef TSM_H_
+#define TSM_H_
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum {
+  TSM_OK = 0,
+  TSM_INVALID_ARGUMENT = 1,
+  TSM_IO_ERROR = 2,
+  TSM_PARSE_ERROR = 3,
+  TSM_CORRUPT_DATA = 4,
+  TSM_UNSUPPORTED = 5,
+  TSM_LIMIT_EXCEEDED = 6,
+  TSM_INTERNAL = 7
+};
+
+typedef struct tsm_mesh tsm_mesh;
+
+typedef struct tsm_decode_options {
+  uint64_t max_vertices; /* 0 = no limit besides the format's own */
+  uint64_t max_faces;
+} tsm_decode_options;
+
+typedef struct tsm_encode_options {
+  int quantization_bits; /* 1..30, 0 = default (14) */
+  int level;             /* 0..9, -1 = default */
+} tsm_encode_options;
+
+/* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
+int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* options, tsm_mesh** out, char* err,
+               size_t err_size);
+
+/* Builds a mesh from positions (3 floats per vertex) and faces given as
+ * face_sizes (face_count entries) and corner indices; face_sizes may be NULL
+ * for triangles only. The arrays are copied. */
+int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t* face_sizes, size_t face_count,
+                    const uint32_t* indices, size_t index_count, tsm_mesh** out, char* err, size_t err_size);
+
+/* Encodes a mesh. On success *out is a malloc'ed buffer the caller frees with tsm_free. */
+int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
+               size_t err_size);
+
+size_t tsm_mesh_vertex_count(const tsm_mesh* mesh);
+size_t tsm_mesh_face_count(const tsm_mesh* mesh);
+size_t tsm_mesh_index_count(const tsm_mesh* mesh);
+const float* tsm_mesh_positions(const tsm_mesh* mesh);      /* 3 * vertex_count */
+const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* mesh); /* face_count + 1 */
+const uint32_t* tsm_mesh_indices(const tsm_mesh* mesh);      /* index_count */
+
+void tsm_mesh_free(tsm_mesh* mesh);
+void tsm_free(void* buffer);
+const char* tsm_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TSM_H_ */

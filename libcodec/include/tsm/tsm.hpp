@@ -1,0 +1,65 @@
+// tsm: Topological Surgery mesh compression, C++ API.
+//
+//   tsm::Mesh mesh;  tsm::read_mesh("bunny.ply", mesh);
+//   std::string bytes;
+//   tsm::encode(mesh, tsm::EncodeOptions{}, bytes);
+//   tsm::Mesh back;  tsm::decode(bytes, back);
+//
+// Everything returns a tsm::Status; nothing throws across this API.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tsm/compare.hpp"
+#include "tsm/io.hpp"
+#include "tsm/mesh.hpp"
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+constexpr int kDefaultQuantizationBits = 14;
+constexpr int kDefaultLevel = 6;
+
+struct EncodeOptions {
+  int quantization_bits = kDefaultQuantizationBits;  // 1..30
+  int level = kDefaultLevel;                         // 0 (fast decode) .. 9 (small)
+};
+
+struct DecodeOptions {
+  // A client bounds its memory with these (0 = only the format's own limits).
+  uint64_t max_vertices = 0;
+  uint64_t max_faces = 0;
+};
+
+Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out);
+Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options = {});
+
+// What `tsm info` shows: header fields and the sections with their sizes.
+struct SectionInfo {
+  uint32_t id = 0;
+  std::string name;
+  std::string codec;
+  uint64_t stored_bytes = 0;   // as stored (after zstd where used)
+  uint64_t raw_bytes = 0;      // before the section codec
+};
+struct FileInfo {
+  uint32_t format_version = 0;
+  uint64_t vertex_count = 0;
+  uint64_t face_count = 0;
+  uint64_t corner_count = 0;
+  int quantization_bits = 0;
+  int level = 0;
+  uint32_t segment_count = 0;
+  double bbox_min[3] = {0, 0, 0};
+  double step = 0;
+  uint64_t file_bytes = 0;
+  std::vector<SectionInfo> sections;
+};
+// Parses the header and section table (checksums verified), not the payload.
+Status inspect(std::string_view bytes, FileInfo& info);
+
+const char* version_string();
+
+}  // namespace tsm

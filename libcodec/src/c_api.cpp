@@ -1,0 +1,123 @@
+// The C API (tsm.h) over the C++ API, for bindings and the WebAssembly build.
+// No exception or C++ type crosses it.
+#include <cstdlib>
+#include <cstring>
+#include <new>
+
+#include "tsm/tsm.h"
+#include "tsm/tsm.hpp"
+
+struct tsm_mesh {
+  tsm::Mesh mesh;
+};
+
+namespace {
+
+int report(const tsm::Status& s, char* err, size_t err_size) {
+  if (err && err_size > 0) {
+    std::string m = s.ok() ? "" : s.message();
+    size_t n = std::min(m.size(), err_size - 1);
+    std::memcpy(err, m.data(), n);
+    err[n] = '\0';
+  }
+  return static_cast<int>(s.code());
+}
+
+template <typename F>
+int guarded(char* err, size_t err_size, F&& f) {
+  try {
+    return report(f(), err, err_size);
+  } catch (const std::bad_alloc&) {
+    return report(tsm::Status(tsm::ErrorCode::limit_exceeded, "out of memory"), err, err_size);
+  } catch (const std::exception& e) {
+    return report(tsm::Status(tsm::ErrorCode::internal, e.what()), err, err_size);
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* options, tsm_mesh** out, char* err,
+               size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!out || (!data && size)) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
+    *out = nullptr;
+    tsm::DecodeOptions o;
+    if (options) {
+      o.max_vertices = options->max_vertices;
+      o.max_faces = options->max_faces;
+    }
+    auto* m = new tsm_mesh;
+    tsm::Status s = tsm::decode(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, o);
+    if (!s.ok()) {
+      delete m;
+      return s;
+    }
+    *out = m;
+    return s;
+  });
+}
+
+int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t* face_sizes, size_t face_count,
+                    const uint32_t* indices, size_t index_count, tsm_mesh** out, char* err, size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!out || (!positions && vertex_count) || (!indices && index_count))
+      return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
+    *out = nullptr;
+    if (index_count > 0xffffffffu || vertex_count > 0xffffffffu)
+      return tsm::Status(tsm::ErrorCode::limit_exceeded, "more than 2^32 - 1 vertices or corners");
+    auto* m = new tsm_mesh;
+    m->mesh.positions.assign(positions, positions + 3 * vertex_count);
+    m->mesh.indices.assign(indices, indices + index_count);
+    m->mesh.face_offsets.assign(1, 0);
+    uint64_t at = 0;
+    for (size_t f = 0; f < face_count; ++f) {
+      at += face_sizes ? face_sizes[f] : 3;
+      m->mesh.face_offsets.push_back(static_cast<uint32_t>(at > 0xffffffffu ? 0xffffffffu : at));
+    }
+    std::string why;
+    if (at != index_count || !m->mesh.valid(&why)) {
+      delete m;
+      return tsm::Status(tsm::ErrorCode::invalid_argument,
+                         at != index_count ? "face sizes do not add up to index_count" : why);
+    }
+    *out = m;
+    return tsm::Status::Ok();
+  });
+}
+
+int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
+               size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!mesh || !out || !out_size) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
+    *out = nullptr;
+    *out_size = 0;
+    tsm::EncodeOptions o;
+    if (options) {
+      if (options->quantization_bits) o.quantization_bits = options->quantization_bits;
+      if (options->level >= 0) o.level = options->level;
+    }
+    std::string bytes;
+    tsm::Status s = tsm::encode(mesh->mesh, o, bytes);
+    if (!s.ok()) return s;
+    auto* buf = static_cast<uint8_t*>(std::malloc(bytes.size() ? bytes.size() : 1));
+    if (!buf) return tsm::Status(tsm::ErrorCode::limit_exceeded, "out of memory");
+    std::memcpy(buf, bytes.data(), bytes.size());
+    *out = buf;
+    *out_size = bytes.size();
+    return s;
+  });
+}
+
+size_t tsm_mesh_vertex_count(const tsm_mesh* m) { return m ? m->mesh.vertex_count() : 0; }
+size_t tsm_mesh_face_count(const tsm_mesh* m) { return m ? m->mesh.face_count() : 0; }
+size_t tsm_mesh_index_count(const tsm_mesh* m) { return m ? m->mesh.corner_count() : 0; }
+const float* tsm_mesh_positions(const tsm_mesh* m) { return m ? m->mesh.positions.data() : nullptr; }
+const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* m) { return m ? m->mesh.face_offsets.data() : nullptr; }
+const uint32_t* tsm_mesh_indices(const tsm_mesh* m) { return m ? m->mesh.indices.data() : nullptr; }
+void tsm_mesh_free(tsm_mesh* m) { delete m; }
+void tsm_free(void* buffer) { std::free(buffer); }
+const char* tsm_version(void) { return tsm::version_string(); }
+
+}  // extern "C"

@@ -1,0 +1,66 @@
+// Internal: the .tsm container (see format-spec/FORMAT.md §2-3).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
+constexpr uint16_t kFormatVersion = 1;
+
+enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
+// A stored section may expand at most this much through its codec; the encoder
+// stores raw when zstd would exceed it, so a decoder can bound every allocation
+// by the input size.
+constexpr uint64_t kMaxExpansion = 1024;
+
+enum SectionId : uint16_t {
+  kSectionEnd = 0,
+  kSectionPositionsRaw = 1,   // quantized positions, u32 triples (foundation codec)
+  kSectionFacesRaw = 2,       // face sizes and corner indices (foundation codec)
+};
+const char* section_name(uint16_t id);
+
+struct Header {
+  uint64_t vertex_count = 0;
+  uint64_t face_count = 0;
+  uint64_t corner_count = 0;
+  uint8_t quantization_bits = 0;
+  uint8_t level = 0;
+  float origin[3] = {0, 0, 0};
+  float extent = 0;               // largest bounding-box extent
+  uint32_t segment_count = 1;
+};
+
+struct Section {
+  uint16_t id = 0;
+  SectionCodec codec = SectionCodec::raw;
+  uint64_t stored_bytes = 0;
+  uint64_t raw_bytes = 0;
+  std::string data;  // raw (decoded) payload
+};
+
+class ContainerWriter {
+ public:
+  explicit ContainerWriter(const Header& header);
+  // Adds a section; tries zstd at `zstd_level` (0 = never) and keeps it when smaller.
+  void add_section(uint16_t id, std::string_view payload, int zstd_level);
+  // Finishes the file (end marker) and returns the bytes.
+  std::string finish();
+
+ private:
+  std::string out_;
+};
+
+// Parses the whole container: header, then every section with checksum and
+// length checks. Raw payloads are returned decompressed.
+Status read_container(std::string_view bytes, Header& header, std::vector<Section>& sections,
+                      bool decode_payloads = true);
+
+uint32_t checksum32(std::string_view bytes);
+
+}  // namespace tsm

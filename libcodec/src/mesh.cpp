@@ -1,0 +1,107 @@
+// The in-memory mesh shared by all stages (not a step of the method itself).
+#include "tsm/mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tsm {
+
+void Mesh::clear() {
+  positions.clear();
+  face_offsets.assign(1, 0);
+  indices.clear();
+}
+
+void Mesh::reserve(size_t vertices, size_t faces, size_t corners) {
+  positions.reserve(3 * vertices);
+  face_offsets.reserve(faces + 1);
+  indices.reserve(corners);
+}
+
+void Mesh::add_vertex(float x, float y, float z) {
+  positions.push_back(x);
+  positions.push_back(y);
+  positions.push_back(z);
+}
+
+void Mesh::add_face(const uint32_t* corners, size_t n) {
+  indices.insert(indices.end(), corners, corners + n);
+  face_offsets.push_back(static_cast<uint32_t>(indices.size()));
+}
+
+void Mesh::add_triangle(uint32_t a, uint32_t b, uint32_t c) {
+  indices.push_back(a);
+  indices.push_back(b);
+  indices.push_back(c);
+  face_offsets.push_back(static_cast<uint32_t>(indices.size()));
+}
+
+bool Mesh::all_triangles() const {
+  for (size_t f = 0; f < face_count(); ++f)
+    if (face_size(f) != 3) return false;
+  return true;
+}
+
+size_t Mesh::degenerate_face_count() const {
+  size_t count = 0;
+  for (size_t f = 0; f < face_count(); ++f) {
+    const uint32_t* c = face(f);
+    uint32_t n = face_size(f);
+    bool degenerate = n < 3;
+    for (uint32_t i = 0; i < n && !degenerate; ++i)
+      for (uint32_t j = i + 1; j < n && !degenerate; ++j) degenerate = c[i] == c[j];
+    count += degenerate;
+  }
+  return count;
+}
+
+size_t Mesh::unreferenced_vertex_count() const {
+  std::vector<bool> used(vertex_count(), false);
+  for (uint32_t v : indices)
+    if (v < used.size()) used[v] = true;
+  return static_cast<size_t>(std::count(used.begin(), used.end(), false));
+}
+
+bool Mesh::all_finite() const {
+  for (float x : positions)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+bool Mesh::valid(std::string* why) const {
+  auto fail = [&](const std::string& msg) {
+    if (why) *why = msg;
+    return false;
+  };
+  if (positions.size() % 3 != 0) return fail("positions size is not a multiple of 3");
+  if (face_offsets.empty() || face_offsets[0] != 0) return fail("face_offsets must start with 0");
+  for (size_t f = 0; f + 1 < face_offsets.size(); ++f)
+    if (face_offsets[f + 1] < face_offsets[f]) return fail("face_offsets decrease at face " + std::to_string(f));
+  if (face_offsets.back() != indices.size()) return fail("face_offsets end does not match the corner count");
+  const size_t nv = vertex_count();
+  for (size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] >= nv)
+      return fail("corner " + std::to_string(i) + " references vertex " + std::to_string(indices[i]) +
+                  " of " + std::to_string(nv));
+  return true;
+}
+
+float BoundingBox::largest_extent() const {
+  return std::max({max[0] - min[0], max[1] - min[1], max[2] - min[2]});
+}
+
+BoundingBox bounding_box(const Mesh& mesh) {
+  BoundingBox box;
+  const size_t n = mesh.vertex_count();
+  if (n == 0) return box;
+  for (int a = 0; a < 3; ++a) box.min[a] = box.max[a] = mesh.positions[static_cast<size_t>(a)];
+  for (size_t v = 0; v < n; ++v)
+    for (int a = 0; a < 3; ++a) {
+      float x = mesh.positions[3 * v + static_cast<size_t>(a)];
+      box.min[a] = std::min(box.min[a], x);
+      box.max[a] = std::max(box.max[a], x);
+    }
+  return box;
+}
+
+}  // namespace tsm
