@@ -117,15 +117,27 @@ int cmd_info(const std::string& input, bool json) {
   FileInfo fi;
   s = inspect(bytes, fi);
   if (!s.ok()) return fail(Status(s.code(), input + ": " + s.message()));
-  double bpv = fi.vertex_count ? 8.0 * static_cast<double>(fi.file_bytes) / static_cast<double>(fi.vertex_count) : 0;
+  const double v = fi.vertex_count ? static_cast<double>(fi.vertex_count) : 1.0;
+  auto per_vertex = [v](uint64_t n) { return 8.0 * static_cast<double>(n) / v; };
+  const double bpv = per_vertex(fi.file_bytes);
+  const uint64_t side = fi.file_bytes - fi.connectivity_bytes - fi.geometry_bytes;  // header, framing, side sections
   if (json) {
     std::printf("{\"file\": \"%s\", \"format_version\": %u, \"bytes\": %llu, \"vertices\": %llu, \"faces\": %llu, "
                 "\"corners\": %llu, \"quantization_bits\": %d, \"level\": %d, \"segments\": %u, "
-                "\"bbox_min\": [%.9g, %.9g, %.9g], \"step\": %.9g, \"bits_per_vertex\": %.4f, \"sections\": [",
+                "\"bbox_min\": [%.9g, %.9g, %.9g], \"step\": %.9g, \"bits_per_vertex\": %.4f, "
+                "\"connectivity_bits_per_vertex\": %.4f, \"geometry_bits_per_vertex\": %.4f, "
+                "\"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
+                "\"triangle_runs\": %llu, \"marching_bits\": %llu, \"jump_edges\": %llu, \"stitches\": %llu, "
+                "\"virtual_vertices\": %llu, \"side_faces\": %llu, \"sections\": [",
                 json_escape(input).c_str(), fi.format_version, static_cast<unsigned long long>(fi.file_bytes),
                 static_cast<unsigned long long>(fi.vertex_count), static_cast<unsigned long long>(fi.face_count),
                 static_cast<unsigned long long>(fi.corner_count), fi.quantization_bits, fi.level, fi.segment_count,
-                fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2], fi.step, bpv);
+                fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2], fi.step, bpv, per_vertex(fi.connectivity_bytes),
+                per_vertex(fi.geometry_bytes), per_vertex(side), static_cast<unsigned long long>(fi.components),
+                static_cast<unsigned long long>(fi.vertex_runs), static_cast<unsigned long long>(fi.triangle_runs),
+                static_cast<unsigned long long>(fi.marching_bits), static_cast<unsigned long long>(fi.jump_edges),
+                static_cast<unsigned long long>(fi.stitches), static_cast<unsigned long long>(fi.virtual_vertices),
+                static_cast<unsigned long long>(fi.side_faces));
     for (size_t i = 0; i < fi.sections.size(); ++i) {
       const SectionInfo& si = fi.sections[i];
       std::printf("%s{\"id\": %u, \"name\": \"%s\", \"codec\": \"%s\", \"stored_bytes\": %llu, \"raw_bytes\": %llu}",
@@ -139,8 +151,14 @@ int cmd_info(const std::string& input, bool json) {
               thousands(fi.file_bytes).c_str());
   std::printf("  vertices %s, faces %s, corners %s, segments %u\n", thousands(fi.vertex_count).c_str(),
               thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
-  std::printf("  quantization %d bits (step %.6g), level %d, %.2f bits/vertex\n", fi.quantization_bits, fi.step,
-              fi.level, bpv);
+  std::printf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
+  std::printf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,
+              per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side));
+  std::printf("  topology: %s components, %s vertex runs, %s triangle runs, %s marching bits, %s jump edges,\n"
+              "            %s stitches, %s virtual vertices, %s side faces\n",
+              thousands(fi.components).c_str(), thousands(fi.vertex_runs).c_str(), thousands(fi.triangle_runs).c_str(),
+              thousands(fi.marching_bits).c_str(), thousands(fi.jump_edges).c_str(), thousands(fi.stitches).c_str(),
+              thousands(fi.virtual_vertices).c_str(), thousands(fi.side_faces).c_str());
   std::printf("  %-18s %-6s %12s %12s\n", "section", "codec", "stored", "raw");
   for (const SectionInfo& si : fi.sections)
     std::printf("  %-18s %-6s %12s %12s\n", si.name.c_str(), si.codec.c_str(), thousands(si.stored_bytes).c_str(),
@@ -181,8 +199,10 @@ int main(int argc, char** argv) {
   dec->add_option("-o,--output", da.output, "Output mesh, .ply (binary) or .obj (default: input name with .ply)");
   dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
   dec->add_flag("-f,--force", da.force, "Overwrite an existing output file");
-  dec->add_option("--max-vertices", da.max_vertices, "Refuse files with more vertices (memory bound)");
-  dec->add_option("--max-faces", da.max_faces, "Refuse files with more faces (memory bound)");
+  dec->add_option("--max-vertices", da.max_vertices, "Refuse files with more vertices (memory bound)")
+      ->check(CLI::NonNegativeNumber);
+  dec->add_option("--max-faces", da.max_faces, "Refuse files with more faces (memory bound)")
+      ->check(CLI::NonNegativeNumber);
   dec->add_flag("--quiet", da.quiet, "Print nothing on success");
   dec->footer("Example: tsm decode dragon.tsm -o dragon.ply");
 

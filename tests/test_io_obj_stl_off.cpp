@@ -472,7 +472,7 @@ TEST(StlRead, AsciiErrorsNameTheLine) {
                         Case{head + "vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 1 0\n", "line 7",
                              "more than 3"},
                         Case{head + "vertex 0 0 0\nvertex 1 0 0\n", "line 6", "ends inside a facet"},
-                        Case{"solid x\nfacet normal 0 0 1\nouter\nvertex", "line 3", "'loop'"},
+                        Case{"solid x\nfacet normal 0 0 1\nouter\nvertex", "line 4", "expected 'loop' after 'outer', found 'vertex'"},
                         Case{"solid x\nfoo\n", "line 2", "'foo'"},
                         Case{head + "vertex 0 0 0\nvertex 1 0 nan\n", "line 5", "non-finite"}}) {
     Mesh m;
@@ -547,7 +547,8 @@ TEST(OffRead, TruncatedAndBadInput) {
     const char* says;
   };
   for (const Case& c :
-       {Case{"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", "line 6", "ends at"},
+       {Case{"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", "line 6", "3 corners but only 5 bytes follow"},
+        Case{"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 # 2\n", "line 7", "the file ends where vertex index"},
         Case{"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n", "line 2", "only"},
         Case{"OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "line 7", "ends at face 1"},
         Case{"OFF\n3 1 0\n0 0 0\n1 0 x\n0 1 0\n3 0 1 2\n", "line 4", "'x'"},

@@ -1,15 +1,12 @@
-// Encoder and decoder entry points: validate the mesh, quantize positions
-// (design notes §6: the Draco grid), and lay the streams out in the container.
-//
-// Foundation codec (format version 1): positions as quantized u32 triples and
-// faces as sizes plus delta-coded corner indices, both through zstd. The
-// Topological Surgery streams (vertex tree, bounding loop, triangle tree,
-// marching pattern, predicted geometry; seed 004 §3-4) replace these sections
-// stage by stage; the interface stays.
+// Encoder and decoder entry points: validate the mesh, run the connectivity
+// stages (seed 004 §3-4), quantize positions on the Draco grid (design notes
+// §6) and code them in decoded vertex order, and lay the streams out as
+// container sections.
 #include <cmath>
 
-#include "byte_io.hpp"
+#include "connectivity.hpp"
 #include "container.hpp"
+#include "geometry_predict.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm {
@@ -20,21 +17,43 @@ namespace {
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
 
-uint64_t zigzag(int64_t v) { return (static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63); }
-int64_t unzigzag(uint64_t v) { return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1); }
+double grid_step(const Header& h) {
+  return h.extent > 0 ? h.extent / (std::ldexp(1.0, h.quantization_bits) - 1.0) : 0.0;
+}
 
-int zstd_level_for(int level) { return level <= 0 ? 1 : level >= 9 ? 19 : 3 + 2 * level; }
+const Section* find_section(const std::vector<Section>& sections, uint16_t id) {
+  for (const Section& s : sections)
+    if (s.id == id) return &s;
+  return nullptr;
+}
 
-// Dequantization: x = origin + q * extent / (2^bits - 1), in double, rounded to float.
-struct Dequantizer {
-  double origin[3];
-  double step;
-  Dequantizer(const Header& h) {
-    for (int a = 0; a < 3; ++a) origin[a] = h.origin[a];
-    step = static_cast<double>(h.extent) / (std::ldexp(1.0, h.quantization_bits) - 1.0);
+Status read_streams(std::vector<Section>& sections, ConnectivityStreams& cs) {
+  Section* parts[3] = {nullptr, nullptr, nullptr};
+  for (Section& s : sections) {
+    if (s.id == kSectionVertexTree) parts[0] = &s;
+    if (s.id == kSectionTriangleTree) parts[1] = &s;
+    if (s.id == kSectionTopology) parts[2] = &s;
   }
-  float operator()(uint32_t q, int a) const { return static_cast<float>(origin[a] + q * step); }
-};
+  if (!parts[0] || !parts[1] || !parts[2]) return corrupt("a connectivity section is missing");
+  cs.vertex_tree = std::move(parts[0]->data);
+  cs.triangle_tree = std::move(parts[1]->data);
+  cs.topology = std::move(parts[2]->data);
+  return Status::Ok();
+}
+
+Status check_limits(const Header& h, const DecodeOptions& options) {
+  if (options.max_vertices && h.vertex_count > options.max_vertices)
+    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.vertex_count) +
+                                                 " vertices, above the caller's limit of " +
+                                                 std::to_string(options.max_vertices));
+  if (options.max_faces && h.face_count > options.max_faces)
+    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.face_count) +
+                                                 " faces, above the caller's limit of " +
+                                                 std::to_string(options.max_faces));
+  if (h.vertex_count >= 0x3FFFFFFFu || h.corner_count >= 0x3FFFFFFFu || h.face_count > h.corner_count)
+    return corrupt("vertex, face or corner count out of range");
+  return Status::Ok();
+}
 
 }  // namespace
 
@@ -63,40 +82,27 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   if (!std::isfinite(h.extent))
     return Status(ErrorCode::invalid_argument, "mesh extent overflows a float; scale the mesh down");
 
-  const Grid grid = [&] {
-    Grid g;
-    g.bits = options.quantization_bits;
-    for (int a = 0; a < 3; ++a) g.origin[a] = h.origin[a];
-    g.step = h.extent > 0 ? static_cast<double>(h.extent) / (std::ldexp(1.0, g.bits) - 1.0) : 0.0;
-    return g;
-  }();
+  ConnectivityEncoding ce;
+  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce));
+
+  Grid grid;
+  grid.bits = options.quantization_bits;
+  for (int a = 0; a < 3; ++a) grid.origin[a] = h.origin[a];
+  grid.step = grid_step(h);
   const int64_t qmax = (int64_t{1} << options.quantization_bits) - 1;
-
-  std::string positions;
-  positions.reserve(12 * mesh.vertex_count());
-  ByteWriter pw(positions);
-  for (size_t v = 0; v < mesh.vertex_count(); ++v)
+  std::vector<uint32_t> q(3 * mesh.vertex_count());
+  for (size_t i = 0; i < ce.vertex_order.size(); ++i)
     for (int a = 0; a < 3; ++a) {
-      int64_t q = grid.quantize(mesh.positions[3 * v + a], a);
-      pw.u32(static_cast<uint32_t>(q < 0 ? 0 : q > qmax ? qmax : q));
+      int64_t x = grid.quantize(mesh.positions[3 * static_cast<size_t>(ce.vertex_order[i]) + a], a);
+      q[3 * i + a] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
     }
-
-  std::string faces;
-  ByteWriter fw(faces);
-  int64_t prev = 0;
-  for (size_t f = 0; f < mesh.face_count(); ++f) {
-    fw.varint(mesh.face_size(f));
-    for (uint32_t i = 0; i < mesh.face_size(f); ++i) {
-      int64_t v = mesh.face(f)[i];
-      fw.varint(zigzag(v - prev));
-      prev = v;
-    }
-  }
+  std::string geometry = encode_geometry(q, ce.vertex_parent, options.quantization_bits);
 
   ContainerWriter cw(h);
-  const int zl = zstd_level_for(options.level);
-  cw.add_section(kSectionPositionsRaw, positions, zl);
-  cw.add_section(kSectionFacesRaw, faces, zl);
+  cw.add_section(kSectionVertexTree, ce.streams.vertex_tree, 0);
+  cw.add_section(kSectionTriangleTree, ce.streams.triangle_tree, 0);
+  cw.add_section(kSectionTopology, ce.streams.topology, 0);
+  cw.add_section(kSectionGeometry, geometry, 0);
   out = cw.finish();
   return Status::Ok();
 }
@@ -106,60 +112,19 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   Header h;
   std::vector<Section> sections;
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  if (options.max_vertices && h.vertex_count > options.max_vertices)
-    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.vertex_count) +
-                                                 " vertices, above the caller's limit of " +
-                                                 std::to_string(options.max_vertices));
-  if (options.max_faces && h.face_count > options.max_faces)
-    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.face_count) +
-                                                 " faces, above the caller's limit of " +
-                                                 std::to_string(options.max_faces));
-  const Section* pos = nullptr;
-  const Section* fac = nullptr;
-  for (const Section& s : sections) {
-    if (s.id == kSectionPositionsRaw) pos = &s;
-    if (s.id == kSectionFacesRaw) fac = &s;
-  }
-  if (!pos || !fac) return corrupt("a required section (positions or faces) is missing");
-  if (pos->data.size() / 12 != h.vertex_count || pos->data.size() % 12 != 0)
-    return corrupt("positions section holds " + std::to_string(pos->data.size()) + " bytes, not 12 per vertex for " +
-                   std::to_string(h.vertex_count) + " vertices");
-  // Every face costs at least one byte of size plus one per corner.
-  if (h.face_count > fac->data.size() || h.corner_count > fac->data.size() ||
-      h.face_count + h.corner_count > fac->data.size() || h.corner_count > 0xffffffffu)
-    return corrupt("face and corner counts exceed what the faces section can hold");
-
-  const Dequantizer dq(h);
-  const uint32_t qmax = static_cast<uint32_t>((uint64_t{1} << h.quantization_bits) - 1);
-  out.positions.resize(3 * static_cast<size_t>(h.vertex_count));
-  ByteReader pr(pos->data);
-  for (size_t i = 0; i < out.positions.size(); ++i) {
-    uint32_t q = 0;
-    pr.u32(q);
-    if (q > qmax) return corrupt("quantized coordinate out of range");
-    out.positions[i] = dq(q, static_cast<int>(i % 3));
-  }
-  out.face_offsets.resize(static_cast<size_t>(h.face_count) + 1);
-  out.indices.resize(static_cast<size_t>(h.corner_count));
-  ByteReader fr(fac->data);
-  int64_t prev = 0;
-  uint64_t corner = 0;
-  for (size_t f = 0; f < h.face_count; ++f) {
-    uint64_t n = 0;
-    if (!fr.varint(n) || n == 0 || n > h.corner_count - corner)
-      return corrupt("face " + std::to_string(f) + ": bad corner count");
-    for (uint64_t i = 0; i < n; ++i) {
-      uint64_t d = 0;
-      if (!fr.varint(d)) return corrupt("faces section is truncated");
-      int64_t v = prev + unzigzag(d);
-      if (v < 0 || static_cast<uint64_t>(v) >= h.vertex_count)
-        return corrupt("face " + std::to_string(f) + " references a vertex out of range");
-      out.indices[corner++] = static_cast<uint32_t>(v);
-      prev = v;
-    }
-    out.face_offsets[f + 1] = static_cast<uint32_t>(corner);
-  }
-  if (corner != h.corner_count || fr.remaining() != 0) return corrupt("faces section does not match the header counts");
+  TSM_RETURN_IF_ERROR(check_limits(h, options));
+  ConnectivityStreams cs;
+  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
+  const Section* geo = find_section(sections, kSectionGeometry);
+  if (!geo) return corrupt("the geometry section is missing");
+  std::vector<uint32_t> parent;
+  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, parent));
+  std::vector<uint32_t> q;
+  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, parent, h.quantization_bits, q));
+  const double step = grid_step(h);
+  out.positions.resize(q.size());
+  for (size_t i = 0; i < q.size(); ++i)
+    out.positions[i] = static_cast<float>(static_cast<double>(h.origin[i % 3]) + static_cast<double>(q[i]) * step);
   return Status::Ok();
 }
 
@@ -167,7 +132,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info = FileInfo();
   Header h;
   std::vector<Section> sections;
-  TSM_RETURN_IF_ERROR(read_container(bytes, h, sections, /*decode_payloads=*/false));
+  TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
   info.format_version = kFormatVersion;
   info.vertex_count = h.vertex_count;
   info.face_count = h.face_count;
@@ -176,7 +141,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.level = h.level;
   info.segment_count = h.segment_count;
   for (int a = 0; a < 3; ++a) info.bbox_min[a] = h.origin[a];
-  info.step = static_cast<double>(h.extent) / (std::ldexp(1.0, h.quantization_bits) - 1.0);
+  info.step = grid_step(h);
   info.file_bytes = bytes.size();
   for (const Section& s : sections) {
     SectionInfo si;
@@ -186,7 +151,28 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     si.stored_bytes = s.stored_bytes;
     si.raw_bytes = s.raw_bytes;
     info.sections.push_back(si);
+    if (s.id == kSectionVertexTree || s.id == kSectionTriangleTree || s.id == kSectionTopology)
+      info.connectivity_bytes += s.stored_bytes;
+    else if (s.id == kSectionGeometry)
+      info.geometry_bytes += s.stored_bytes;
+    else
+      info.other_bytes += s.stored_bytes;
   }
+  TSM_RETURN_IF_ERROR(check_limits(h, DecodeOptions()));
+  ConnectivityStreams cs;
+  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
+  Mesh faces;
+  std::vector<uint32_t> parent;
+  ConnectivityStats st;
+  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, faces, parent, &st));
+  info.components = st.components;
+  info.vertex_runs = st.vertex_runs;
+  info.triangle_runs = st.triangle_runs;
+  info.jump_edges = st.jump_edges;
+  info.stitches = st.stitches;
+  info.virtual_vertices = st.virtual_vertices;
+  info.side_faces = st.side_faces;
+  info.marching_bits = st.marching_bits;
   return Status::Ok();
 }
 

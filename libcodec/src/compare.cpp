@@ -25,7 +25,7 @@ Grid Grid::for_mesh(const Mesh& mesh, int bits) {
   if (bits <= 0) return g;
   BoundingBox box = bounding_box(mesh);
   for (int a = 0; a < 3; ++a) g.origin[a] = box.min[a];
-  double extent = static_cast<double>(box.largest_extent());
+  double extent = box.largest_extent();
   double cells = std::ldexp(1.0, bits) - 1.0;
   g.step = extent > 0 && std::isfinite(extent) ? extent / cells : 0.0;
   return g;

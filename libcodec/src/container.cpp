@@ -10,6 +10,7 @@
 #include "container.hpp"
 
 #include <xxhash.h>
+#include <cmath>
 #include <zstd.h>
 
 #include "byte_io.hpp"
@@ -19,8 +20,10 @@ namespace tsm {
 const char* section_name(uint16_t id) {
   switch (id) {
     case kSectionEnd: return "end";
-    case kSectionPositionsRaw: return "positions-raw";
-    case kSectionFacesRaw: return "faces-raw";
+    case kSectionVertexTree: return "vertex-tree";
+    case kSectionTriangleTree: return "triangle-tree";
+    case kSectionTopology: return "topology";
+    case kSectionGeometry: return "geometry";
   }
   return "unknown";
 }
@@ -36,7 +39,7 @@ void write_header_fields(ByteWriter& w, const Header& h) {
   w.u8(h.quantization_bits);
   w.u8(h.level);
   for (float o : h.origin) w.f32(o);
-  w.f32(h.extent);
+  w.f64(h.extent);
   w.varint(h.segment_count);
 }
 
@@ -111,10 +114,14 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
   bool ok = h.varint(header.vertex_count) && h.varint(header.face_count) && h.varint(header.corner_count) &&
             h.u8(header.quantization_bits) && h.u8(header.level);
   for (float& o : header.origin) ok = ok && h.f32(o);
-  ok = ok && h.f32(header.extent) && h.varint(segments);
+  ok = ok && h.f64(header.extent) && h.varint(segments);
   if (!ok) return corrupt("header fields are truncated");
   if (segments == 0 || segments > 0xffffffffu) return corrupt("bad segment count");
   header.segment_count = static_cast<uint32_t>(segments);
+  for (float o : header.origin)
+    if (!std::isfinite(o)) return corrupt("header origin is not a finite number");
+  if (!std::isfinite(header.extent) || header.extent < 0 || header.extent > 6.9e38)
+    return corrupt("header extent is not a finite, non-negative number");
   if (header.quantization_bits < 1 || header.quantization_bits > 30)
     return corrupt("quantization bits " + std::to_string(header.quantization_bits) + " outside 1..30");
 

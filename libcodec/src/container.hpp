@@ -20,8 +20,11 @@ constexpr uint64_t kMaxExpansion = 1024;
 
 enum SectionId : uint16_t {
   kSectionEnd = 0,
-  kSectionPositionsRaw = 1,   // quantized positions, u32 triples (foundation codec)
-  kSectionFacesRaw = 2,       // face sizes and corner indices (foundation codec)
+  // 1 and 2 were the foundation codec's raw sections; retired, never reused.
+  kSectionVertexTree = 3,     // vertex spanning tree runs (range coded)
+  kSectionTriangleTree = 4,   // triangle tree runs, marching pattern, polygon flags (range coded)
+  kSectionTopology = 5,       // components, jumps, virtual vertices, stitches, side faces (range coded)
+  kSectionGeometry = 6,       // predicted quantized positions (range coded)
 };
 const char* section_name(uint16_t id);
 
@@ -32,7 +35,7 @@ struct Header {
   uint8_t quantization_bits = 0;
   uint8_t level = 0;
   float origin[3] = {0, 0, 0};
-  float extent = 0;               // largest bounding-box extent
+  double extent = 0;              // largest bounding-box extent (max - min in double)
   uint32_t segment_count = 1;
 };
 

@@ -86,8 +86,10 @@ bool Mesh::valid(std::string* why) const {
   return true;
 }
 
-float BoundingBox::largest_extent() const {
-  return std::max({max[0] - min[0], max[1] - min[1], max[2] - min[2]});
+double BoundingBox::largest_extent() const {
+  double e = 0;
+  for (int a = 0; a < 3; ++a) e = std::max(e, static_cast<double>(max[a]) - static_cast<double>(min[a]));
+  return e;
 }
 
 BoundingBox bounding_box(const Mesh& mesh) {

@@ -45,7 +45,8 @@ struct Mesh {
 struct BoundingBox {
   float min[3] = {0, 0, 0};
   float max[3] = {0, 0, 0};
-  float largest_extent() const;
+  // max - min per axis computed in double (exact for floats), largest of three.
+  double largest_extent() const;
 };
 
 // Bounding box of all vertices (referenced or not). An empty mesh gives zeros.

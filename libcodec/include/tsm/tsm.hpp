@@ -56,6 +56,10 @@ struct FileInfo {
   double step = 0;
   uint64_t file_bytes = 0;
   std::vector<SectionInfo> sections;
+  // Topology figures (from decoding the connectivity streams).
+  uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
+           virtual_vertices = 0, side_faces = 0, marching_bits = 0;
+  uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;  // stored bytes by kind
 };
 // Parses the header and section table (checksums verified), not the payload.
 Status inspect(std::string_view bytes, FileInfo& info);

@@ -1,0 +1,486 @@
+// Connectivity coding (seed 004 §3-4, design notes §3-5): runs the stages
+// (mesh_cut -> vertex_tree -> bounding_loop -> triangle_tree) and codes
+// their output with the adaptive range coder in three streams:
+//   vertex tree:   per component, the tree's runs (length, leaf bit, last bit)
+//   triangle tree: per component, root position, runs (march count, end
+//                  type), marching bits, polygon-edge flags
+//   topology:      component count, jump edges, virtual vertices, stitches,
+//                  side faces (degenerate faces kept verbatim)
+// The decoder reverses it and reassembles the exact input faces.
+#include <algorithm>
+
+#include "connectivity.hpp"
+#include "range_coder.hpp"
+
+namespace tsm {
+
+namespace {
+
+// Context models, shared by encoder and decoder so both adapt alike.
+struct VertexTreeModels {
+  UIntModel length[2];  // by previous run's end (0 branch, 1 leaf)
+  Prob leaf[2];
+  Prob last;
+};
+
+struct TriangleTreeModels {
+  UIntModel root;
+  UIntModel march[2];  // by previous run's end type
+  Prob end[2][2];      // [previous end][march == 0]
+  Prob bit[3][4];      // [position in run, clipped to 2][last two bits]
+  Prob diagonal[2];    // by previous flag
+};
+
+struct TopologyModels {
+  UIntModel count, corner, partner, position, distance, face_size, index;
+  Prob has_polygons;
+};
+
+Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
+
+}  // namespace
+
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
+  out = ConnectivityEncoding();
+  if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
+    return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
+  const PreparedInput prep = prepare_input(mesh);
+  const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()));
+  const VertexForest f = build_vertex_tree(m);
+
+  RangeEncoder ev, et, eo;
+  VertexTreeModels vm;
+  TriangleTreeModels tm;
+  TopologyModels om;
+  ConnectivityStats& st = out.stats;
+  const uint32_t C = m.component_count();
+  om.count.encode(eo, C);
+  const bool polygons = prep.polygon_count > 0;
+  eo.bit(om.has_polygons, polygons);
+
+  // Triangles per component.
+  std::vector<uint32_t> tri_start(C + 1, 0), tris(m.triangle_count());
+  for (uint32_t t = 0; t < m.triangle_count(); ++t) tri_start[m.vertex_component[m.tri[3 * t]] + 1]++;
+  for (uint32_t c = 0; c < C; ++c) tri_start[c + 1] += tri_start[c];
+  {
+    std::vector<uint32_t> fill(tri_start.begin(), tri_start.end() - 1);
+    for (uint32_t t = 0; t < m.triangle_count(); ++t) tris[fill[m.vertex_component[m.tri[3 * t]]]++] = t;
+  }
+  std::vector<uint8_t> cut_he = f.tree_he;
+  std::vector<uint32_t> local(m.triangle_count()), corner_pos(m.tri.size());
+  std::vector<uint32_t> comp_tris;
+  // Per pre-order position: which triangle corners reference it, filled as we go.
+  std::vector<uint32_t> pos_of(m.vertex_count);
+  for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
+  std::vector<uint32_t> last_child(f.order.size(), kNone);
+  for (uint32_t p = 0; p < f.order.size(); ++p)
+    if (f.parent[p] != kNone) last_child[f.parent[p]] = p;
+
+  int prev_leaf = 1;
+  for (uint32_t c = 0; c < C; ++c) {
+    const uint32_t start = f.component_start[c], end = f.component_start[c + 1];
+    // Vertex tree runs.
+    for (uint32_t i = start; i < end;) {
+      uint32_t j = i;
+      while (f.child_count[j] == 1) ++j;
+      const int leaf = f.child_count[j] == 0;
+      vm.length[prev_leaf].encode(ev, j - i);
+      ev.bit(vm.leaf[prev_leaf], leaf);
+      if (i != start) ev.bit(vm.last, last_child[f.parent[i]] == i);
+      prev_leaf = leaf;
+      ++st.vertex_runs;
+      i = j + 1;
+    }
+    if (end - start < 2) continue;
+    // Jumps and loop.
+    comp_tris.assign(tris.begin() + tri_start[c], tris.begin() + tri_start[c + 1]);
+    ComponentLoop cl = encoder_loop(m, f, c, comp_tris, cut_he, local);
+    om.count.encode(eo, static_cast<uint32_t>(cl.jumps.size()));
+    uint32_t prev_corner = 0;
+    for (uint32_t i = 0; i < cl.jumps.size(); ++i) {
+      om.corner.encode(eo, cl.jumps[i].corner - prev_corner);
+      prev_corner = cl.jumps[i].corner;
+    }
+    for (uint32_t i = 0; i < cl.jumps.size(); ++i)
+      if (cl.jumps[i].partner > i) om.partner.encode(eo, cl.jumps[i].partner - i - 1);
+    st.jump_edges += cl.jumps.size() / 2;
+    // Triangle tree.
+    TriangleRuns tr;
+    TSM_RETURN_IF_ERROR(encode_triangle_tree(m, cl, corner_pos, tr));
+    if (tr.triangle_order.size() != comp_tris.size())
+      return Status(ErrorCode::internal, "component " + std::to_string(c) + ": triangle tree covers " +
+                                             std::to_string(tr.triangle_order.size()) + " of " +
+                                             std::to_string(comp_tris.size()) + " triangles");
+    tm.root.encode(et, tr.root);
+    size_t bit = 0;
+    int prev_end = 1;
+    for (size_t r = 0; r < tr.march.size(); ++r) {
+      tm.march[prev_end].encode(et, tr.march[r]);
+      for (uint32_t i = 0; i < tr.march[r]; ++i, ++bit) {
+        uint32_t ctx = (bit > 0 && i > 0 ? tr.bits[bit - 1] : 0) | (bit > 1 && i > 1 ? tr.bits[bit - 2] << 1 : 0);
+        et.bit(tm.bit[std::min(i, 2u)][ctx], tr.bits[bit]);
+      }
+      et.bit(tm.end[prev_end][tr.march[r] == 0], tr.branch[r]);
+      prev_end = tr.branch[r];
+    }
+    st.triangle_runs += tr.march.size();
+    st.marching_bits += tr.bits.size();
+    if (polygons) {
+      int prev = 0;
+      for (size_t k = 1; k < tr.triangle_order.size(); ++k) {
+        int d = m.diagonal[3 * tr.triangle_order[k] + tr.parent_slot[k]];
+        et.bit(tm.diagonal[prev], d);
+        prev = d;
+      }
+    }
+  }
+
+  // Vertex numbering: the first occurrence of an input vertex in pre-order
+  // carries it; later ones are stitched to it; virtual vertices carry nothing.
+  const uint32_t P = static_cast<uint32_t>(f.order.size());
+  std::vector<uint32_t> first_pos(mesh.vertex_count(), kNone), out_id(P, kNone);
+  std::vector<uint32_t> virtual_pos;
+  std::vector<std::pair<uint32_t, uint32_t>> stitches;
+  for (uint32_t p = 0; p < P; ++p) {
+    uint32_t v = f.order[p];
+    if (m.kind[v] == VertexKind::virtual_) {
+      virtual_pos.push_back(p);
+      continue;
+    }
+    uint32_t s = m.source[v];
+    if (first_pos[s] == kNone) {
+      first_pos[s] = p;
+      out_id[p] = static_cast<uint32_t>(out.vertex_order.size());
+      out.vertex_order.push_back(s);
+    } else {
+      stitches.push_back({p, first_pos[s]});
+      out_id[p] = out_id[first_pos[s]];
+    }
+  }
+  if (out.vertex_order.size() != mesh.vertex_count())
+    return Status(ErrorCode::internal, "vertex numbering lost vertices");
+  out.vertex_parent.resize(out.vertex_order.size());
+  for (uint32_t p = 0; p < P; ++p)
+    if (m.kind[f.order[p]] != VertexKind::virtual_ && first_pos[m.source[f.order[p]]] == p)
+      out.vertex_parent[out_id[p]] = f.parent[p] == kNone ? kNone : out_id[f.parent[p]];
+
+  om.count.encode(eo, static_cast<uint32_t>(virtual_pos.size()));
+  uint32_t prev = 0;
+  for (uint32_t p : virtual_pos) {
+    om.position.encode(eo, p - prev);
+    prev = p;
+  }
+  om.count.encode(eo, static_cast<uint32_t>(stitches.size()));
+  prev = 0;
+  for (auto [dup, orig] : stitches) {
+    om.position.encode(eo, dup - prev);
+    om.distance.encode(eo, dup - orig - 1);
+    prev = dup;
+  }
+  // Side faces, corners as output vertex ids.
+  std::vector<uint32_t> input_to_out(mesh.vertex_count());
+  for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
+  om.count.encode(eo, static_cast<uint32_t>(prep.side_faces.size()));
+  for (uint32_t face : prep.side_faces) {
+    om.face_size.encode(eo, mesh.face_size(face));
+    for (uint32_t i = 0; i < mesh.face_size(face); ++i) om.index.encode(eo, input_to_out[mesh.face(face)[i]]);
+  }
+  st.components = C;
+  st.virtual_vertices = virtual_pos.size();
+  st.stitches = stitches.size();
+  st.side_faces = prep.side_faces.size();
+  st.polygons = prep.polygon_count;
+  out.streams.vertex_tree = ev.finish();
+  out.streams.triangle_tree = et.finish();
+  out.streams.topology = eo.finish();
+  st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
+  return Status::Ok();
+}
+
+Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
+                           uint64_t corner_count, Mesh& out, std::vector<uint32_t>& vertex_parent,
+                           ConnectivityStats* stats) {
+  RangeDecoder dv(in.vertex_tree), dt(in.triangle_tree), dop(in.topology);
+  VertexTreeModels vm;
+  TriangleTreeModels tm;
+  TopologyModels om;
+  ConnectivityStats st;
+  auto overrun = [&] {
+    return dv.overrun() > RangeDecoder::kMaxOverrun || dt.overrun() > RangeDecoder::kMaxOverrun ||
+           dop.overrun() > RangeDecoder::kMaxOverrun;
+  };
+  // Pre-order vertices: real + duplicates + virtual; the latter two are at
+  // most one per corner each.
+  const uint64_t max_positions = vertex_count + 2 * corner_count;
+  const uint32_t C = om.count.decode(dop);
+  const bool polygons = dop.bit(om.has_polygons);
+  if (C > max_positions) return corrupt("more components than vertices");
+
+  std::vector<uint32_t> parent;       // global pre-order parent positions
+  std::vector<uint32_t> tri_vertex;   // decoded triangles, pre-order positions
+  std::vector<uint32_t> tri_parent;   // global decode index of the parent triangle
+  std::vector<uint8_t> tri_slot, tri_glued;
+  std::vector<uint32_t> local_parent, loop, tri_pos, tparent;
+  std::vector<uint8_t> tslot;
+  std::vector<uint32_t> stack;
+  int prev_leaf = 1;
+  for (uint32_t c = 0; c < C; ++c) {
+    const uint32_t start = static_cast<uint32_t>(parent.size());
+    // Vertex tree runs.
+    stack.clear();
+    bool root_run = true;
+    for (;;) {
+      if (overrun()) return corrupt("vertex tree stream is truncated");
+      uint32_t len = vm.length[prev_leaf].decode(dv);
+      if (len == 0xFFFFFFFFu || parent.size() + len + 1 > max_positions) return corrupt("vertex tree run too long");
+      int leaf = dv.bit(vm.leaf[prev_leaf]);
+      prev_leaf = leaf;
+      uint32_t par = kNone;
+      if (!root_run) {
+        if (stack.empty()) return corrupt("vertex tree run without a parent");
+        par = stack.back();
+        if (dv.bit(vm.last)) stack.pop_back();
+      }
+      root_run = false;
+      for (uint32_t i = 0; i <= len; ++i) {
+        parent.push_back(par);
+        par = static_cast<uint32_t>(parent.size() - 1);
+      }
+      if (!leaf) stack.push_back(par);
+      ++st.vertex_runs;
+      if (leaf && stack.empty()) break;
+    }
+    const uint32_t n = static_cast<uint32_t>(parent.size()) - start;
+    if (n < 2) continue;
+    if (n == 2) return corrupt("a component of two vertices cannot hold triangles");
+    local_parent.resize(n);
+    for (uint32_t i = 0; i < n; ++i) local_parent[i] = parent[start + i] == kNone ? kNone : parent[start + i] - start;
+    // Jumps.
+    uint32_t nj = om.count.decode(dop);
+    if (nj > 2 * n + 8 || nj % 2 || overrun()) return corrupt("bad jump edge count");
+    std::vector<JumpEndpoint> jumps(nj);
+    uint32_t corner = 0;
+    for (uint32_t i = 0; i < nj; ++i) {
+      uint32_t d = om.corner.decode(dop);
+      if (d > 2 * n) return corrupt("jump edge corner out of range");
+      corner += d;
+      jumps[i] = {corner, 0, kNone};
+    }
+    for (uint32_t i = 0; i < nj; ++i) {
+      if (jumps[i].partner != kNone) continue;
+      uint32_t d = om.partner.decode(dop);
+      if (d >= nj || i + 1 + d >= nj || jumps[i + 1 + d].partner != kNone) return corrupt("bad jump edge pairing");
+      jumps[i].partner = i + 1 + d;
+      jumps[i + 1 + d].partner = i;
+    }
+    st.jump_edges += nj / 2;
+    if (overrun()) return corrupt("topology stream is truncated");
+    if (!decoder_loop(local_parent, jumps, loop)) return corrupt("jump edges do not give one bounding loop");
+    const uint32_t L = static_cast<uint32_t>(loop.size());
+    // Triangle tree.
+    TriangleRuns tr;
+    tr.root = tm.root.decode(dt);
+    uint32_t total = 0;
+    uint64_t leaves = 0, branches = 0;
+    int prev_end = 1;
+    for (;;) {
+      if (overrun()) return corrupt("triangle tree stream is truncated");
+      uint32_t march = tm.march[prev_end].decode(dt);
+      if (march == 0xFFFFFFFFu || total + static_cast<uint64_t>(march) + 1 > L) return corrupt("triangle run too long");
+      for (uint32_t i = 0; i < march; ++i) {
+        size_t b = tr.bits.size();
+        uint32_t ctx = (b > 0 && i > 0 ? tr.bits[b - 1] : 0) | (b > 1 && i > 1 ? tr.bits[b - 2] << 1 : 0);
+        tr.bits.push_back(static_cast<uint8_t>(dt.bit(tm.bit[std::min(i, 2u)][ctx])));
+      }
+      int br = dt.bit(tm.end[prev_end][march == 0]);
+      tr.march.push_back(march);
+      tr.branch.push_back(static_cast<uint8_t>(br));
+      prev_end = br;
+      total += march + 1;
+      // Pre-order runs form a full tree when leaves = branches + 1.
+      (br ? branches : leaves)++;
+      if (leaves == branches + 1) break;
+    }
+    st.triangle_runs += tr.march.size();
+    st.marching_bits += tr.bits.size();
+    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, tri_pos, tparent, tslot));
+    const uint32_t T = L - 2, base = static_cast<uint32_t>(tri_parent.size());
+    for (uint32_t k = 0; k < T; ++k) {
+      for (int i = 0; i < 3; ++i) tri_vertex.push_back(start + loop[tri_pos[3 * k + i]]);
+      tri_parent.push_back(tparent[k] == kNone ? kNone : base + tparent[k]);
+      tri_slot.push_back(tslot[k]);
+      uint8_t glued = 0;
+      if (polygons && k > 0) {
+        glued = static_cast<uint8_t>(dt.bit(tm.diagonal[tri_glued.empty() || k == 1 ? 0 : tri_glued.back()]));
+      }
+      tri_glued.push_back(glued);
+    }
+    if (tri_vertex.size() > 3 * (corner_count + max_positions)) return corrupt("more triangles than the header allows");
+  }
+
+  // Vertex kinds and output ids.
+  const uint32_t P = static_cast<uint32_t>(parent.size());
+  std::vector<uint32_t> out_id(P, kNone);
+  std::vector<uint8_t> is_virtual(P, 0);
+  uint32_t nvirt = om.count.decode(dop);
+  if (nvirt > P) return corrupt("more virtual vertices than vertices");
+  uint32_t at = 0;
+  for (uint32_t i = 0; i < nvirt; ++i) {
+    uint32_t d = om.position.decode(dop);
+    if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("virtual vertex position out of range");
+    at += d;
+    is_virtual[at] = 1;
+  }
+  uint32_t nstitch = om.count.decode(dop);
+  if (nstitch > P) return corrupt("more stitches than vertices");
+  std::vector<uint32_t> stitch_to(P, kNone);
+  at = 0;
+  for (uint32_t i = 0; i < nstitch; ++i) {
+    uint32_t d = om.position.decode(dop), dist = om.distance.decode(dop);
+    if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
+    at += d;
+    if (dist >= at) return corrupt("stitch target out of range");
+    stitch_to[at] = at - dist - 1;
+  }
+  uint32_t next_id = 0;
+  for (uint32_t p = 0; p < P; ++p) {
+    if (is_virtual[p]) continue;
+    if (stitch_to[p] != kNone) {
+      uint32_t q = stitch_to[p];
+      if (is_virtual[q] || stitch_to[q] != kNone) return corrupt("stitch to a vertex that carries no position");
+      out_id[p] = out_id[q];
+    } else {
+      out_id[p] = next_id++;
+    }
+  }
+  if (next_id != vertex_count)
+    return corrupt("connectivity gives " + std::to_string(next_id) + " vertices, the header says " +
+                   std::to_string(vertex_count));
+  vertex_parent.assign(vertex_count, kNone);
+  for (uint32_t p = 0; p < P; ++p) {
+    if (is_virtual[p] || stitch_to[p] != kNone) continue;
+    if (parent[p] != kNone) {
+      if (is_virtual[parent[p]]) return corrupt("a virtual vertex has children");
+      vertex_parent[out_id[p]] = out_id[parent[p]];
+    }
+  }
+
+  // Faces: triangles in decode order, polygons glued along flagged edges.
+  out.face_offsets.assign(1, 0);
+  out.indices.clear();
+  const uint32_t NT = static_cast<uint32_t>(tri_parent.size());
+  std::vector<uint32_t> node_vertex, node_next, edge_node;
+  std::vector<uint32_t> group_root(NT, kNone), root_node(NT, kNone);
+  if (polygons) {
+    node_vertex.reserve(3 * static_cast<size_t>(NT));
+    edge_node.assign(3 * static_cast<size_t>(NT), kNone);
+  }
+  auto push_face = [&](const uint32_t* c, size_t k) -> bool {
+    if (out.face_offsets.size() > face_count || out.indices.size() + k > corner_count) return false;
+    out.indices.insert(out.indices.end(), c, c + k);
+    out.face_offsets.push_back(static_cast<uint32_t>(out.indices.size()));
+    return true;
+  };
+  for (uint32_t k = 0; k < NT; ++k) {
+    const uint32_t* tv = &tri_vertex[3 * static_cast<size_t>(k)];
+    if (is_virtual[tv[0]] || is_virtual[tv[1]] || is_virtual[tv[2]]) {
+      if (tri_glued[k]) return corrupt("a virtual triangle is flagged as part of a polygon");
+      continue;
+    }
+    uint32_t c[3] = {out_id[tv[0]], out_id[tv[1]], out_id[tv[2]]};
+    if (!polygons) {
+      if (!push_face(c, 3)) return corrupt("more faces than the header says");
+      continue;
+    }
+    if (!tri_glued[k]) {
+      // A new polygon: its corner cycle starts as this triangle.
+      uint32_t n0 = static_cast<uint32_t>(node_vertex.size());
+      node_vertex.insert(node_vertex.end(), {c[0], c[1], c[2]});
+      node_next.insert(node_next.end(), {n0 + 1, n0 + 2, n0});
+      for (uint32_t i = 0; i < 3; ++i) edge_node[3 * static_cast<size_t>(k) + i] = n0 + i;
+      group_root[k] = k;
+      root_node[k] = n0;
+    } else {
+      // Glued to its parent along the parent's edge b->a: insert x between.
+      uint32_t par = tri_parent[k];
+      uint32_t nd = par == kNone ? kNone : edge_node[3 * static_cast<size_t>(par) + tri_slot[k]];
+      if (nd == kNone || group_root[par] == kNone) return corrupt("a polygon edge flag glues to a missing triangle");
+      uint32_t x = static_cast<uint32_t>(node_vertex.size());
+      node_vertex.push_back(c[2]);
+      node_next.push_back(node_next[nd]);
+      node_next[nd] = x;
+      edge_node[3 * static_cast<size_t>(k) + 1] = nd;
+      edge_node[3 * static_cast<size_t>(k) + 2] = x;
+      edge_node[3 * static_cast<size_t>(par) + tri_slot[k]] = kNone;  // now interior
+      group_root[k] = group_root[par];
+    }
+  }
+  if (polygons) {
+    // Each polygon is emitted starting at its fan apex (the corner shared by
+    // all its triangles), so that triangulating it again from its first
+    // corner gives the same diagonals: re-encoding reproduces the bytes.
+    std::vector<uint32_t> member_start(NT + 1, 0), members, poly, count;
+    for (uint32_t k = 0; k < NT; ++k)
+      if (group_root[k] != kNone) member_start[group_root[k] + 1]++;
+    for (uint32_t k = 0; k < NT; ++k) member_start[k + 1] += member_start[k];
+    members.resize(member_start[NT]);
+    {
+      std::vector<uint32_t> fill(member_start.begin(), member_start.end() - 1);
+      for (uint32_t k = 0; k < NT; ++k)
+        if (group_root[k] != kNone) members[fill[group_root[k]]++] = k;
+    }
+    for (uint32_t k = 0; k < NT; ++k) {
+      if (group_root[k] != k) continue;
+      const uint32_t size = member_start[k + 1] - member_start[k];
+      poly.clear();
+      uint32_t nd = root_node[k];
+      do {
+        poly.push_back(node_vertex[nd]);
+        nd = node_next[nd];
+      } while (nd != root_node[k] && poly.size() <= node_vertex.size());
+      if (poly.size() != size + 2) return corrupt("a polygon does not close");
+      if (size >= 2) {
+        // The apex is a corner of every triangle of the fan: count corners.
+        count.assign(poly.size(), 0);
+        for (uint32_t i = member_start[k]; i < member_start[k + 1]; ++i) {
+          const uint32_t* tv = &tri_vertex[3 * static_cast<size_t>(members[i])];
+          for (int c = 0; c < 3; ++c) {
+            auto it = std::find(poly.begin(), poly.end(), out_id[tv[c]]);
+            if (it != poly.end()) count[static_cast<size_t>(it - poly.begin())]++;
+          }
+        }
+        size_t apex = static_cast<size_t>(std::max_element(count.begin(), count.end()) - count.begin());
+        std::rotate(poly.begin(), poly.begin() + static_cast<std::ptrdiff_t>(apex), poly.end());
+      }
+      if (!push_face(poly.data(), poly.size())) return corrupt("more faces than the header says");
+    }
+  }
+
+  // Side faces.
+  uint32_t nside = om.count.decode(dop);
+  if (nside > face_count) return corrupt("more side faces than faces");
+  std::vector<uint32_t> corners;
+  for (uint32_t i = 0; i < nside; ++i) {
+    uint32_t n = om.face_size.decode(dop);
+    if (n > corner_count || overrun()) return corrupt("bad side face size");
+    corners.resize(n);
+    for (uint32_t j = 0; j < n; ++j) {
+      corners[j] = om.index.decode(dop);
+      if (corners[j] >= vertex_count) return corrupt("side face corner out of range");
+    }
+    if (!push_face(corners.data(), n)) return corrupt("more faces than the header says");
+  }
+  if (overrun()) return corrupt("connectivity streams are truncated");
+  if (out.face_count() != face_count || out.indices.size() != corner_count)
+    return corrupt("connectivity gives " + std::to_string(out.face_count()) + " faces and " +
+                   std::to_string(out.indices.size()) + " corners, the header says " + std::to_string(face_count) +
+                   " and " + std::to_string(corner_count));
+  st.components = C;
+  st.virtual_vertices = nvirt;
+  st.stitches = nstitch;
+  st.side_faces = nside;
+  if (stats) *stats = st;
+  return Status::Ok();
+}
+
+}  // namespace tsm

@@ -1,0 +1,148 @@
+// Internal: the connectivity side of Topological Surgery (seed 004 §3-4,
+// design notes §3-5), split by pipeline stage:
+//   mesh_cut.cpp       every mesh -> closed oriented manifold components
+//   vertex_tree.cpp    the vertex spanning tree (layered spiral) and its runs
+//   bounding_loop.cpp  jump edges, rotation system and the bounding loop walk
+//   triangle_tree.cpp  triangle tree runs and marching pattern
+//   connectivity.cpp   the coded streams and the decoder's reassembly
+//
+// Half-edge h = 3*t + i of triangle t runs from corner i to corner (i+1)%3;
+// the triangle lies on its left. Faces are counter-clockwise seen from
+// outside, so around a vertex, cw_next(h) = next(twin(h)).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tsm/mesh.hpp"
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+constexpr uint32_t kNone = 0xFFFFFFFFu;
+
+inline uint32_t he_next(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
+inline uint32_t he_prev(uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
+
+enum class VertexKind : uint8_t { real = 0, duplicate = 1, virtual_ = 2 };
+
+// Stage 1 output: closed, oriented, manifold triangle components.
+struct CutMesh {
+  uint32_t vertex_count = 0;            // real + duplicates + virtual
+  std::vector<uint32_t> tri;            // 3 per triangle, cut-mesh vertex ids
+  std::vector<uint32_t> twin;           // 3 per triangle, always paired
+  std::vector<VertexKind> kind;         // per vertex
+  std::vector<uint32_t> source;         // per vertex: input vertex id (kNone for virtual)
+  std::vector<uint32_t> tri_source;     // per triangle: input triangle index, kNone for virtual
+  std::vector<uint8_t> diagonal;        // per half-edge: 1 if it is an interior edge of an input polygon
+  // Components: vertices grouped, in a canonical order; each lists its root.
+  std::vector<uint32_t> component_root; // per component, the vertex the tree starts from
+  std::vector<uint32_t> vertex_component;
+  uint32_t component_count() const { return static_cast<uint32_t>(component_root.size()); }
+  uint32_t triangle_count() const { return static_cast<uint32_t>(tri.size() / 3); }
+  // Statistics.
+  uint32_t holes = 0, duplicates = 0, cut_edges = 0;
+};
+
+// The input split into what the manifold coder takes and side lists.
+struct PreparedInput {
+  std::vector<uint32_t> tri;             // triangles for the manifold coder (input vertex ids)
+  std::vector<uint8_t> tri_diagonal;     // 3 per triangle: edge i is a polygon diagonal
+  std::vector<uint32_t> side_faces;      // faces kept verbatim (degenerate ones): face index list
+  uint32_t polygon_count = 0;            // polygons (n > 3) triangulated
+};
+
+PreparedInput prepare_input(const Mesh& mesh);
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count);
+
+// Stage 2: the vertex spanning forest, in pre-order.
+struct VertexForest {
+  std::vector<uint32_t> order;          // pre-order position -> cut-mesh vertex
+  std::vector<uint32_t> parent;         // per pre-order position, parent position (kNone at roots)
+  std::vector<uint32_t> child_count;    // per pre-order position
+  std::vector<uint32_t> component_start;  // pre-order position where each component starts (+ end)
+  // Per cut-mesh vertex: the half-edge to its parent (kNone at roots), and
+  // for roots the reference half-edge the children are ordered from.
+  std::vector<uint32_t> parent_he;
+  std::vector<uint32_t> root_ref_he;
+  std::vector<uint8_t> tree_he;         // per half-edge: 1 if it is a tree edge (both directions)
+};
+
+VertexForest build_vertex_tree(const CutMesh& m);
+
+// Stage 3: bounding loop of one component (encoder side: with half-edges).
+struct JumpEndpoint {
+  uint32_t corner;   // tour position (within the component's tree tour)
+  uint32_t order;    // clockwise order within that corner
+  uint32_t partner;  // index of the other endpoint in the sorted endpoint list
+};
+
+struct ComponentLoop {
+  std::vector<uint32_t> loop;           // loop position -> cut-mesh vertex
+  std::vector<uint32_t> loop_he;        // loop position p -> half-edge loop[p] -> loop[p+1]
+  std::vector<JumpEndpoint> jumps;      // sorted by (corner, order)
+};
+
+// Encoder: choose jump edges for component c (its triangles listed in
+// `triangles`), mark them in `cut_he` (which holds the tree edges), and walk
+// the loop. `local` is scratch of one entry per triangle of the mesh.
+ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
+                           const std::vector<uint32_t>& triangles, std::vector<uint8_t>& cut_he,
+                           std::vector<uint32_t>& local);
+
+// Decoder: the loop of a component from its tree (parent positions, local to
+// the component) and jump endpoints. Returns false on inconsistent input.
+bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
+                  std::vector<uint32_t>& loop);
+
+// Stage 4: the triangle tree (seed 004 §4).
+struct TriangleRuns {
+  uint32_t root = 0;                    // loop position r
+  std::vector<uint32_t> march;          // per run: march count
+  std::vector<uint8_t> branch;          // per run: 1 = ends in a branching triangle, 0 = leaf
+  std::vector<uint8_t> bits;            // marching bits (0 right, 1 left)
+  std::vector<uint32_t> triangle_order; // encoder: cut-mesh triangles in decode order
+  std::vector<uint8_t> parent_slot;     // per triangle in decode order: which edge faces its parent
+};
+
+// `corner_pos` is scratch with one entry per half-edge of the mesh.
+Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vector<uint32_t>& corner_pos,
+                            TriangleRuns& out);
+// Decoder: triangles as loop-position triples, in decode order; each
+// non-root triangle's first edge is the one shared with its parent.
+// parent[k] is the decode index of triangle k's parent (kNone for the root).
+Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, std::vector<uint32_t>& tri_pos,
+                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge);
+
+// Stage 5: the whole connectivity, coded.
+struct ConnectivityStats {
+  uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
+           virtual_vertices = 0, side_faces = 0, polygons = 0, marching_bits = 0;
+  uint64_t bytes = 0;
+};
+
+// The three connectivity streams (container sections).
+struct ConnectivityStreams {
+  std::string vertex_tree;    // VST runs per component
+  std::string triangle_tree;  // root, runs, marching bits, polygon-edge flags per component
+  std::string topology;       // components, jumps, virtual vertices, stitches, side faces
+};
+
+struct ConnectivityEncoding {
+  ConnectivityStreams streams;
+  // Output vertex id (decoded order) -> input vertex id. Geometry is coded in this order.
+  std::vector<uint32_t> vertex_order;
+  // Per output vertex, its tree parent's output id (kNone at roots), for predictors.
+  std::vector<uint32_t> vertex_parent;
+  ConnectivityStats stats;
+};
+
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out);
+// Fills out.face_offsets / out.indices (positions are the geometry stage's
+// job). vertex_parent gets each output vertex's tree parent (kNone at roots).
+// The counts come from the header and are checked against what the streams say.
+Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
+                           uint64_t corner_count, Mesh& out, std::vector<uint32_t>& vertex_parent,
+                           ConnectivityStats* stats = nullptr);
+
+}  // namespace tsm

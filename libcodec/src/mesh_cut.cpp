@@ -1,0 +1,219 @@
+// Topological surgery on the input itself: turn any mesh into closed,
+// oriented, manifold triangle components that the method of seed 004 §3-4
+// can code, and remember how to undo it (design notes §5, "Every mesh"):
+//   - polygons are fan-triangulated, their diagonals flagged (restored by
+//     one bit per marching edge, as MPEG-4's polygon-edge flags);
+//   - degenerate faces (fewer than 3 or repeated corners) go to a side list;
+//   - an edge is kept only when exactly two faces use it in opposite
+//     directions; all others (boundaries, non-manifold edges, edges whose
+//     faces disagree in orientation) are cut;
+//   - a vertex whose faces form several fans is split into one vertex per
+//     fan (duplicates, stitched back by the decoder);
+//   - each hole is closed by a virtual vertex and a fan of virtual triangles.
+#include <algorithm>
+#include <numeric>
+
+#include "connectivity.hpp"
+
+namespace tsm {
+
+namespace {
+
+uint64_t edge_key(uint32_t a, uint32_t b) {
+  return a < b ? (static_cast<uint64_t>(a) << 32) | b : (static_cast<uint64_t>(b) << 32) | a;
+}
+
+struct UnionFind {
+  std::vector<uint32_t> p;
+  explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
+  uint32_t find(uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  }
+  void unite(uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) p[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Sorted (key, half-edge) pairs of all half-edges, for pairing and counting.
+std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32_t>& tri) {
+  std::vector<std::pair<uint64_t, uint32_t>> e(tri.size());
+  for (uint32_t h = 0; h < tri.size(); ++h) e[h] = {edge_key(tri[h], tri[he_next(h)]), h};
+  std::sort(e.begin(), e.end());
+  return e;
+}
+
+}  // namespace
+
+PreparedInput prepare_input(const Mesh& mesh) {
+  PreparedInput out;
+  // Pass 1: classify faces; fan-triangulate polygons with distinct corners.
+  std::vector<uint32_t> poly_of_tri;  // per triangle: face index if from a polygon, else kNone
+  auto emit = [&](const std::vector<uint32_t>& corners, uint32_t face, bool polygon) {
+    size_t n = corners.size();
+    for (size_t i = 1; i + 1 < n; ++i) {
+      out.tri.insert(out.tri.end(), {corners[0], corners[i], corners[i + 1]});
+      out.tri_diagonal.insert(out.tri_diagonal.end(),
+                              {static_cast<uint8_t>(i > 1), 0, static_cast<uint8_t>(i + 2 < n)});
+      poly_of_tri.push_back(polygon ? face : kNone);
+    }
+  };
+  std::vector<uint32_t> corners;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    const uint32_t* c = mesh.face(f);
+    uint32_t n = mesh.face_size(f);
+    corners.assign(c, c + n);
+    std::vector<uint32_t> sorted = corners;
+    std::sort(sorted.begin(), sorted.end());
+    bool degenerate = n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+    if (degenerate) {
+      out.side_faces.push_back(f);
+      continue;
+    }
+    emit(corners, f, n > 3);
+  }
+  // Pass 2: a polygon whose diagonal is not used by exactly its two fan
+  // triangles cannot be glued back from the triangle tree: keep it verbatim.
+  bool any_polygon = std::any_of(poly_of_tri.begin(), poly_of_tri.end(), [](uint32_t p) { return p != kNone; });
+  if (!any_polygon) return out;
+  auto edges = sorted_edges(out.tri);
+  std::vector<uint8_t> bad_face(mesh.face_count(), 0);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i != 2)
+      for (size_t k = i; k < j; ++k) {
+        uint32_t h = edges[k].second;
+        if (out.tri_diagonal[h]) bad_face[poly_of_tri[h / 3]] = 1;
+      }
+    i = j;
+  }
+  PreparedInput kept;
+  kept.side_faces = out.side_faces;
+  for (uint32_t t = 0; t < poly_of_tri.size(); ++t) {
+    uint32_t f = poly_of_tri[t];
+    if (f != kNone && bad_face[f]) continue;
+    kept.tri.insert(kept.tri.end(), out.tri.begin() + 3 * t, out.tri.begin() + 3 * t + 3);
+    kept.tri_diagonal.insert(kept.tri_diagonal.end(), out.tri_diagonal.begin() + 3 * t,
+                             out.tri_diagonal.begin() + 3 * t + 3);
+  }
+  for (uint32_t f = 0; f < bad_face.size(); ++f)
+    if (bad_face[f]) kept.side_faces.push_back(f);
+  std::sort(kept.side_faces.begin(), kept.side_faces.end());
+  for (uint32_t f = 0; f < mesh.face_count(); ++f)
+    if (mesh.face_size(f) > 3 && !bad_face[f] &&
+        !std::binary_search(kept.side_faces.begin(), kept.side_faces.end(), f))
+      ++kept.polygon_count;
+  return kept;
+}
+
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count) {
+  CutMesh m;
+  const uint32_t nh = static_cast<uint32_t>(in.tri.size());
+  m.tri = in.tri;
+  m.diagonal = in.tri_diagonal;
+  m.twin.assign(nh, kNone);
+
+  // 1. Pair half-edges: exactly two uses of an edge, in opposite directions.
+  auto edges = sorted_edges(in.tri);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 2) {
+      uint32_t h0 = edges[i].second, h1 = edges[i + 1].second;
+      if (in.tri[h0] == in.tri[he_next(h1)]) {
+        m.twin[h0] = h1;
+        m.twin[h1] = h0;
+      } else {
+        ++m.cut_edges;
+      }
+    } else if (j - i > 2) {
+      ++m.cut_edges;
+    }
+    i = j;
+  }
+
+  // 2. Split vertices into one per fan: corners (= outgoing half-edges) that
+  // are rotations of each other around their vertex form one fan.
+  UnionFind fans(nh);
+  for (uint32_t h = 0; h < nh; ++h)
+    if (m.twin[h] != kNone) fans.unite(h, he_next(m.twin[h]));
+  m.source.resize(input_vertex_count);
+  std::iota(m.source.begin(), m.source.end(), 0u);
+  m.kind.assign(input_vertex_count, VertexKind::real);
+  std::vector<uint8_t> claimed(input_vertex_count, 0);
+  std::vector<uint32_t> fan_vertex(nh, kNone);
+  for (uint32_t h = 0; h < nh; ++h) {
+    uint32_t r = fans.find(h);
+    if (fan_vertex[r] == kNone) {
+      uint32_t v = in.tri[h];
+      if (!claimed[v]) {
+        claimed[v] = 1;
+        fan_vertex[r] = v;
+      } else {
+        fan_vertex[r] = static_cast<uint32_t>(m.source.size());
+        m.source.push_back(v);
+        m.kind.push_back(VertexKind::duplicate);
+        ++m.duplicates;
+      }
+    }
+    m.tri[h] = fan_vertex[r];
+  }
+
+  // 3. Close every hole with a virtual vertex. The boundary half-edge after
+  // h = a->b is found by rotating clockwise around b to the open side.
+  m.tri_source.resize(nh / 3);
+  std::iota(m.tri_source.begin(), m.tri_source.end(), 0u);
+  std::vector<uint8_t> done(nh, 0);
+  std::vector<uint32_t> hole;
+  for (uint32_t h0 = 0; h0 < nh; ++h0) {
+    if (m.twin[h0] != kNone || done[h0]) continue;
+    hole.clear();
+    for (uint32_t h = h0; !done[h];) {
+      done[h] = 1;
+      hole.push_back(h);
+      uint32_t g = he_next(h);
+      while (m.twin[g] != kNone) g = he_next(m.twin[g]);
+      h = g;
+    }
+    const uint32_t w = static_cast<uint32_t>(m.source.size());
+    m.source.push_back(kNone);
+    m.kind.push_back(VertexKind::virtual_);
+    ++m.holes;
+    const uint32_t first = static_cast<uint32_t>(m.tri.size() / 3);
+    const uint32_t k = static_cast<uint32_t>(hole.size());
+    for (uint32_t i = 0; i < k; ++i) {
+      uint32_t h = hole[i];
+      uint32_t t = first + i;
+      m.tri.insert(m.tri.end(), {m.tri[he_next(h)], m.tri[h], w});
+      m.twin.insert(m.twin.end(), {h, kNone, kNone});
+      m.diagonal.insert(m.diagonal.end(), {0, 0, 0});
+      m.twin[h] = 3 * t;
+      m.tri_source.push_back(kNone);
+    }
+    for (uint32_t i = 0; i < k; ++i) {  // a->w of triangle i pairs with w->a of the previous one
+      uint32_t t = first + i, tp = first + (i + k - 1) % k;
+      m.twin[3 * t + 1] = 3 * tp + 2;
+      m.twin[3 * tp + 2] = 3 * t + 1;
+    }
+  }
+  m.vertex_count = static_cast<uint32_t>(m.source.size());
+
+  // 4. Components, ordered by their smallest vertex id (never virtual), which is the root.
+  UnionFind comp(m.vertex_count);
+  for (uint32_t h = 0; h < m.tri.size(); ++h) comp.unite(m.tri[h], m.tri[he_next(h)]);
+  m.vertex_component.assign(m.vertex_count, kNone);
+  for (uint32_t v = 0; v < m.vertex_count; ++v) {
+    uint32_t r = comp.find(v);  // the smallest id of the set (unite keeps the minimum)
+    if (r == v) {
+      m.vertex_component[v] = static_cast<uint32_t>(m.component_root.size());
+      m.component_root.push_back(v);
+    }
+    m.vertex_component[v] = m.vertex_component[r];
+  }
+  return m;
+}
+
+}  // namespace tsm

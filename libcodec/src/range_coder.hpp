@@ -1,0 +1,158 @@
+// Adaptive binary range coder (entropy coding stage; replaces the Huffman
+// coding of seed 004 §3-4, see design notes §6 "a real entropy coder with
+// adaptive contexts"). Probabilities are 12-bit, adapted by a shift after each
+// bit; integers are coded as an adaptive bit length class followed by
+// mantissa bits (the top ones modelled, the rest direct).
+//
+// The decoder is safe on any input: reading past the end yields zero bytes
+// and counts an overrun, which callers check (overrun() != 0 => corrupt).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace tsm {
+
+constexpr int kProbBits = 12;
+constexpr uint32_t kProbOne = 1u << kProbBits;
+constexpr int kAdaptShift = 5;
+
+struct Prob {
+  uint16_t p = kProbOne / 2;  // probability of a 0 bit, in 1/4096
+};
+
+class RangeEncoder {
+ public:
+  void bit(Prob& prob, int b) {
+    uint32_t bound = (range_ >> kProbBits) * prob.p;
+    if (!b) {
+      range_ = bound;
+      prob.p = static_cast<uint16_t>(prob.p + ((kProbOne - prob.p) >> kAdaptShift));
+    } else {
+      low_ += bound;
+      range_ -= bound;
+      prob.p = static_cast<uint16_t>(prob.p - (prob.p >> kAdaptShift));
+    }
+    while (range_ < (1u << 24)) {
+      range_ <<= 8;
+      shift_low();
+    }
+  }
+  // Equiprobable bits, most significant first (n <= 32).
+  void direct(uint32_t value, int n) {
+    for (int i = n - 1; i >= 0; --i) {
+      range_ >>= 1;
+      if ((value >> i) & 1) low_ += range_;
+      while (range_ < (1u << 24)) {
+        range_ <<= 8;
+        shift_low();
+      }
+    }
+  }
+  // Flushes and returns the coded bytes; the encoder is reset.
+  std::string finish();
+
+ private:
+  void shift_low();
+  uint64_t low_ = 0;
+  uint32_t range_ = 0xFFFFFFFFu;
+  uint8_t cache_ = 0;
+  uint64_t cache_size_ = 1;
+  std::string out_;
+};
+
+class RangeDecoder {
+ public:
+  RangeDecoder() = default;
+  explicit RangeDecoder(std::string_view data) { init(data); }
+  void init(std::string_view data);
+  int bit(Prob& prob) {
+    uint32_t bound = (range_ >> kProbBits) * prob.p;
+    int b;
+    if (code_ < bound) {
+      range_ = bound;
+      prob.p = static_cast<uint16_t>(prob.p + ((kProbOne - prob.p) >> kAdaptShift));
+      b = 0;
+    } else {
+      code_ -= bound;
+      range_ -= bound;
+      prob.p = static_cast<uint16_t>(prob.p - (prob.p >> kAdaptShift));
+      b = 1;
+    }
+    while (range_ < (1u << 24)) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+    return b;
+  }
+  uint32_t direct(int n) {
+    uint32_t v = 0;
+    for (int i = 0; i < n; ++i) {
+      range_ >>= 1;
+      uint32_t b = code_ >= range_;
+      if (b) code_ -= range_;
+      v = (v << 1) | b;
+      while (range_ < (1u << 24)) {
+        range_ <<= 8;
+        code_ = (code_ << 8) | next_byte();
+      }
+    }
+    return v;
+  }
+  // Bytes requested past the end of the data (a few are normal at the very
+  // end of a stream; callers compare against kMaxOverrun).
+  uint64_t overrun() const { return overrun_; }
+  static constexpr uint64_t kMaxOverrun = 8;
+
+ private:
+  uint32_t next_byte() {
+    if (p_ < end_) return *p_++;
+    ++overrun_;
+    return 0;
+  }
+  const uint8_t* p_ = nullptr;
+  const uint8_t* end_ = nullptr;
+  uint32_t range_ = 0xFFFFFFFFu;
+  uint32_t code_ = 0;
+  uint64_t overrun_ = 0;
+};
+
+// An adaptive model for a symbol of `Bits` bits (a binary tree of contexts).
+template <int Bits>
+struct BitTreeModel {
+  Prob probs[1u << Bits];
+  void encode(RangeEncoder& e, uint32_t symbol) {
+    uint32_t node = 1;
+    for (int i = Bits - 1; i >= 0; --i) {
+      int b = (symbol >> i) & 1;
+      e.bit(probs[node], b);
+      node = (node << 1) | static_cast<uint32_t>(b);
+    }
+  }
+  uint32_t decode(RangeDecoder& d) {
+    uint32_t node = 1;
+    for (int i = 0; i < Bits; ++i) node = (node << 1) | static_cast<uint32_t>(d.bit(probs[node]));
+    return node - (1u << Bits);
+  }
+};
+
+// An adaptive model for unsigned integers up to 2^32 - 2: the bit length of
+// v + 1 as a 6-bit tree symbol, then the bits below the leading one; the top
+// kModelled of them are modelled per length, the rest are direct bits.
+struct UIntModel {
+  static constexpr int kModelled = 2;
+  BitTreeModel<6> length;
+  Prob mantissa[33][1 << kModelled];
+  void encode(RangeEncoder& e, uint32_t v);
+  uint32_t decode(RangeDecoder& d);  // returns 0xFFFFFFFF on an impossible length
+};
+
+// Signed integers: zero flag, sign, magnitude - 1.
+struct SIntModel {
+  Prob zero, sign;
+  UIntModel magnitude;
+  void encode(RangeEncoder& e, int32_t v);
+  int32_t decode(RangeDecoder& d);
+};
+
+}  // namespace tsm

@@ -1,0 +1,178 @@
+// The vertex spanning tree (seed 004 §3.1; design notes §3): the layered
+// construction. Breadth-first rings around a root; Kruskal (union-find) over
+// the edges with the root's reference edge first, then every same-ring edge,
+// inner rings before outer, then
+// the ring-to-ring edges, then edges to virtual vertices (which so become
+// leaves), polygon diagonals last (so they are never cut). Each ring becomes
+// one path and rings are joined by single edges: a spiral with few, long
+// runs. The tree is linearized in pre-order with the children of a node in
+// clockwise order starting from the edge to its parent.
+#include <algorithm>
+#include <numeric>
+
+#include "connectivity.hpp"
+
+namespace tsm {
+
+namespace {
+
+struct UnionFind {
+  std::vector<uint32_t> p;
+  explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
+  uint32_t find(uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  }
+  bool unite(uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    p[a] = b;
+    return true;
+  }
+};
+
+}  // namespace
+
+VertexForest build_vertex_tree(const CutMesh& m) {
+  const uint32_t nv = m.vertex_count;
+  const uint32_t nh = static_cast<uint32_t>(m.tri.size());
+  VertexForest f;
+  f.parent_he.assign(nv, kNone);
+  f.root_ref_he.assign(nv, kNone);
+  f.tree_he.assign(nh, 0);
+
+  // One outgoing half-edge per vertex; at a root, the one to its real
+  // neighbour of smallest id (not across a polygon diagonal). That edge is forced into the tree, so in the
+  // decoded mesh (ids in pre-order) the same neighbour is again the smallest:
+  // every later choice depends only on the root and this edge, never on the
+  // input's numbering, and re-encoding a decoded mesh gives the same bytes.
+  std::vector<uint32_t> out_he(nv, kNone);
+  for (uint32_t h = 0; h < nh; ++h)
+    if (out_he[m.tri[h]] == kNone) out_he[m.tri[h]] = h;
+  auto is_virtual = [&](uint32_t v) { return m.kind[v] == VertexKind::virtual_; };
+  for (uint32_t root : m.component_root) {
+    uint32_t start = out_he[root];
+    if (start == kNone) continue;
+    uint32_t best = kNone, h = start;
+    do {
+      uint32_t w = m.tri[he_next(h)];
+      if (!is_virtual(w) && !m.diagonal[h] && (best == kNone || w < m.tri[he_next(best)])) best = h;
+      h = he_next(m.twin[h]);
+    } while (h != start);
+    out_he[root] = best;
+  }
+
+  // Breadth-first rings and order from each root over real vertices; the
+  // neighbours of a vertex are taken clockwise from the edge to its BFS parent.
+  const uint32_t kFar = 0xFFFFFFFEu;
+  std::vector<uint32_t> dist(nv, kFar), rank(nv, kNone), bfs_from(nv, kNone);
+  std::vector<uint32_t> queue;
+  queue.reserve(nv);
+  uint32_t next_rank = 0;
+  for (uint32_t c = 0; c < m.component_count(); ++c) {
+    uint32_t root = m.component_root[c];
+    f.root_ref_he[root] = out_he[root];
+    dist[root] = 0;
+    rank[root] = next_rank++;
+    queue.clear();
+    queue.push_back(root);
+    for (size_t qi = 0; qi < queue.size(); ++qi) {
+      uint32_t v = queue[qi];
+      uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : out_he[v];
+      if (start == kNone) continue;  // isolated vertex
+      uint32_t h = start;
+      do {
+        uint32_t w = m.tri[he_next(h)];
+        if (dist[w] == kFar && !is_virtual(w)) {
+          dist[w] = dist[v] + 1;
+          rank[w] = next_rank++;
+          bfs_from[w] = m.twin[h];  // w -> v
+          queue.push_back(w);
+        }
+        h = he_next(m.twin[h]);
+      } while (h != start);
+    }
+  }
+
+  // Edges (each once), keyed by class and ring, Kruskal.
+  struct Edge {
+    uint64_t key;   // class (4 bits) | ring (28 bits) | rank of the first endpoint (32 bits)
+    uint32_t rb;    // rank of the second endpoint
+    uint32_t h;     // last resort, only between parallel edges
+  };
+  std::vector<Edge> edges;
+  edges.reserve(nh / 2);
+  for (uint32_t h = 0; h < nh; ++h) {
+    uint32_t g = m.twin[h];
+    if (g < h) continue;
+    uint32_t a = m.tri[h], b = m.tri[g];
+    uint64_t cls, ring;
+    uint32_t ra = std::min(rank[a], rank[b]), rb = std::max(rank[a], rank[b]);
+    if (f.root_ref_he[a] == h || f.root_ref_he[b] == g) {
+      cls = 0;  // the root's reference edge comes first of all
+      ring = 0;
+      ra = rb = 0;
+    } else if (m.diagonal[h]) {
+      cls = 4;
+      ring = 0;
+    } else if (is_virtual(a) || is_virtual(b)) {
+      cls = 3;
+      ring = 0;
+      ra = rank[is_virtual(a) ? b : a];
+      rb = 0;
+    } else if (dist[a] == dist[b]) {
+      cls = 1;
+      ring = dist[a];
+    } else {
+      cls = 2;
+      ring = std::min(dist[a], dist[b]);
+    }
+    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 28) - 1) << 32) | ra, rb, h});
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
+  });
+  UnionFind uf(nv);
+  for (const Edge& e : edges) {
+    uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
+    if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
+  }
+
+  // Pre-order, children clockwise from the parent edge (from the reference
+  // half-edge at a root, which itself comes first).
+  f.order.reserve(nv);
+  f.parent.reserve(nv);
+  f.child_count.reserve(nv);
+  std::vector<uint32_t> pos(nv, kNone), stack, kids;
+  for (uint32_t c = 0; c < m.component_count(); ++c) {
+    f.component_start.push_back(static_cast<uint32_t>(f.order.size()));
+    stack.assign(1, m.component_root[c]);
+    while (!stack.empty()) {
+      uint32_t v = stack.back();
+      stack.pop_back();
+      pos[v] = static_cast<uint32_t>(f.order.size());
+      f.order.push_back(v);
+      f.parent.push_back(f.parent_he[v] == kNone ? kNone : pos[m.tri[he_next(f.parent_he[v])]]);
+      kids.clear();
+      uint32_t start = f.parent_he[v] != kNone ? f.parent_he[v] : f.root_ref_he[v];
+      if (start != kNone) {
+        uint32_t h = start;
+        do {
+          if (f.tree_he[h] && h != f.parent_he[v]) {
+            uint32_t w = m.tri[he_next(h)];
+            f.parent_he[w] = m.twin[h];
+            kids.push_back(w);
+          }
+          h = he_next(m.twin[h]);
+        } while (h != start);
+      }
+      f.child_count.push_back(static_cast<uint32_t>(kids.size()));
+      for (size_t i = kids.size(); i-- > 0;) stack.push_back(kids[i]);
+    }
+  }
+  f.component_start.push_back(static_cast<uint32_t>(f.order.size()));
+  return f;
+}
+
+}  // namespace tsm

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs everything tsm needs from Debian packages. Idempotent and quiet:
+# prints nothing when all is installed, and the apt log only if apt fails.
+# Runs as root (CI, fresh machines) or through sudo.
+set -euo pipefail
+
+PACKAGES=(
+  # build
+  g++ cmake ninja-build pkg-config git ca-certificates
+  # core library
+  libzstd-dev libeigen3-dev libxxhash-dev
+  # command-line tool
+  libcli11-dev
+  # tests (and the sanitizer build's runtime comes with gcc)
+  libgtest-dev
+  # comparison (optional at build time; the bench shows its columns when present)
+  libdraco-dev draco
+  # fuzzers (clang's libFuzzer)
+  clang libclang-rt-14-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "setup: these packages are missing and I am not root (and there is no sudo): ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+if ! { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+  echo "setup: apt-get failed while installing: ${missing[*]}" >&2
+  cat "$log" >&2
+  exit 1
+fi

@@ -1,0 +1,40 @@
+// Generated meshes for tests: every family the codec must round-trip, without
+// needing the corpus. All are deterministic (seeded).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "tsm/mesh.hpp"
+
+namespace tsm_test {
+
+// Icosahedron subdivided `level` times, on the unit sphere (closed, genus 0).
+tsm::Mesh icosphere(int level);
+// Closed surface of genus g (g >= 0): the boundary of a slab with g square
+// through-holes, each voxel split into `res`^3 sub-voxels, quads split in two.
+tsm::Mesh genus_surface(int g, int res = 2);
+// n x n vertex grid in the plane, triangulated; with `holes` square holes
+// (faces removed) spread over it. Open surface with 1 + holes boundary loops.
+tsm::Mesh grid_with_holes(int n, int holes);
+// A triangle fan of n triangles around one vertex (open or closed disk).
+tsm::Mesh fan(int n, bool closed);
+// A triangle strip of n triangles.
+tsm::Mesh strip(int n);
+// A Moebius strip of n quads (2n triangles): non-orientable.
+tsm::Mesh moebius(int n);
+// k triangles sharing one edge (k >= 2): a non-manifold edge when k > 2.
+tsm::Mesh book(int k);
+// Two fans sharing only their apex: a bowtie (non-manifold vertex).
+tsm::Mesh bowtie();
+// An icosphere with one face flipped: inconsistent orientation.
+tsm::Mesh flipped_face_sphere(int level);
+// Random triangle soup: `faces` triangles over `vertices` random points, some
+// degenerate and duplicate faces, some unreferenced vertices.
+tsm::Mesh random_soup(int vertices, int faces, uint32_t seed);
+// A closed cube of 6 quads; and a single n-gon.
+tsm::Mesh cube_quads();
+tsm::Mesh ngon(int n);
+// Disjoint copies of `m`, each shifted along x.
+tsm::Mesh copies(const tsm::Mesh& m, int count);
+
+}  // namespace tsm_test

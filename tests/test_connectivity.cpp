@@ -1,0 +1,212 @@
+// Exact round trip of the Topological Surgery connectivity on every kind of
+// mesh a user can hand us (issue: connectivity), through the public API.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "connectivity.hpp"
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/tsm.hpp"
+
+using namespace tsm;
+using namespace tsm_test;
+
+namespace {
+
+// Encodes, decodes, checks the oracle, and checks canonical re-encoding.
+void expect_round_trip(const Mesh& m, const std::string& what, int q = 14, bool check_reencode = true) {
+  std::string bytes;
+  EncodeOptions eo;
+  eo.quantization_bits = q;
+  Status s = encode(m, eo, bytes);
+  ASSERT_TRUE(s.ok()) << what << ": " << s.to_string();
+  Mesh back;
+  s = decode(bytes, back);
+  ASSERT_TRUE(s.ok()) << what << ": " << s.to_string();
+  CompareResult r = compare_meshes(m, back, q);
+  EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+  // Half a step, plus float rounding of the decoded coordinate.
+  EXPECT_LE(r.max_position_error, 0.5 + 1e-3) << what;
+  std::string again;
+  ASSERT_TRUE(encode(m, eo, again).ok());
+  EXPECT_TRUE(bytes == again) << what << ": encoding is not deterministic";
+  if (check_reencode) {
+    std::string re;
+    ASSERT_TRUE(encode(back, eo, re).ok());
+    EXPECT_TRUE(re == bytes) << what << ": re-encoding the decoded mesh gives other bytes";
+  }
+}
+
+ConnectivityStats stats_of(const Mesh& m) {
+  ConnectivityEncoding ce;
+  EXPECT_TRUE(encode_connectivity(m, ce).ok());
+  return ce.stats;
+}
+
+}  // namespace
+
+TEST(Connectivity, Spheres) {
+  for (int level = 0; level <= 4; ++level) expect_round_trip(icosphere(level), "icosphere " + std::to_string(level));
+}
+
+TEST(Connectivity, TorusOfGenus1To8NeedsTwoJumpEdgesPerHandle) {
+  for (int g = 1; g <= 8; ++g) {
+    Mesh m = genus_surface(g, 2);
+    expect_round_trip(m, "genus " + std::to_string(g));
+    EXPECT_EQ(stats_of(m).jump_edges, 2u * g) << "genus " << g;
+  }
+  EXPECT_EQ(stats_of(genus_surface(0, 2)).jump_edges, 0u);
+}
+
+TEST(Connectivity, SpheresWithOneToFiftyHoles) {
+  for (int holes : {1, 2, 3, 7, 20, 50}) {
+    Mesh m = grid_with_holes(40, holes);
+    expect_round_trip(m, "grid with holes " + std::to_string(holes));
+    // One virtual vertex per boundary loop: the outer one plus each hole.
+    EXPECT_EQ(stats_of(m).virtual_vertices, 1u + holes);
+  }
+}
+
+TEST(Connectivity, MoebiusStripAndInconsistentOrientation) {
+  // Known gap: meshes cut for orientation or non-manifoldness round-trip
+  // exactly, but re-encoding them is not yet byte-identical (which fan of a
+  // split vertex keeps its id depends on face order).
+  expect_round_trip(moebius(12), "moebius", 14, false);
+  expect_round_trip(flipped_face_sphere(2), "sphere with a flipped face");
+}
+
+TEST(Connectivity, TwoToTenFacesOnOneEdge) {
+  for (int k = 2; k <= 10; ++k) expect_round_trip(book(k), "book " + std::to_string(k));
+}
+
+TEST(Connectivity, BowtieNeedsAStitch) {
+  expect_round_trip(bowtie(), "bowtie");
+  EXPECT_GE(stats_of(bowtie()).stitches, 1u);
+}
+
+TEST(Connectivity, DuplicateAndDegenerateFaces) {
+  Mesh m = icosphere(1);
+  m.add_triangle(0, 1, 2);
+  m.add_triangle(m.indices[0], m.indices[1], m.indices[2]);  // duplicate of face 0
+  m.add_triangle(3, 3, 4);                                   // repeated index
+  const uint32_t two[2] = {5, 6};
+  m.add_face(two, 2);                                        // a 2-gon
+  const uint32_t one[1] = {7};
+  m.add_face(one, 1);
+  const uint32_t bad_quad[4] = {1, 2, 1, 3};
+  m.add_face(bad_quad, 4);                                   // polygon with a repeated corner
+  expect_round_trip(m, "duplicate and degenerate faces");
+}
+
+TEST(Connectivity, QuadsAndNgons) {
+  expect_round_trip(cube_quads(), "cube of quads");
+  for (int n : {4, 5, 8, 17}) expect_round_trip(ngon(n), "ngon " + std::to_string(n));
+  Mesh mixed = copies(cube_quads(), 3);
+  Mesh ico = icosphere(2);
+  for (size_t v = 0; v < ico.vertex_count(); ++v)
+    mixed.add_vertex(ico.positions[3 * v] + 20, ico.positions[3 * v + 1], ico.positions[3 * v + 2]);
+  for (size_t f = 0; f < ico.face_count(); ++f)
+    mixed.add_triangle(ico.face(f)[0] + 24, ico.face(f)[1] + 24, ico.face(f)[2] + 24);
+  expect_round_trip(mixed, "quads and triangles");
+}
+
+TEST(Connectivity, FansStripsAndTinyMeshes) {
+  expect_round_trip(fan(8, false), "open fan");
+  expect_round_trip(fan(8, true), "closed fan");
+  expect_round_trip(strip(30), "strip");
+  Mesh one;
+  one.add_vertex(0, 0, 0);
+  one.add_vertex(1, 0, 0);
+  one.add_vertex(0, 1, 0);
+  one.add_triangle(0, 1, 2);
+  expect_round_trip(one, "one triangle");
+  Mesh two = one;
+  two.add_vertex(1, 1, 0);
+  two.add_triangle(1, 3, 2);
+  expect_round_trip(two, "two triangles");
+  Mesh three = two;
+  three.add_vertex(2, 1, 0);
+  three.add_triangle(1, 4, 3);
+  expect_round_trip(three, "three triangles");
+}
+
+TEST(Connectivity, EmptyMeshesAndPointSets) {
+  expect_round_trip(Mesh(), "empty mesh");
+  Mesh points;
+  for (int i = 0; i < 10; ++i) points.add_vertex(static_cast<float>(i), 0, static_cast<float>(i * i));
+  expect_round_trip(points, "point set");
+  Mesh with_isolated = icosphere(1);
+  with_isolated.add_vertex(5, 5, 5);
+  expect_round_trip(with_isolated, "sphere plus an unreferenced vertex");
+}
+
+TEST(Connectivity, SeveralComponents) {
+  expect_round_trip(copies(icosphere(1), 5), "five spheres");
+  expect_round_trip(copies(genus_surface(2, 1), 3), "three double tori");
+}
+
+TEST(Connectivity, RandomSoups) {
+  for (uint32_t seed = 1; seed <= 20; ++seed)
+    expect_round_trip(random_soup(30 + static_cast<int>(seed), 40 + 3 * static_cast<int>(seed), seed),
+                      "soup " + std::to_string(seed), 14, false);
+}
+
+// Property test: thousands of random meshes of mixed structure.
+TEST(Connectivity, PropertyThousandsOfRandomMeshes) {
+  std::mt19937 rng(12345);
+  for (int iter = 0; iter < 2000; ++iter) {
+    Mesh m;
+    int kind = static_cast<int>(rng() % 4);
+    if (kind == 0) {
+      m = random_soup(3 + static_cast<int>(rng() % 12), static_cast<int>(rng() % 20), static_cast<uint32_t>(rng()));
+    } else if (kind == 1) {
+      m = grid_with_holes(3 + static_cast<int>(rng() % 5), static_cast<int>(rng() % 3));
+    } else if (kind == 2) {
+      m = icosphere(static_cast<int>(rng() % 2));
+    } else {
+      m = genus_surface(static_cast<int>(rng() % 3), 1);
+    }
+    // Random damage: drop, flip, duplicate faces; add polygons and strays.
+    Mesh d;
+    d.positions = m.positions;
+    for (size_t f = 0; f < m.face_count(); ++f) {
+      std::vector<uint32_t> c(m.face(f), m.face(f) + m.face_size(f));
+      uint32_t roll = static_cast<uint32_t>(rng() % 20);
+      if (roll == 0) continue;
+      if (roll == 1) std::swap(c[0], c[1]);
+      d.add_face(c.data(), c.size());
+      if (roll == 2) d.add_face(c.data(), c.size());
+    }
+    if (rng() % 3 == 0 && d.vertex_count() >= 4) {
+      uint32_t q[4] = {0, 1, 2, 3};
+      d.add_face(q, 4);
+    }
+    if (rng() % 4 == 0) d.add_vertex(9, 9, 9);
+    std::string bytes;
+    Status s = encode(d, EncodeOptions{}, bytes);
+    ASSERT_TRUE(s.ok()) << "iteration " << iter << ": " << s.to_string();
+    Mesh back;
+    s = decode(bytes, back);
+    ASSERT_TRUE(s.ok()) << "iteration " << iter << ": " << s.to_string();
+    CompareResult r = compare_meshes(d, back, kDefaultQuantizationBits);
+    ASSERT_TRUE(r.equal) << "iteration " << iter << " (kind " << kind << "): " << r.difference;
+  }
+}
+
+TEST(Connectivity, CorpusRoundTrips) {
+  TSM_REQUIRE_CORPUS();
+  for (const auto& entry : std::filesystem::directory_iterator(corpus_dir() + "/edge")) {
+    Mesh m;
+    if (!read_mesh(entry.path().string(), m).ok()) continue;  // refused files are the readers' tests
+    expect_round_trip(m, entry.path().filename().string(), 14, true);
+  }
+  // The low-resolution dragons are non-manifold: exact, but re-encoding is
+  // not yet canonical for them (see the Moebius test).
+  for (const char* name : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply"}) {
+    Mesh m;
+    ASSERT_TRUE(read_mesh(corpus_file(name), m).ok()) << name;
+    expect_round_trip(m, name, 11, std::string(name) == "bun_zipper.ply");
+  }
+}
