@@ -3,6 +3,7 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <cmath>
+#include <limits>
 
 #include "connectivity.hpp"
 #include "container.hpp"
@@ -123,8 +124,12 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   TSM_RETURN_IF_ERROR(decode_geometry(geo->data, parent, h.quantization_bits, q));
   const double step = grid_step(h);
   out.positions.resize(q.size());
-  for (size_t i = 0; i < q.size(); ++i)
-    out.positions[i] = static_cast<float>(static_cast<double>(h.origin[i % 3]) + static_cast<double>(q[i]) * step);
+  constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
+  for (size_t i = 0; i < q.size(); ++i) {
+    double x = static_cast<double>(h.origin[i % 3]) + static_cast<double>(q[i]) * step;
+    if (!(std::fabs(x) <= kFloatMax)) return corrupt("a decoded coordinate is beyond the float range");
+    out.positions[i] = static_cast<float>(x);
+  }
   return Status::Ok();
 }
 

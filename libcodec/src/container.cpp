@@ -11,6 +11,7 @@
 
 #include <xxhash.h>
 #include <cmath>
+#include <limits>
 #include <zstd.h>
 
 #include "byte_io.hpp"

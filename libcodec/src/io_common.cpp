@@ -61,7 +61,8 @@ MeshFormat format_from_extension(std::string_view path) {
 }
 
 MeshFormat sniff_format(std::string_view bytes) {
-  if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" && (bytes[3] == '\n' || bytes[3] == '\r'))
+  if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" &&
+      (bytes[3] == '\n' || bytes[3] == '\r' || bytes[3] == ' ' || bytes[3] == '\t'))
     return MeshFormat::ply;
   // Binary STL: 80-byte header, uint32 count, 50 bytes per triangle. Checked
   // before "solid" because binary headers often start with that word too.

@@ -4,6 +4,7 @@
 #pragma once
 #include <charconv>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -78,7 +79,9 @@ class TextCursor {
       long double w = 0;
       auto r2 = std::from_chars(s, end_, w);
       if (r2.ec != std::errc() && r2.ec != std::errc::result_out_of_range) return false;
-      v = static_cast<T>(w);
+      // Clamp first: casting an out-of-range value to a narrower type is undefined.
+      const long double big = static_cast<long double>(std::numeric_limits<T>::max());
+      v = w > big ? std::numeric_limits<T>::infinity() : w < -big ? -std::numeric_limits<T>::infinity() : static_cast<T>(w);
       r.ptr = r2.ptr;
     } else if (r.ec != std::errc()) {
       return false;

@@ -1,0 +1,641 @@
+// tsm::encode / tsm::decode / tsm::inspect through the public API only: round
+// trips over every generated family, option and argument errors, and hostile
+// input (truncation, corruption, forged headers, caller limits).
+//
+// The section layout will change when the Topological Surgery streams land;
+// these tests only rely on the container header (format-spec/FORMAT.md), which
+// stays.
+#include <gtest/gtest.h>
+#include <xxhash.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/tsm.hpp"
+
+namespace {
+
+using tsm::ErrorCode;
+using tsm::Mesh;
+
+struct Named {
+  const char* name;
+  Mesh mesh;
+};
+
+Mesh point_set(int n) {
+  Mesh m;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> d(-5, 7);
+  for (int i = 0; i < n; ++i) m.add_vertex(d(rng), d(rng), d(rng));
+  return m;
+}
+
+std::vector<Named> families() {
+  std::vector<Named> out;
+  out.push_back({"icosphere(3)", tsm_test::icosphere(3)});
+  out.push_back({"genus_surface(2)", tsm_test::genus_surface(2)});
+  out.push_back({"grid_with_holes(12,3)", tsm_test::grid_with_holes(12, 3)});
+  out.push_back({"fan(9,open)", tsm_test::fan(9, false)});
+  out.push_back({"fan(9,closed)", tsm_test::fan(9, true)});
+  out.push_back({"strip(21)", tsm_test::strip(21)});
+  out.push_back({"moebius(16)", tsm_test::moebius(16)});
+  out.push_back({"book(5)", tsm_test::book(5)});
+  out.push_back({"bowtie", tsm_test::bowtie()});
+  out.push_back({"flipped_face_sphere(2)", tsm_test::flipped_face_sphere(2)});
+  out.push_back({"random_soup(300,500)", tsm_test::random_soup(300, 500, 17)});
+  out.push_back({"cube_quads", tsm_test::cube_quads()});
+  out.push_back({"ngon(11)", tsm_test::ngon(11)});
+  out.push_back({"copies(icosphere(1),4)", tsm_test::copies(tsm_test::icosphere(1), 4)});
+  out.push_back({"copies(cube_quads,3)", tsm_test::copies(tsm_test::cube_quads(), 3)});
+  out.push_back({"empty", Mesh()});
+  out.push_back({"point_set(50)", point_set(50)});
+  Mesh one;
+  one.add_vertex(1.5f, -2.0f, 3.25f);
+  out.push_back({"single_point", one});
+  return out;
+}
+
+// The largest position error a correct codec can have, in grid steps: half a
+// step for the quantization, plus the rounding of the dequantized value
+// (computed in double) to the nearest float, at most half a float ulp of the
+// largest coordinate magnitude.
+double error_bound(const Mesh& original, const Mesh& decoded, int q) {
+  tsm::Grid g = tsm::Grid::for_mesh(original, q);
+  if (g.step <= 0) return 0.5 + 1e-6;
+  float big = 0;
+  for (const Mesh* m : {&original, &decoded})
+    for (float x : m->positions) big = std::max(big, std::fabs(x));
+  double half_ulp = 0.5 * static_cast<double>(std::nextafter(big, std::numeric_limits<float>::infinity()) - big);
+  return 0.5 + half_ulp / g.step + 1e-6;
+}
+
+std::string encode_ok(const Mesh& m, int q = 14, int level = 6) {
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{q, level}, bytes);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return bytes;
+}
+
+// --- Round trips ----------------------------------------------------------
+
+TEST(Codec, RoundTripEveryFamily) {
+  for (const Named& n : families()) {
+    for (int q : {1, 8, 14, 30}) {
+      for (int level : {0, 9}) {
+        SCOPED_TRACE(std::string(n.name) + " q=" + std::to_string(q) + " level=" + std::to_string(level));
+        std::string bytes;
+        tsm::Status s = tsm::encode(n.mesh, tsm::EncodeOptions{q, level}, bytes);
+        ASSERT_TRUE(s.ok()) << s.to_string();
+        Mesh back;
+        s = tsm::decode(bytes, back);
+        ASSERT_TRUE(s.ok()) << s.to_string();
+        EXPECT_TRUE(back.valid());
+        EXPECT_TRUE(back.all_finite());
+        tsm::CompareResult r = tsm::compare_meshes(n.mesh, back, q);
+        EXPECT_TRUE(r.equal) << r.difference;
+        EXPECT_LE(r.max_position_error, error_bound(n.mesh, back, q));
+      }
+    }
+  }
+}
+
+TEST(Codec, RoundTripDefaultOptionsAndAllLevels) {
+  Mesh m = tsm_test::genus_surface(1);
+  Mesh first;
+  for (int level = 0; level <= 9; ++level) {
+    std::string bytes = encode_ok(m, tsm::kDefaultQuantizationBits, level);
+    Mesh back;
+    ASSERT_TRUE(tsm::decode(bytes, back).ok());
+    EXPECT_TRUE(tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits).equal) << "level " << level;
+    // The level trades size for speed; the decoded mesh is the same.
+    if (level == 0) first = back;
+    EXPECT_EQ(back.positions, first.positions) << "level " << level;
+    EXPECT_EQ(back.indices, first.indices) << "level " << level;
+    EXPECT_EQ(back.face_offsets, first.face_offsets) << "level " << level;
+  }
+  std::string bytes;
+  ASSERT_TRUE(tsm::encode(m, tsm::EncodeOptions{}, bytes).ok());
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  EXPECT_EQ(fi.quantization_bits, tsm::kDefaultQuantizationBits);
+  EXPECT_EQ(fi.level, tsm::kDefaultLevel);
+}
+
+TEST(Codec, RoundTripAwkwardCoordinates) {
+  // Extents that are not exact in float, far from the origin, tiny and huge.
+  std::vector<Named> cases;
+  Mesh far = tsm_test::icosphere(2);
+  for (size_t i = 0; i < far.positions.size(); i += 3) far.positions[i] = far.positions[i] * 0.37f + 1000.3f;
+  cases.push_back({"far from origin", far});
+  Mesh tiny = tsm_test::random_soup(100, 150, 5);
+  for (float& x : tiny.positions) x *= 1e-30f;
+  cases.push_back({"tiny", tiny});
+  Mesh huge = tsm_test::random_soup(100, 150, 6);
+  for (float& x : huge.positions) x *= 1e37f;
+  cases.push_back({"huge", huge});
+  Mesh flat = tsm_test::grid_with_holes(8, 1);  // zero extent on one axis
+  cases.push_back({"flat", flat});
+  Mesh line;
+  for (int i = 0; i < 10; ++i) line.add_vertex(0.1f * static_cast<float>(i), 0.3f, -0.2f);
+  line.add_triangle(0, 5, 9);
+  cases.push_back({"collinear", line});
+  Mesh same;
+  for (int i = 0; i < 4; ++i) same.add_vertex(0.25f, 0.5f, 0.75f);
+  same.add_triangle(0, 1, 2);
+  same.add_triangle(3, 2, 1);
+  cases.push_back({"all coincident", same});
+  // max - min (1.01405269...) is not a float; rounded to the nearest float it
+  // is smaller than the true extent, so the vertex at max x lands one grid
+  // point beyond the last (2^q - 1) for q >= 24 unless the grid allows for it.
+  Mesh rounded;
+  rounded.add_vertex(-0x1.e3f482p-1f, 0.0f, 0.0f);  // -0.945224822
+  rounded.add_vertex(0x1.19eb4p-4f, 0.0f, 0.0f);    // 0.0688278675
+  rounded.add_vertex(0x1.19eb4p-4f, 0.5f, 0.0f);
+  rounded.add_triangle(0, 1, 2);
+  cases.push_back({"extent rounds down in float", rounded});
+  for (const Named& n : cases)
+    for (int q : {1, 8, 14, 24, 27, 30}) {
+      SCOPED_TRACE(std::string(n.name) + " q=" + std::to_string(q));
+      std::string bytes = encode_ok(n.mesh, q);
+      Mesh back;
+      tsm::Status s = tsm::decode(bytes, back);
+      ASSERT_TRUE(s.ok()) << s.to_string();
+      tsm::CompareResult r = tsm::compare_meshes(n.mesh, back, q);
+      EXPECT_TRUE(r.equal) << r.difference;
+      EXPECT_LE(r.max_position_error, error_bound(n.mesh, back, q));
+    }
+}
+
+TEST(Codec, EmptyAndPointSetOnly) {
+  Mesh empty;
+  std::string bytes = encode_ok(empty);
+  EXPECT_FALSE(bytes.empty());
+  Mesh back = tsm_test::icosphere(1);  // decode must clear what was there
+  ASSERT_TRUE(tsm::decode(bytes, back).ok());
+  EXPECT_EQ(back.vertex_count(), 0u);
+  EXPECT_EQ(back.face_count(), 0u);
+  EXPECT_TRUE(back.valid());
+
+  Mesh pts = point_set(40);
+  bytes = encode_ok(pts, 12);
+  ASSERT_TRUE(tsm::decode(bytes, back).ok());
+  EXPECT_EQ(back.vertex_count(), 40u);
+  EXPECT_EQ(back.face_count(), 0u);
+  EXPECT_TRUE(tsm::compare_meshes(pts, back, 12).equal);
+}
+
+TEST(Codec, Deterministic) {
+  for (const Named& n : families()) {
+    std::string a = encode_ok(n.mesh, 11, 9);
+    Mesh copy = n.mesh;
+    std::string b = encode_ok(copy, 11, 9);
+    EXPECT_EQ(a, b) << n.name;
+  }
+}
+
+TEST(Codec, InspectReportsHeader) {
+  Mesh m = tsm_test::copies(tsm_test::cube_quads(), 2);
+  std::string bytes = encode_ok(m, 10, 3);
+  tsm::FileInfo fi;
+  tsm::Status s = tsm::inspect(bytes, fi);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  EXPECT_EQ(fi.format_version, 1u);
+  EXPECT_EQ(fi.vertex_count, m.vertex_count());
+  EXPECT_EQ(fi.face_count, m.face_count());
+  EXPECT_EQ(fi.corner_count, m.corner_count());
+  EXPECT_EQ(fi.quantization_bits, 10);
+  EXPECT_EQ(fi.level, 3);
+  EXPECT_EQ(fi.segment_count, 1u);
+  EXPECT_EQ(fi.file_bytes, bytes.size());
+  tsm::BoundingBox box = tsm::bounding_box(m);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(fi.bbox_min[a], box.min[a]);
+  EXPECT_DOUBLE_EQ(fi.step, static_cast<double>(box.largest_extent()) / 1023.0);
+  ASSERT_FALSE(fi.sections.empty());
+  uint64_t stored = 0;
+  for (const tsm::SectionInfo& si : fi.sections) {
+    EXPECT_FALSE(si.name.empty());
+    EXPECT_TRUE(si.codec == "raw" || si.codec == "zstd") << si.codec;
+    if (si.codec == "raw") {
+      EXPECT_EQ(si.raw_bytes, si.stored_bytes);
+    }
+    stored += si.stored_bytes;
+  }
+  EXPECT_LT(stored, bytes.size());
+}
+
+// --- Argument errors -------------------------------------------------------
+
+TEST(Codec, InvalidOptionsRefused) {
+  Mesh m = tsm_test::icosphere(1);
+  std::string bytes = "untouched";
+  for (int q : {-1, 0, 31, 64}) {
+    tsm::Status s = tsm::encode(m, tsm::EncodeOptions{q, 6}, bytes);
+    EXPECT_EQ(s.code(), ErrorCode::invalid_argument) << "q=" << q;
+    EXPECT_NE(s.message().find("quantization"), std::string::npos) << s.message();
+  }
+  for (int level : {-1, 10, 100}) {
+    tsm::Status s = tsm::encode(m, tsm::EncodeOptions{14, level}, bytes);
+    EXPECT_EQ(s.code(), ErrorCode::invalid_argument) << "level=" << level;
+    EXPECT_NE(s.message().find("level"), std::string::npos) << s.message();
+  }
+}
+
+TEST(Codec, NonFinitePositionsRefused) {
+  for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                    -std::numeric_limits<float>::infinity()}) {
+    Mesh m = tsm_test::icosphere(1);
+    m.positions[7] = bad;
+    std::string bytes;
+    tsm::Status s = tsm::encode(m, tsm::EncodeOptions{}, bytes);
+    EXPECT_EQ(s.code(), ErrorCode::invalid_argument) << bad;
+    EXPECT_FALSE(s.message().empty());
+  }
+  // Finite coordinates whose extent overflows a float: refused up front, or
+  // an exact round trip.
+  Mesh m;
+  m.add_vertex(-3e38f, 0, 0);
+  m.add_vertex(3e38f, 1e38f, 0);
+  m.add_vertex(0, -2e38f, 3e38f);
+  m.add_triangle(0, 1, 2);
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{}, bytes);
+  if (!s.ok()) {
+    EXPECT_EQ(s.code(), ErrorCode::invalid_argument) << s.to_string();
+  } else {
+    Mesh back;
+    s = tsm::decode(bytes, back);
+    ASSERT_TRUE(s.ok()) << s.to_string();
+    EXPECT_TRUE(back.all_finite());
+    auto r = tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits);
+    EXPECT_TRUE(r.equal) << r.difference;
+  }
+}
+
+TEST(Codec, InvalidMeshRefused) {
+  std::string bytes;
+  Mesh out_of_range = tsm_test::icosphere(1);
+  out_of_range.indices[5] = static_cast<uint32_t>(out_of_range.vertex_count());
+  EXPECT_EQ(tsm::encode(out_of_range, tsm::EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+
+  Mesh ragged = tsm_test::icosphere(1);
+  ragged.positions.push_back(1.0f);
+  EXPECT_EQ(tsm::encode(ragged, tsm::EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+
+  Mesh offsets = tsm_test::icosphere(1);
+  offsets.face_offsets.back() += 1;
+  EXPECT_EQ(tsm::encode(offsets, tsm::EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+
+  Mesh start = tsm_test::icosphere(1);
+  start.face_offsets[0] = 1;
+  EXPECT_EQ(tsm::encode(start, tsm::EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+
+  Mesh decreasing = tsm_test::cube_quads();
+  std::swap(decreasing.face_offsets[2], decreasing.face_offsets[3]);
+  EXPECT_EQ(tsm::encode(decreasing, tsm::EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+}
+
+TEST(Codec, FaceWithNoCornersRefusedOrRoundTrips) {
+  // Mesh::valid() accepts a face with zero corners (equal offsets). The
+  // encoder must either refuse it up front or give back a file that decodes.
+  Mesh m = tsm_test::cube_quads();
+  m.face_offsets.push_back(m.face_offsets.back());
+  ASSERT_TRUE(m.valid());
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{}, bytes);
+  if (!s.ok()) {
+    EXPECT_EQ(s.code(), ErrorCode::invalid_argument) << s.to_string();
+    return;
+  }
+  Mesh back;
+  s = tsm::decode(bytes, back);
+  ASSERT_TRUE(s.ok()) << "encode accepted an empty face but its output does not decode: " << s.to_string();
+  auto r = tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits);
+  EXPECT_TRUE(r.equal) << r.difference;
+}
+
+// --- Hostile input ---------------------------------------------------------
+
+TEST(Codec, GarbageRefused) {
+  Mesh back;
+  EXPECT_EQ(tsm::decode("", back).code(), ErrorCode::corrupt_data);
+  EXPECT_EQ(tsm::decode("ply\nformat ascii 1.0\n", back).code(), ErrorCode::corrupt_data);
+  EXPECT_EQ(tsm::decode(std::string(100, '\0'), back).code(), ErrorCode::corrupt_data);
+  tsm::FileInfo fi;
+  EXPECT_EQ(tsm::inspect("TSM", fi).code(), ErrorCode::corrupt_data);
+}
+
+TEST(Codec, EveryTruncationRefused) {
+  Mesh m = tsm_test::cube_quads();
+  m.add_vertex(9, 9, 9);  // and an unreferenced vertex
+  std::string bytes = encode_ok(m, 8, 6);
+  ASSERT_LT(bytes.size(), 4096u);
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    std::string cut = bytes.substr(0, n);
+    Mesh back;
+    tsm::Status s = tsm::decode(cut, back);
+    EXPECT_FALSE(s.ok()) << "prefix of " << n << " of " << bytes.size() << " bytes decoded";
+    EXPECT_FALSE(s.message().empty());
+    tsm::FileInfo fi;
+    EXPECT_FALSE(tsm::inspect(cut, fi).ok()) << "prefix " << n;
+  }
+  // Trailing bytes are refused as well.
+  Mesh back;
+  EXPECT_EQ(tsm::decode(bytes + '\0', back).code(), ErrorCode::corrupt_data);
+  EXPECT_EQ(tsm::decode(bytes + bytes, back).code(), ErrorCode::corrupt_data);
+  ASSERT_TRUE(tsm::decode(bytes, back).ok());
+}
+
+TEST(Codec, RandomSingleByteCorruptionNeverCrashes) {
+  Mesh m = tsm_test::icosphere(2);
+  std::string bytes = encode_ok(m, 12, 6);
+  std::mt19937 rng(2024);
+  std::uniform_int_distribution<size_t> at(0, bytes.size() - 1);
+  std::uniform_int_distribution<int> flip(1, 255);
+  int refused = 0;
+  for (int i = 0; i < 2000; ++i) {
+    std::string bad = bytes;
+    size_t p = at(rng);
+    bad[p] = static_cast<char>(static_cast<uint8_t>(bad[p]) ^ static_cast<uint8_t>(flip(rng)));
+    Mesh back;
+    tsm::Status s = tsm::decode(bad, back);
+    if (s.ok()) {
+      std::string why;
+      EXPECT_TRUE(back.valid(&why)) << "byte " << p << ": decoded an invalid mesh: " << why;
+    } else {
+      ++refused;
+      EXPECT_NE(s.code(), ErrorCode::internal) << s.message();
+      EXPECT_FALSE(s.message().empty());
+    }
+    tsm::FileInfo fi;
+    (void)tsm::inspect(bad, fi);
+  }
+  // Checksums (header and section payloads) and the length checks catch
+  // nearly every change.
+  EXPECT_GT(refused, 1900);
+}
+
+// An encoded file split into its header fields (format-spec/FORMAT.md §2-3)
+// and its sections, so a test can change a header field and rebuild a file
+// with a valid header checksum. The extent is stored as f32 or f64 depending
+// on the format revision; its width is taken from the encoded file.
+struct Parsed {
+  uint16_t version = 0, flags = 0;
+  uint64_t vertices = 0, faces = 0, corners = 0;
+  uint8_t bits = 0, level = 0;
+  float origin[3] = {0, 0, 0};
+  double extent = 0;
+  size_t extent_bytes = 0;  // 4 or 8
+  uint64_t segments = 0;
+  std::string body;  // everything after the header checksum
+};
+
+void put_varint(std::string& s, uint64_t v) {
+  while (v >= 0x80) {
+    s.push_back(static_cast<char>((v & 0x7f) | 0x80));
+    v >>= 7;
+  }
+  s.push_back(static_cast<char>(v));
+}
+void put_le(std::string& s, uint64_t v, size_t n) {
+  for (size_t i = 0; i < n; ++i) s.push_back(static_cast<char>(v >> (8 * i)));
+}
+uint64_t get_le(const std::string& s, size_t& p, size_t n) {
+  uint64_t v = 0;
+  for (size_t i = 0; i < n; ++i) v |= static_cast<uint64_t>(static_cast<uint8_t>(s.at(p + i))) << (8 * i);
+  p += n;
+  return v;
+}
+uint64_t get_varint(const std::string& s, size_t& p) {
+  uint64_t v = 0;
+  for (int shift = 0;; shift += 7) {
+    uint8_t b = static_cast<uint8_t>(s.at(p++));
+    v |= static_cast<uint64_t>(b & 0x7f) << shift;
+    if (!(b & 0x80)) return v;
+  }
+}
+
+Parsed parse(const std::string& file) {
+  Parsed h;
+  size_t p = 4;
+  h.version = static_cast<uint16_t>(get_le(file, p, 2));
+  h.flags = static_cast<uint16_t>(get_le(file, p, 2));
+  size_t len = static_cast<size_t>(get_varint(file, p));
+  const size_t fields_end = p + len;
+  h.vertices = get_varint(file, p);
+  h.faces = get_varint(file, p);
+  h.corners = get_varint(file, p);
+  h.bits = static_cast<uint8_t>(file.at(p++));
+  h.level = static_cast<uint8_t>(file.at(p++));
+  for (float& o : h.origin) {
+    uint32_t b = static_cast<uint32_t>(get_le(file, p, 4));
+    std::memcpy(&o, &b, 4);
+  }
+  h.extent_bytes = fields_end - p - 1;  // the encoder writes segment_count 1: one byte
+  if (h.extent_bytes == 4) {
+    uint32_t b = static_cast<uint32_t>(get_le(file, p, 4));
+    float f;
+    std::memcpy(&f, &b, 4);
+    h.extent = f;
+  } else {
+    uint64_t b = get_le(file, p, h.extent_bytes);
+    std::memcpy(&h.extent, &b, 8);
+  }
+  h.segments = get_varint(file, p);
+  h.body = file.substr(p + 4);
+  return h;
+}
+
+std::string build(const Parsed& h) {
+  std::string s = "TSM\x1a";
+  put_le(s, h.version, 2);
+  put_le(s, h.flags, 2);
+  std::string f;
+  put_varint(f, h.vertices);
+  put_varint(f, h.faces);
+  put_varint(f, h.corners);
+  f.push_back(static_cast<char>(h.bits));
+  f.push_back(static_cast<char>(h.level));
+  for (float o : h.origin) {
+    uint32_t b;
+    std::memcpy(&b, &o, 4);
+    put_le(f, b, 4);
+  }
+  if (h.extent_bytes == 4) {
+    float e = static_cast<float>(h.extent);
+    uint32_t b;
+    std::memcpy(&b, &e, 4);
+    put_le(f, b, 4);
+  } else {
+    uint64_t b;
+    std::memcpy(&b, &h.extent, 8);
+    put_le(f, b, 8);
+  }
+  put_varint(f, h.segments);
+  put_varint(s, f.size());
+  s += f;
+  put_le(s, XXH32(s.data(), s.size(), 0), 4);
+  return s + h.body;
+}
+
+TEST(Codec, ForgingHelpersRebuildTheEncodersBytes) {
+  // Guards the helpers the tests below use.
+  Mesh m = tsm_test::icosphere(1);
+  std::string bytes = encode_ok(m, 9, 4);
+  Parsed h = parse(bytes);
+  ASSERT_TRUE(h.extent_bytes == 4 || h.extent_bytes == 8) << h.extent_bytes;
+  EXPECT_EQ(h.version, 1);
+  EXPECT_EQ(h.vertices, m.vertex_count());
+  EXPECT_EQ(h.faces, m.face_count());
+  EXPECT_EQ(h.corners, m.corner_count());
+  EXPECT_EQ(h.bits, 9);
+  EXPECT_EQ(h.level, 4);
+  EXPECT_EQ(h.segments, 1u);
+  tsm::BoundingBox box = tsm::bounding_box(m);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(h.origin[a], box.min[a]);
+  EXPECT_NEAR(h.extent, static_cast<double>(box.largest_extent()), 1e-6);
+  EXPECT_EQ(build(h), bytes);
+}
+
+TEST(Codec, ForgedHugeCountsRefusedQuickly) {
+  Mesh m = tsm_test::icosphere(1);
+  const Parsed good = parse(encode_ok(m, 9, 4));
+  for (int which = 0; which < 3; ++which) {
+    Parsed h = good;
+    (which == 0 ? h.vertices : which == 1 ? h.faces : h.corners) = 4000000000ull;
+    std::string forged = build(h);
+    auto t0 = std::chrono::steady_clock::now();
+    Mesh back;
+    tsm::Status s = tsm::decode(forged, back);
+    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(s.code(), ErrorCode::corrupt_data) << which << ": " << s.to_string();
+    EXPECT_LT(ms, 250.0) << which << ": took long enough to have allocated for the claimed counts";
+    EXPECT_LT(back.positions.capacity(), 100000u);
+    EXPECT_LT(back.indices.capacity(), 100000u);
+    // Inspect either refuses it or shows the claim, quickly.
+    tsm::FileInfo fi;
+    t0 = std::chrono::steady_clock::now();
+    tsm::Status si = tsm::inspect(forged, fi);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(ms, 250.0) << which;
+    if (si.ok()) {
+      EXPECT_EQ(which == 0 ? fi.vertex_count : which == 1 ? fi.face_count : fi.corner_count, 4000000000ull);
+    } else {
+      EXPECT_EQ(si.code(), ErrorCode::corrupt_data) << si.to_string();
+    }
+  }
+  // 2^64 - 1 of everything.
+  Parsed h = good;
+  h.vertices = h.faces = h.corners = ~uint64_t{0};
+  Mesh back;
+  EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
+}
+
+TEST(Codec, ForgedHeaderFieldsRefused) {
+  Mesh m = tsm_test::icosphere(1);
+  const Parsed good = parse(encode_ok(m, 9, 4));
+  Mesh back;
+  ASSERT_TRUE(tsm::decode(build(good), back).ok());
+  {
+    Parsed h = good;
+    h.version = 2;
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::unsupported);
+  }
+  {
+    Parsed h = good;
+    h.flags = 1;
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
+  }
+  for (int bits : {0, 31, 255}) {
+    Parsed h = good;
+    h.bits = static_cast<uint8_t>(bits);
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << bits;
+  }
+  {
+    Parsed h = good;
+    h.segments = 0;
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
+  }
+  {
+    // Header checksum.
+    std::string f = build(good);
+    f[10] = static_cast<char>(f[10] ^ 1);
+    EXPECT_EQ(tsm::decode(f, back).code(), ErrorCode::corrupt_data);
+  }
+  for (int which = 0; which < 3; ++which) {
+    // One vertex, face or corner fewer or more than the streams hold.
+    for (int delta : {-1, 1}) {
+      Parsed h = good;
+      uint64_t& c = which == 0 ? h.vertices : which == 1 ? h.faces : h.corners;
+      c = static_cast<uint64_t>(static_cast<int64_t>(c) + delta);
+      tsm::Status s = tsm::decode(build(h), back);
+      EXPECT_EQ(s.code(), ErrorCode::corrupt_data) << which << " " << delta << ": " << s.to_string();
+    }
+  }
+}
+
+TEST(Codec, ForgedNonFiniteGridRefused) {
+  // The encoder never writes a non-finite or negative grid; a decoder given
+  // one must not hand back NaN or infinite positions as a valid mesh.
+  Mesh m = tsm_test::icosphere(1);
+  const Parsed good = parse(encode_ok(m, 9, 4));
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (int which = 0; which < 7; ++which) {
+    Parsed h = good;
+    if (which == 0) h.extent = nan;
+    if (which == 1) h.extent = inf;
+    if (which == 2) h.origin[1] = std::numeric_limits<float>::quiet_NaN();
+    if (which == 3) h.origin[2] = -std::numeric_limits<float>::infinity();
+    if (which == 4) h.extent = 1e300;  // finite as f64, beyond any float
+    if (which == 5) {                  // each finite, but origin + extent overflows a float
+      h.origin[0] = 3e38f;
+      h.extent = 6e38;
+    }
+    if (which == 6) h.extent = -1.0;
+    Mesh back;
+    tsm::Status s = tsm::decode(build(h), back);
+    EXPECT_TRUE(!s.ok() || back.all_finite()) << "case " << which << ": decoded non-finite positions";
+    if (!s.ok()) {
+      EXPECT_EQ(s.code(), ErrorCode::corrupt_data) << s.to_string();
+    }
+  }
+}
+
+TEST(Codec, DecodeLimits) {
+  Mesh m = tsm_test::icosphere(2);
+  std::string bytes = encode_ok(m);
+  Mesh back;
+  tsm::DecodeOptions o;
+  o.max_vertices = m.vertex_count() - 1;
+  tsm::Status s = tsm::decode(bytes, back, o);
+  EXPECT_EQ(s.code(), ErrorCode::limit_exceeded) << s.to_string();
+  EXPECT_NE(s.message().find(std::to_string(m.vertex_count())), std::string::npos) << s.message();
+  o.max_vertices = m.vertex_count();
+  EXPECT_TRUE(tsm::decode(bytes, back, o).ok());
+
+  o = tsm::DecodeOptions();
+  o.max_faces = m.face_count() - 1;
+  s = tsm::decode(bytes, back, o);
+  EXPECT_EQ(s.code(), ErrorCode::limit_exceeded) << s.to_string();
+  o.max_faces = m.face_count();
+  EXPECT_TRUE(tsm::decode(bytes, back, o).ok());
+  EXPECT_TRUE(tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits).equal);
+
+  // A limit is checked against the header before the payload matters: a
+  // forged huge claim reports the limit.
+  Parsed h = parse(bytes);
+  h.vertices = 4000000000ull;
+  o = tsm::DecodeOptions();
+  o.max_vertices = 1000000;
+  EXPECT_EQ(tsm::decode(build(h), back, o).code(), ErrorCode::limit_exceeded);
+}
+
+}  // namespace
