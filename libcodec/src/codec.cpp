@@ -127,7 +127,9 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
   for (size_t i = 0; i < q.size(); ++i) {
     double x = static_cast<double>(h.origin[i % 3]) + static_cast<double>(q[i]) * step;
-    if (!(std::fabs(x) <= kFloatMax)) return corrupt("a decoded coordinate is beyond the float range");
+    // A grid point may lie up to half a step past the largest input
+    // coordinate; near the float limit, clamp (the input was within range).
+    x = x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
     out.positions[i] = static_cast<float>(x);
   }
   return Status::Ok();

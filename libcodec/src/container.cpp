@@ -149,6 +149,10 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
     if (checksum32(stored) != csum)
       return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) +
                      ": checksum mismatch (the file is damaged)");
+    for (const Section& prev : sections)
+      if (prev.id == id)
+        return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) +
+                       " appears twice");
     Section s;
     s.id = id;
     s.codec = static_cast<SectionCodec>(codec);
