@@ -13,26 +13,6 @@
 
 namespace tsm {
 
-namespace {
-
-struct UnionFind {
-  std::vector<uint32_t> p;
-  explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
-  uint32_t find(uint32_t x) {
-    while (p[x] != x) x = p[x] = p[p[x]];
-    return x;
-  }
-  bool unite(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a == b) return false;
-    p[a] = b;
-    return true;
-  }
-};
-
-}  // namespace
-
 ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
                            const std::vector<uint32_t>& triangles, std::vector<uint8_t>& cut_he,
                            std::vector<uint32_t>& local) {

@@ -24,6 +24,27 @@ constexpr uint32_t kNone = 0xFFFFFFFFu;
 inline uint32_t he_next(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
 inline uint32_t he_prev(uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
 
+// Union-find over dense ids; unite() keeps the smaller id as the set's root,
+// so the root of a set is its smallest member.
+struct UnionFind {
+  std::vector<uint32_t> p;
+  explicit UnionFind(size_t n) : p(n) {
+    for (size_t i = 0; i < n; ++i) p[i] = static_cast<uint32_t>(i);
+  }
+  uint32_t find(uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  }
+  bool unite(uint32_t a, uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    if (a < b) p[b] = a;
+    else p[a] = b;
+    return true;
+  }
+};
+
 enum class VertexKind : uint8_t { real = 0, duplicate = 1, virtual_ = 2 };
 
 // Stage 1 output: closed, oriented, manifold triangle components.

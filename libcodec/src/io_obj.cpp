@@ -43,19 +43,6 @@ namespace {
 
 constexpr size_t kMaxIndexableVertices = std::numeric_limits<uint32_t>::max();
 
-// A token for an error message: at most 32 characters, non-printable bytes
-// shown as '?', quoted.
-std::string quote(std::string_view s) {
-  std::string out = "'";
-  size_t n = s.size() < 32 ? s.size() : 32;
-  for (size_t i = 0; i < n; ++i) {
-    unsigned char c = static_cast<unsigned char>(s[i]);
-    out.push_back(c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?');
-  }
-  if (n < s.size()) out += "...";
-  out += "'";
-  return out;
-}
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
 bool is_line_end(char c) { return c == '\n' || c == '\r'; }

@@ -32,17 +32,6 @@ namespace {
 
 constexpr uint64_t kMaxIndexableVertices = std::numeric_limits<uint32_t>::max();
 
-std::string quote(std::string_view s) {
-  std::string out = "'";
-  size_t n = s.size() < 32 ? s.size() : 32;
-  for (size_t i = 0; i < n; ++i) {
-    unsigned char c = static_cast<unsigned char>(s[i]);
-    out.push_back(c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?');
-  }
-  if (n < s.size()) out += "...";
-  out += "'";
-  return out;
-}
 
 bool iequals(std::string_view a, const char* b) {
   size_t n = std::strlen(b);

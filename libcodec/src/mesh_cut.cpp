@@ -23,20 +23,6 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (static_cast<uint64_t>(a) << 32) | b : (static_cast<uint64_t>(b) << 32) | a;
 }
 
-struct UnionFind {
-  std::vector<uint32_t> p;
-  explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
-  uint32_t find(uint32_t x) {
-    while (p[x] != x) x = p[x] = p[p[x]];
-    return x;
-  }
-  void unite(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) p[std::max(a, b)] = std::min(a, b);
-  }
-};
-
 // Sorted (key, half-edge) pairs of all half-edges, for pairing and counting.
 std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32_t>& tri) {
   std::vector<std::pair<uint64_t, uint32_t>> e(tri.size());

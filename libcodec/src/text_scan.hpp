@@ -106,6 +106,20 @@ class TextCursor {
   const std::string& name_;
 };
 
+// A token for an error message: at most 32 characters, non-printable bytes
+// shown as '?', quoted.
+inline std::string quote(std::string_view s) {
+  std::string out = "'";
+  size_t n = s.size() < 32 ? s.size() : 32;
+  for (size_t i = 0; i < n; ++i) {
+    unsigned char c = static_cast<unsigned char>(s[i]);
+    out.push_back(c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?');
+  }
+  if (n < s.size()) out += "...";
+  out += "'";
+  return out;
+}
+
 // "NAME: byte OFFSET: what" as a parse_error, for binary formats.
 inline Status binary_error(const std::string& name, size_t offset, const std::string& what) {
   return Status(ErrorCode::parse_error, name + ": byte " + std::to_string(offset) + ": " + what);

@@ -14,26 +14,6 @@
 
 namespace tsm {
 
-namespace {
-
-struct UnionFind {
-  std::vector<uint32_t> p;
-  explicit UnionFind(size_t n) : p(n) { std::iota(p.begin(), p.end(), 0u); }
-  uint32_t find(uint32_t x) {
-    while (p[x] != x) x = p[x] = p[p[x]];
-    return x;
-  }
-  bool unite(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a == b) return false;
-    p[a] = b;
-    return true;
-  }
-};
-
-}  // namespace
-
 VertexForest build_vertex_tree(const CutMesh& m) {
   const uint32_t nv = m.vertex_count;
   const uint32_t nh = static_cast<uint32_t>(m.tri.size());
