@@ -24,13 +24,8 @@ using tsm::ReadInfo;
 using tsm::ReadOptions;
 using tsm::Status;
 
-using Faces = std::vector<std::vector<uint32_t>>;
-
-Faces faces_of(const Mesh& m) {
-  Faces out;
-  for (size_t f = 0; f < m.face_count(); ++f) out.emplace_back(m.face(f), m.face(f) + m.face_size(f));
-  return out;
-}
+using tsm_test::Faces;
+using tsm_test::faces_of;
 
 std::vector<float> positions_of(const Mesh& m) { return m.positions; }
 

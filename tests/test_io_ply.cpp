@@ -27,13 +27,8 @@ using tsm::ReadOptions;
 using tsm::Status;
 using tsm::WriteOptions;
 
-using Faces = std::vector<std::vector<uint32_t>>;
-
-Faces faces_of(const Mesh& m) {
-  Faces out;
-  for (size_t f = 0; f < m.face_count(); ++f) out.emplace_back(m.face(f), m.face(f) + m.face_size(f));
-  return out;
-}
+using tsm_test::Faces;
+using tsm_test::faces_of;
 
 uint32_t bits(float x) {
   uint32_t b;

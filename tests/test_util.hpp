@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "tsm/mesh.hpp"
 
@@ -17,6 +18,14 @@ inline std::string corpus_dir() {
 }
 inline bool have_corpus() { return std::filesystem::is_directory(corpus_dir()); }
 inline std::string corpus_file(const std::string& rel) { return corpus_dir() + "/" + rel; }
+
+// Faces as corner lists, for exact comparisons.
+using Faces = std::vector<std::vector<uint32_t>>;
+inline Faces faces_of(const tsm::Mesh& m) {
+  Faces out;
+  for (size_t f = 0; f < m.face_count(); ++f) out.emplace_back(m.face(f), m.face(f) + m.face_size(f));
+  return out;
+}
 
 // A fresh empty folder under the system temp dir, removed by the destructor.
 struct TempDir {

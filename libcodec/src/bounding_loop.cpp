@@ -127,25 +127,23 @@ bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEnd
   std::vector<uint32_t> fill(tree_start.begin(), tree_start.end() - 1);
   for (uint32_t v = 1; v < n; ++v) tree_to[fill[v]++] = parent[v];  // parent slot first
   for (uint32_t v = 1; v < n; ++v) tree_to[fill[parent[v]]++] = v;
+  // The tree slot at w pointing back to its neighbour v: the parent slot (0)
+  // if v is w's parent, else v's child slot (children sorted by position).
+  auto slot_back = [&](uint32_t v, uint32_t w) -> uint32_t {
+    if (w != 0 && parent[w] == v) return 0;
+    uint32_t lo = tree_start[w] + (w != 0 ? 1 : 0), hi = tree_start[w + 1];
+    auto it = std::lower_bound(tree_to.begin() + lo, tree_to.begin() + hi, v);
+    if (it == tree_to.begin() + hi || *it != v) return kNone;
+    return static_cast<uint32_t>(it - tree_to.begin()) - tree_start[w];
+  };
   // Tree tour: position q arrives at vertex corner_v[q] after slot corner_s[q].
   std::vector<uint32_t> corner_v(tour), corner_s(tour);
   {
-    // Reverse slot lookup for tree edges: slot of v -> slot at the neighbour.
     uint32_t v = 0, s = 0;  // leaving the root by slot 0 (first child)
     for (uint32_t step = 0; step < tour; ++step) {
       uint32_t w = tree_to[tree_start[v] + s];
-      // The slot at w pointing back to v: the parent slot (0) if v is w's
-      // parent, else the child slot of v at w.
-      uint32_t back;
-      if (w != 0 && parent[w] == v) {
-        back = 0;
-      } else {
-        // v is a child of w: find it (children are sorted by pre-order position).
-        uint32_t lo = tree_start[w] + (w != 0 ? 1 : 0), hi = tree_start[w + 1];
-        auto it = std::lower_bound(tree_to.begin() + lo, tree_to.begin() + hi, v);
-        if (it == tree_to.begin() + hi || *it != v) return false;
-        back = static_cast<uint32_t>(it - tree_to.begin()) - tree_start[w];
-      }
+      uint32_t back = slot_back(v, w);
+      if (back == kNone) return false;
       uint32_t q = (step + 1) % tour;
       corner_v[q] = w;
       corner_s[q] = back;
@@ -190,14 +188,8 @@ bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEnd
     for (uint32_t v = 0; v < n; ++v)
       for (uint32_t s = 0; s < degree[v]; ++s) {
         uint32_t w = tree_to[tree_start[v] + s];
-        uint32_t ws;
-        if (w != 0 && parent[w] == v) {
-          ws = 0;
-        } else {
-          uint32_t lo = tree_start[w] + (w != 0 ? 1 : 0), hi = tree_start[w + 1];
-          ws = static_cast<uint32_t>(std::lower_bound(tree_to.begin() + lo, tree_to.begin() + hi, v) - tree_to.begin()) -
-               tree_start[w];
-        }
+        uint32_t ws = slot_back(v, w);
+        if (ws == kNone) return false;
         back[tree_slot_pos[tree_start[v] + s]] = tree_slot_pos[tree_start[w] + ws];
       }
   }

@@ -56,6 +56,16 @@ Status check_limits(const Header& h, const DecodeOptions& options) {
   return Status::Ok();
 }
 
+// The connectivity of a parsed container: faces into `out`, tree parents of
+// the output vertices into `parent` (shared by decode and inspect).
+Status decode_topology(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
+                       std::vector<uint32_t>& parent, ConnectivityStats* stats) {
+  TSM_RETURN_IF_ERROR(check_limits(h, options));
+  ConnectivityStreams cs;
+  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
+  return decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, parent, stats);
+}
+
 }  // namespace
 
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
@@ -113,13 +123,10 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   Header h;
   std::vector<Section> sections;
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  TSM_RETURN_IF_ERROR(check_limits(h, options));
-  ConnectivityStreams cs;
-  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
   const Section* geo = find_section(sections, kSectionGeometry);
   if (!geo) return corrupt("the geometry section is missing");
   std::vector<uint32_t> parent;
-  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, parent));
+  TSM_RETURN_IF_ERROR(decode_topology(h, sections, options, out, parent, nullptr));
   std::vector<uint32_t> q;
   TSM_RETURN_IF_ERROR(decode_geometry(geo->data, parent, h.quantization_bits, q));
   const double step = grid_step(h);
@@ -165,13 +172,10 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     else
       info.other_bytes += s.stored_bytes;
   }
-  TSM_RETURN_IF_ERROR(check_limits(h, DecodeOptions()));
-  ConnectivityStreams cs;
-  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
   Mesh faces;
   std::vector<uint32_t> parent;
   ConnectivityStats st;
-  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, faces, parent, &st));
+  TSM_RETURN_IF_ERROR(decode_topology(h, sections, DecodeOptions(), faces, parent, &st));
   info.components = st.components;
   info.vertex_runs = st.vertex_runs;
   info.triangle_runs = st.triangle_runs;
