@@ -107,9 +107,10 @@ ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
 }
 
 bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
-                  std::vector<uint32_t>& loop) {
+                  std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin) {
   const uint32_t n = static_cast<uint32_t>(parent.size());
   loop.clear();
+  loop_twin.clear();
   if (n < 2) return true;
   // Tree slots per vertex in clockwise order: parent first, then children in
   // pre-order (= clockwise) order. slot_start[v] .. slot_start[v+1].
@@ -198,16 +199,28 @@ bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEnd
   std::vector<uint32_t> owner(total);
   for (uint32_t v = 0; v < n; ++v)
     for (uint32_t s = start[v]; s < start[v + 1]; ++s) owner[s] = v;
+  // Loop position p leaves by slot s; the same edge walked the other way is
+  // the position that leaves by back[s] (its twin on the cut surface).
   loop.reserve(total);
+  std::vector<uint32_t> left_at(total, kNone), slot_of;
+  slot_of.reserve(total);
   uint32_t s = start[0];
   do {
-    if (loop.size() >= total) return false;
+    if (loop.size() >= total || left_at[s] != kNone) return false;
+    left_at[s] = static_cast<uint32_t>(loop.size());
+    slot_of.push_back(s);
     loop.push_back(owner[s]);
     uint32_t r = back[s];
     uint32_t w = owner[r];
     s = r + 1 == start[w + 1] ? start[w] : r + 1;
   } while (s != start[0]);
-  return loop.size() == total;
+  if (loop.size() != total) return false;
+  loop_twin.resize(total);
+  for (uint32_t p = 0; p < total; ++p) {
+    loop_twin[p] = left_at[back[slot_of[p]]];
+    if (loop_twin[p] == kNone) return false;
+  }
+  return true;
 }
 
 }  // namespace tsm

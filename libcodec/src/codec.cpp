@@ -2,6 +2,7 @@
 // stages (seed 004 §3-4), quantize positions on the Draco grid (design notes
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -59,11 +60,11 @@ Status check_limits(const Header& h, const DecodeOptions& options) {
 // The connectivity of a parsed container: faces into `out`, tree parents of
 // the output vertices into `parent` (shared by decode and inspect).
 Status decode_topology(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
-                       std::vector<uint32_t>& parent, ConnectivityStats* stats) {
+                       GeometryLayout& layout, ConnectivityStats* stats) {
   TSM_RETURN_IF_ERROR(check_limits(h, options));
   ConnectivityStreams cs;
   TSM_RETURN_IF_ERROR(read_streams(sections, cs));
-  return decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, parent, stats);
+  return decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, layout, stats);
 }
 
 }  // namespace
@@ -93,21 +94,38 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   if (!std::isfinite(h.extent))
     return Status(ErrorCode::invalid_argument, "mesh extent overflows a float; scale the mesh down");
 
-  ConnectivityEncoding ce;
-  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce));
-
   Grid grid;
   grid.bits = options.quantization_bits;
   for (int a = 0; a < 3; ++a) grid.origin[a] = h.origin[a];
   grid.step = grid_step(h);
   const int64_t qmax = (int64_t{1} << options.quantization_bits) - 1;
-  std::vector<uint32_t> q(3 * mesh.vertex_count());
-  for (size_t i = 0; i < ce.vertex_order.size(); ++i)
-    for (int a = 0; a < 3; ++a) {
-      int64_t x = grid.quantize(mesh.positions[3 * static_cast<size_t>(ce.vertex_order[i]) + a], a);
-      q[3 * i + a] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
-    }
-  std::string geometry = encode_geometry(q, ce.vertex_parent, options.quantization_bits);
+  std::vector<uint32_t> qin(3 * mesh.vertex_count());  // by input id
+  for (size_t i = 0; i < qin.size(); ++i) {
+    int64_t x = grid.quantize(mesh.positions[i], static_cast<int>(i % 3));
+    qin[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
+  }
+  auto reorder = [&](const ConnectivityEncoding& c) {  // by output id
+    std::vector<uint32_t> q(qin.size());
+    for (size_t v = 0; v < c.vertex_order.size(); ++v)
+      for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(c.vertex_order[v]) + a];
+    return q;
+  };
+
+  ConnectivityEncoding ce;
+  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce));
+  std::vector<uint32_t> q = reorder(ce);
+  // Vertices on no triangle go last, ordered by a nearby surface vertex
+  // that predicts them: a second pass with those anchors.
+  std::vector<uint32_t> anchor = find_anchors(ce.layout, q, options.quantization_bits);
+  if (std::any_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) {
+    std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
+    for (size_t v = 0; v < anchor.size(); ++v) by_input[ce.vertex_order[v]] = anchor[v];
+    ce = ConnectivityEncoding();
+    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, &by_input));
+    q = reorder(ce);
+  }
+  const Lattice lattice = find_lattice(q, static_cast<uint32_t>(mesh.vertex_count()));
+  std::string geometry = encode_geometry(ce.layout, q, options.quantization_bits, options.level, &lattice);
 
   ContainerWriter cw(h);
   cw.add_section(kSectionVertexTree, ce.streams.vertex_tree, 0);
@@ -125,10 +143,10 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
   const Section* geo = find_section(sections, kSectionGeometry);
   if (!geo) return corrupt("the geometry section is missing");
-  std::vector<uint32_t> parent;
-  TSM_RETURN_IF_ERROR(decode_topology(h, sections, options, out, parent, nullptr));
+  GeometryLayout layout;
+  TSM_RETURN_IF_ERROR(decode_topology(h, sections, options, out, layout, nullptr));
   std::vector<uint32_t> q;
-  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, parent, h.quantization_bits, q));
+  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, layout, h.quantization_bits, q));
   const double step = grid_step(h);
   out.positions.resize(q.size());
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
@@ -173,9 +191,9 @@ Status inspect(std::string_view bytes, FileInfo& info) {
       info.other_bytes += s.stored_bytes;
   }
   Mesh faces;
-  std::vector<uint32_t> parent;
+  GeometryLayout layout;
   ConnectivityStats st;
-  TSM_RETURN_IF_ERROR(decode_topology(h, sections, DecodeOptions(), faces, parent, &st));
+  TSM_RETURN_IF_ERROR(decode_topology(h, sections, DecodeOptions(), faces, layout, &st));
   info.components = st.components;
   info.vertex_runs = st.vertex_runs;
   info.triangle_runs = st.triangle_runs;

@@ -40,12 +40,12 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 
 }  // namespace
 
-Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const std::vector<uint32_t>* anchor) {
   out = ConnectivityEncoding();
   if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
     return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
   const PreparedInput prep = prepare_input(mesh);
-  const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()));
+  const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), anchor);
   const VertexForest f = build_vertex_tree(m);
 
   RangeEncoder ev, et, eo;
@@ -73,6 +73,10 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
   std::vector<uint32_t> pos_of(m.vertex_count);
   for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
   std::vector<uint32_t> last_child(f.order.size(), kNone);
+  // Triangles in decode order, and how each is rotated to start at its gate.
+  std::vector<uint32_t> dec_tri, dec_of(m.triangle_count(), kNone);
+  std::vector<uint8_t> rot(m.triangle_count(), 0);
+  dec_tri.reserve(m.triangle_count());
   for (uint32_t p = 0; p < f.order.size(); ++p)
     if (f.parent[p] != kNone) last_child[f.parent[p]] = p;
 
@@ -111,6 +115,18 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
       return Status(ErrorCode::internal, "component " + std::to_string(c) + ": triangle tree covers " +
                                              std::to_string(tr.triangle_order.size()) + " of " +
                                              std::to_string(comp_tris.size()) + " triangles");
+    for (size_t k = 0; k < tr.triangle_order.size(); ++k) {
+      const uint32_t t = tr.triangle_order[k];
+      dec_of[t] = static_cast<uint32_t>(dec_tri.size());
+      dec_tri.push_back(t);
+      rot[t] = tr.parent_slot[k];
+    }
+    {  // The root triangle starts at loop position root - 1, as the decoder emits it.
+      const uint32_t t = tr.triangle_order[0], L = static_cast<uint32_t>(cl.loop.size());
+      const uint32_t first = cl.loop[(tr.root + L - 1) % L];
+      for (uint8_t j = 0; j < 3; ++j)
+        if (m.tri[3 * t + j] == first) rot[t] = j;
+    }
     tm.root.encode(et, tr.root);
     size_t bit = 0;
     int prev_end = 1;
@@ -159,10 +175,27 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
   }
   if (out.vertex_order.size() != mesh.vertex_count())
     return Status(ErrorCode::internal, "vertex numbering lost vertices");
-  out.vertex_parent.resize(out.vertex_order.size());
+  GeometryLayout& g = out.layout;
+  g.vertex_count = static_cast<uint32_t>(out.vertex_order.size());
+  g.parent.assign(g.vertex_count, kNone);
   for (uint32_t p = 0; p < P; ++p)
     if (m.kind[f.order[p]] != VertexKind::virtual_ && first_pos[m.source[f.order[p]]] == p)
-      out.vertex_parent[out_id[p]] = f.parent[p] == kNone ? kNone : out_id[f.parent[p]];
+      g.parent[out_id[p]] = f.parent[p] == kNone ? kNone : out_id[f.parent[p]];
+  g.vertex = out_id;
+  g.anchor.assign(g.vertex_count, kNone);
+  if (anchor)
+    for (uint32_t v = 0; v < g.vertex_count; ++v) g.anchor[v] = (*anchor)[out.vertex_order[v]];
+  if (dec_tri.size() != m.triangle_count()) return Status(ErrorCode::internal, "triangle trees lost triangles");
+  g.tri.resize(3 * dec_tri.size());
+  g.twin.resize(3 * dec_tri.size());
+  for (size_t k = 0; k < dec_tri.size(); ++k) {
+    const uint32_t t = dec_tri[k];
+    for (uint32_t e = 0; e < 3; ++e) {
+      g.tri[3 * k + e] = pos_of[m.tri[3 * t + (rot[t] + e) % 3]];
+      const uint32_t h = m.twin[3 * t + (rot[t] + e) % 3], t2 = h / 3;
+      g.twin[3 * k + e] = 3 * dec_of[t2] + (h % 3 + 3 - rot[t2]) % 3;
+    }
+  }
 
   om.count.encode(eo, static_cast<uint32_t>(virtual_pos.size()));
   uint32_t prev = 0;
@@ -198,7 +231,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out) {
 }
 
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
-                           uint64_t corner_count, Mesh& out, std::vector<uint32_t>& vertex_parent,
+                           uint64_t corner_count, Mesh& out, GeometryLayout& layout,
                            ConnectivityStats* stats) {
   RangeDecoder dv(in.vertex_tree), dt(in.triangle_tree), dop(in.topology);
   VertexTreeModels vm;
@@ -220,7 +253,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   std::vector<uint32_t> tri_vertex;   // decoded triangles, pre-order positions
   std::vector<uint32_t> tri_parent;   // global decode index of the parent triangle
   std::vector<uint8_t> tri_slot, tri_glued;
-  std::vector<uint32_t> local_parent, loop, tri_pos, tparent;
+  std::vector<uint32_t> local_parent, loop, loop_twin, tri_pos, tparent, edge_loop, loop_he;
+  std::vector<uint32_t>& twin = layout.twin;  // per decoded half-edge
+  twin.clear();
   std::vector<uint8_t> tslot;
   std::vector<uint32_t> stack;
   int prev_leaf = 1;
@@ -275,7 +310,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     }
     st.jump_edges += nj / 2;
     if (overrun()) return corrupt("topology stream is truncated");
-    if (!decoder_loop(local_parent, jumps, loop)) return corrupt("jump edges do not give one bounding loop");
+    if (!decoder_loop(local_parent, jumps, loop, loop_twin)) return corrupt("jump edges do not give one bounding loop");
     const uint32_t L = static_cast<uint32_t>(loop.size());
     // Triangle tree.
     TriangleRuns tr;
@@ -303,8 +338,25 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     }
     st.triangle_runs += tr.march.size();
     st.marching_bits += tr.bits.size();
-    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, tri_pos, tparent, tslot));
+    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, tri_pos, tparent, tslot, edge_loop));
     const uint32_t T = L - 2, base = static_cast<uint32_t>(tri_parent.size());
+    // Half-edges across: parent and child share the gate; each loop edge
+    // meets the loop edge that walks the same cut edge the other way.
+    twin.resize(3 * (static_cast<size_t>(base) + T), kNone);
+    loop_he.assign(L, kNone);
+    for (uint32_t h = 0; h < 3 * T; ++h)
+      if (edge_loop[h] != kNone) {
+        if (loop_he[edge_loop[h]] != kNone) return corrupt("a loop edge belongs to two triangles");
+        loop_he[edge_loop[h]] = 3 * base + h;
+      }
+    for (uint32_t h = 0; h < 3 * T; ++h) {
+      if (edge_loop[h] != kNone) twin[3 * size_t{base} + h] = loop_he[loop_twin[edge_loop[h]]];
+      if (h % 3 == 0 && h > 0) {
+        uint32_t par = 3 * (base + tparent[h / 3]) + tslot[h / 3];
+        twin[3 * size_t{base} + h] = par;
+        twin[par] = 3 * base + h;
+      }
+    }
     for (uint32_t k = 0; k < T; ++k) {
       for (int i = 0; i < 3; ++i) tri_vertex.push_back(start + loop[tri_pos[3 * k + i]]);
       tri_parent.push_back(tparent[k] == kNone ? kNone : base + tparent[k]);
@@ -356,14 +408,19 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (next_id != vertex_count)
     return corrupt("connectivity gives " + std::to_string(next_id) + " vertices, the header says " +
                    std::to_string(vertex_count));
-  vertex_parent.assign(vertex_count, kNone);
+  for (size_t h = 0; h < twin.size(); ++h)
+    if (twin[h] >= twin.size() || twin[twin[h]] != h) return corrupt("the cut surface does not close");
+  layout.vertex_count = static_cast<uint32_t>(vertex_count);
+  layout.parent.assign(vertex_count, kNone);
   for (uint32_t p = 0; p < P; ++p) {
     if (is_virtual[p] || stitch_to[p] != kNone) continue;
     if (parent[p] != kNone) {
       if (is_virtual[parent[p]]) return corrupt("a virtual vertex has children");
-      vertex_parent[out_id[p]] = out_id[parent[p]];
+      layout.parent[out_id[p]] = out_id[parent[p]];
     }
   }
+  layout.vertex = out_id;
+  layout.tri = tri_vertex;
 
   // Faces: triangles in decode order, polygons glued along flagged edges.
   out.face_offsets.assign(1, 0);

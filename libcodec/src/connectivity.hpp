@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry_predict.hpp"
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
@@ -74,7 +75,9 @@ struct PreparedInput {
 };
 
 PreparedInput prepare_input(const Mesh& mesh);
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count);
+// isolated_key (optional, per input vertex) orders the vertices on no triangle.
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count,
+                 const std::vector<uint32_t>* isolated_key = nullptr);
 
 // Stage 2: the vertex spanning forest, in pre-order.
 struct VertexForest {
@@ -112,9 +115,11 @@ ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
                            std::vector<uint32_t>& local);
 
 // Decoder: the loop of a component from its tree (parent positions, local to
-// the component) and jump endpoints. Returns false on inconsistent input.
+// the component) and jump endpoints; loop_twin[p] is the loop position that
+// walks loop edge p the other way (the two sides of a cut edge). Returns
+// false on inconsistent input.
 bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
-                  std::vector<uint32_t>& loop);
+                  std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin);
 
 // Stage 4: the triangle tree (seed 004 §4).
 struct TriangleRuns {
@@ -132,8 +137,12 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
 // Decoder: triangles as loop-position triples, in decode order; each
 // non-root triangle's first edge is the one shared with its parent.
 // parent[k] is the decode index of triangle k's parent (kNone for the root).
+// edge_loop[3k + e] is the loop position p when edge e of triangle k is loop
+// edge p (loop[p] -> loop[p+1]), kNone when it is shared with a triangle of
+// the same tree.
 Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, std::vector<uint32_t>& tri_pos,
-                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge);
+                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge,
+                            std::vector<uint32_t>& edge_loop);
 
 // Stage 5: the whole connectivity, coded.
 struct ConnectivityStats {
@@ -151,19 +160,23 @@ struct ConnectivityStreams {
 
 struct ConnectivityEncoding {
   ConnectivityStreams streams;
-  // Output vertex id (decoded order) -> input vertex id. Geometry is coded in this order.
+  // Output vertex id (vertex-tree pre-order) -> input vertex id.
   std::vector<uint32_t> vertex_order;
-  // Per output vertex, its tree parent's output id (kNone at roots), for predictors.
-  std::vector<uint32_t> vertex_parent;
+  // The cut surface as the decoder will rebuild it, for the geometry coder.
+  GeometryLayout layout;
   ConnectivityStats stats;
 };
 
-Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out);
+// anchor (optional, per input vertex): for a vertex on no triangle, the
+// output id of a nearby surface vertex (kNone if none), which orders those
+// vertices and lets the geometry coder predict them from it.
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out,
+                           const std::vector<uint32_t>* anchor = nullptr);
 // Fills out.face_offsets / out.indices (positions are the geometry stage's
-// job). vertex_parent gets each output vertex's tree parent (kNone at roots).
-// The counts come from the header and are checked against what the streams say.
+// job) and the layout the geometry decoder walks. The counts come from the
+// header and are checked against what the streams say.
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
-                           uint64_t corner_count, Mesh& out, std::vector<uint32_t>& vertex_parent,
+                           uint64_t corner_count, Mesh& out, GeometryLayout& layout,
                            ConnectivityStats* stats = nullptr);
 
 }  // namespace tsm

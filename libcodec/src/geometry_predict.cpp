@@ -1,79 +1,634 @@
-// Geometry prediction and residual coding (seed 004 §3.2, design notes §6).
-// Positions are quantized on the Draco grid and visited in decoded vertex
-// order (vertex-tree pre-order). Each vertex is predicted from its tree
-// parent (the K = 1 case of the paper's ancestor predictor); roots are
-// predicted from the previous root. Residuals are coded per axis with an
-// adaptive signed-integer model whose context is the magnitude class of the
-// parent's own residual on that axis.
+// Geometry prediction and residual coding (seed 004 §3.2; design notes §6
+// and §9). Positions are quantized on the Draco grid; each vertex is
+// predicted from vertices decoded before it and the residual is range coded.
+//
+// Predictors (the first byte of the geometry section says which):
+//  - parallelograms: vertices in march order (first appearance in the
+//    triangle tree's decode order). The connectivity is decoded first, so a
+//    new vertex p sees every triangle around it: each triangle (p, u, w) whose
+//    neighbour across u-w has a decoded far corner o gives u + w - o; the
+//    prediction is their average (Draco's multi-parallelogram, without
+//    flags). With none, the average of p's decoded neighbours.
+//  - gate: the same order, only the parallelogram across the gate (the edge
+//    the march entered by); cheaper to decode.
+//  - ancestors: the paper's predictor, vertex-tree order, P = sum lambda_i
+//    v_{n-i} over the K nearest tree ancestors, lambda fitted per mesh by
+//    least squares (Eigen) and stored as 16.16 fixed point.
+// Residuals: per axis an adaptive signed-integer model chosen by the
+// prediction class (how much was known) and an activity context (the bit
+// length of the residuals of the neighbours, and of this vertex's earlier
+// axes).
 #include "geometry_predict.hpp"
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "byte_io.hpp"
 #include "connectivity.hpp"
 #include "range_coder.hpp"
+#include "tsm/compare.hpp"
 
 namespace tsm {
 
 namespace {
 
-constexpr int kClasses = 4;
+constexpr int kClasses = 5;    // 0 nothing known, 1 neighbour average, 2..4: 1, 2, 3+ parallelograms
+constexpr int kActivity = 14;  // activity contexts
+constexpr uint8_t kUnknown = 0xFF;
+constexpr int kMaxAncestors = 4;
+constexpr int kLambdaShift = 16;
 
-int magnitude_class(int64_t r) {
-  uint64_t a = static_cast<uint64_t>(r < 0 ? -r : r);
-  return a == 0 ? 0 : a < 4 ? 1 : a < 64 ? 2 : 3;
+int bitlen(uint64_t x) { return bit_length(x); }
+constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
+using ResidualModel = SIntModelT<kMantissa>;
+
+int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
+  int64_t num = 2 * sum + n, den = 2 * n;
+  return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
-struct GeometryModels {
-  SIntModel axis[3][kClasses];
+struct ResidualModels {
+  ResidualModel m[3][kClasses][kActivity];
+  // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
+  // then the lattice index offset from the plane nearest the prediction.
+  Prob on[3][3];
+  ResidualModel index[3][3][kActivity];
+  // Vertices on no triangle: predicted from an anchor surface vertex.
+  Prob has_anchor;
+  UIntModel anchor_gap;
 };
+
+// The encoder's and decoder's view of the coded symbols; everything else in
+// the traversals below is shared, so both sides make the same predictions.
+// The value passed in is the encoder's; the decoder ignores it.
+struct EncodeSink {
+  static constexpr bool kEncoder = true;
+  RangeEncoder e;
+  int bit(Prob& p, int b) {
+    e.bit(p, b);
+    return b;
+  }
+  int32_t sint(ResidualModel& m, int64_t v) {
+    m.encode(e, static_cast<int32_t>(v));
+    return static_cast<int32_t>(v);
+  }
+  uint32_t uint(UIntModel& m, uint32_t v) {
+    m.encode(e, v);
+    return v;
+  }
+  bool truncated() const { return false; }
+};
+
+struct DecodeSink {
+  static constexpr bool kEncoder = false;
+  RangeDecoder d;
+  int bit(Prob& p, int) { return d.bit(p); }
+  int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
+  uint32_t uint(UIntModel& m, uint32_t) { return m.decode(d); }
+  bool truncated() const { return d.overrun() > RangeDecoder::kMaxOverrun; }
+};
+
+struct Coder {
+  std::unique_ptr<ResidualModels> models = std::make_unique<ResidualModels>();
+  std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
+  int64_t qmax = 0;
+  Lattice lattice;
+
+  template <class Sink>
+  bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity) {
+    uint64_t sum = 0, top = 0;
+    int on_count = 0;
+    for (int a = 0; a < 3; ++a) {
+      int ctx = a == 0 ? activity : (activity + bitlen(top) + 1) / 2;
+      ctx = std::min(ctx, kActivity - 1);
+      const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
+      uint32_t& x = q[3 * static_cast<size_t>(v) + a];
+      const std::vector<uint32_t>& L = lattice.values[a];
+      bool coded = false;
+      if (!L.empty()) {
+        // Nearest plane to the prediction (the lower one on a tie).
+        size_t j = static_cast<size_t>(std::lower_bound(L.begin(), L.end(), static_cast<uint32_t>(p)) - L.begin());
+        if (j == L.size() || (j > 0 && p - L[j - 1] <= L[j] - p)) j = j == 0 ? 0 : j - 1;
+        size_t jx = 0;
+        int on = 0;
+        if constexpr (Sink::kEncoder) {
+          auto it = std::lower_bound(L.begin(), L.end(), x);
+          on = it != L.end() && *it == x;
+          jx = static_cast<size_t>(it - L.begin());
+        }
+        on = s.bit(models->on[a][on_count], on);
+        if (on) {
+          int64_t d = s.sint(models->index[a][on_count][ctx], static_cast<int64_t>(jx) - static_cast<int64_t>(j));
+          int64_t k = static_cast<int64_t>(j) + d;
+          if (k < 0 || k >= static_cast<int64_t>(L.size())) return false;
+          x = L[static_cast<size_t>(k)];
+          ++on_count;
+          coded = true;
+        }
+      }
+      if (!coded) {
+        int64_t r = s.sint(models->m[a][cls][ctx], static_cast<int64_t>(x) - p);
+        if (p + r < 0 || p + r > qmax) return false;
+        x = static_cast<uint32_t>(p + r);
+      }
+      const int64_t r = static_cast<int64_t>(x) - p;
+      uint64_t ar = static_cast<uint64_t>(r < 0 ? -r : r);
+      sum += ar;
+      top = std::max(top, ar);
+    }
+    act[v] = static_cast<uint8_t>(std::min(bitlen(sum), 254));
+    return true;
+  }
+};
+
+// Prediction from the triangles around a vertex (march, greedy and gate
+// orders share it).
+template <class Sink>
+struct SurfaceCoder {
+  const GeometryLayout& g;
+  Coder& c;
+  Sink& s;
+  std::vector<uint32_t>& q;
+  int64_t last[3];
+  int last_act = 0;
+
+  SurfaceCoder(const GeometryLayout& layout, Coder& coder, Sink& sink, std::vector<uint32_t>& qs)
+      : g(layout), c(coder), s(sink), q(qs) {
+    for (int a = 0; a < 3; ++a) last[a] = (c.qmax + 1) / 2;
+  }
+  uint32_t known(uint32_t p) const {  // output vertex at position p if decoded, else kNone
+    uint32_t v = g.vertex[p];
+    return v != kNone && c.act[v] != kUnknown ? v : kNone;
+  }
+  const uint32_t* at(uint32_t v) const { return &q[3 * static_cast<size_t>(v)]; }
+
+  // Codes the vertex at the origin of half-edge h0 (undecoded, not virtual);
+  // multi: every triangle around it, else only h0's triangle.
+  bool code(uint32_t h0, bool multi) {
+    const uint32_t v = g.vertex[g.tri[h0]];
+    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, pred[3];
+    int npara = 0, nnb = 0, actsum = 0;
+    auto neighbour = [&](uint32_t u) {
+      for (int a = 0; a < 3; ++a) nb[a] += at(u)[a];
+      ++nnb;
+      actsum += c.act[u];
+    };
+    auto visit = [&](uint32_t h) {
+      uint32_t u = known(g.tri[he_next(h)]);
+      if (u == kNone) return;
+      neighbour(u);
+      uint32_t w = known(g.tri[he_prev(h)]);
+      if (w == kNone) return;
+      uint32_t o = known(g.tri[he_prev(g.twin[he_next(h)])]);
+      if (o == kNone) return;
+      for (int a = 0; a < 3; ++a) para[a] += int64_t{at(u)[a]} + at(w)[a] - at(o)[a];
+      ++npara;
+    };
+    if (multi) {
+      uint32_t h = h0;
+      size_t guard = 0;
+      do {
+        visit(h);
+        h = he_next(g.twin[h]);
+      } while (h != h0 && ++guard < g.tri.size());
+    } else {
+      visit(h0);
+      uint32_t w = known(g.tri[he_prev(h0)]);  // the root triangle's third corner sees two
+      if (w != kNone && npara == 0) neighbour(w);
+    }
+    int cls;
+    if (npara) {
+      for (int a = 0; a < 3; ++a) pred[a] = div_round(para[a], npara);
+      cls = 1 + std::min(npara, 3);
+    } else if (nnb) {
+      for (int a = 0; a < 3; ++a) pred[a] = div_round(nb[a], nnb);
+      cls = 1;
+    } else {
+      for (int a = 0; a < 3; ++a) pred[a] = last[a];
+      cls = 0;
+    }
+    return point(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act);
+  }
+  bool point(uint32_t v, const int64_t pred[3], int cls, int activity) {
+    if (!c.vertex(s, q, v, pred, cls, activity)) return false;
+    for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
+    last_act = c.act[v];
+    return true;
+  }
+  // Vertices on no triangle (isolated points), in output order: from their
+  // anchor (a surface vertex near them; anchors ascend, coded as gaps), or
+  // without one from the previous point.
+  bool isolated() {
+    uint32_t prev_anchor = 0;
+    for (uint32_t v = 0; v < g.vertex_count; ++v) {
+      if (c.act[v] != kUnknown) continue;
+      uint32_t anchor = kNone;
+      if constexpr (Sink::kEncoder) {
+        uint32_t x = g.anchor.empty() ? kNone : g.anchor[v];
+        if (x != kNone && x >= prev_anchor && c.act[x] != kUnknown) anchor = x;
+      }
+      int64_t pred[3];
+      if (s.bit(c.models->has_anchor, anchor != kNone)) {
+        uint32_t gap = s.uint(c.models->anchor_gap, anchor - prev_anchor);
+        anchor = prev_anchor + gap;
+        if (gap == 0xFFFFFFFFu || anchor < prev_anchor || anchor >= g.vertex_count || c.act[anchor] == kUnknown)
+          return false;
+        prev_anchor = anchor;
+        for (int a = 0; a < 3; ++a) pred[a] = at(anchor)[a];
+      } else {
+        for (int a = 0; a < 3; ++a) pred[a] = last[a];
+      }
+      if (!point(v, pred, 0, last_act)) return false;
+      if ((v & 4095) == 0 && s.truncated()) return false;
+    }
+    return true;
+  }
+};
+
+// March order: vertices as the triangle tree first reaches them.
+template <class Sink>
+bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
+  SurfaceCoder<Sink> sc(g, c, s, q);
+  for (uint32_t h0 = 0; h0 < g.tri.size(); ++h0) {
+    if (sc.known(g.tri[h0]) != kNone || g.vertex[g.tri[h0]] == kNone) continue;
+    if (!sc.code(h0, multi)) return false;
+    if ((h0 & 4095) == 0 && s.truncated()) return false;
+  }
+  return sc.isolated();
+}
+
+// Greedy order: next the vertex with the most complete parallelograms (then
+// the most decoded neighbours); ties first-in first-out. Counts are kept
+// incrementally: a parallelogram completes when the last of its three known
+// corners is decoded. A new component starts at the first undecoded corner
+// in march order.
+template <class Sink>
+bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q) {
+  SurfaceCoder<Sink> sc(g, c, s, q);
+  const uint32_t n = g.vertex_count;
+  const uint32_t H = static_cast<uint32_t>(g.tri.size());
+  std::vector<uint32_t> first_he(n, kNone);
+  for (uint32_t h = 0; h < H; ++h) {
+    uint32_t v = g.vertex[g.tri[h]];
+    if (v != kNone && first_he[v] == kNone) first_he[v] = h;
+  }
+  std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
+  constexpr int kBuckets = 16;
+  std::vector<uint32_t> bucket[kBuckets];
+  size_t head[kBuckets] = {};
+  auto priority = [&](uint32_t x) { return std::min<int>(npara[x], 3) * 4 + std::min<int>(nnb[x], 3); };
+  auto bump = [&](uint32_t x) {
+    int p = priority(x);
+    if (p != prio[x]) {
+      prio[x] = static_cast<uint8_t>(p);
+      bucket[p].push_back(x);
+    }
+  };
+  auto decoded = [&](uint32_t v) {  // update counts around the vertex just coded
+    uint32_t h0 = first_he[v], h = h0;
+    size_t guard = 0;
+    do {
+      const uint32_t hn = he_next(h), hp = he_prev(h);
+      const uint32_t pu = g.tri[hn], pw = g.tri[hp];
+      const uint32_t u = sc.known(pu), w = sc.known(pw);
+      // v as a neighbour of u.
+      if (u == kNone && g.vertex[pu] != kNone) {
+        uint32_t x = g.vertex[pu];
+        if (nnb[x] < 255) ++nnb[x];
+        // Parallelogram of u in triangle (u, w, v), across w-v.
+        if (w != kNone && sc.known(g.tri[he_prev(g.twin[hp])]) != kNone && npara[x] < 255) ++npara[x];
+        bump(x);
+      }
+      // Parallelogram of w in triangle (w, v, u), across v-u.
+      if (w == kNone && g.vertex[pw] != kNone && u != kNone && sc.known(g.tri[he_prev(g.twin[h])]) != kNone) {
+        uint32_t x = g.vertex[pw];
+        if (npara[x] < 255) ++npara[x];
+        bump(x);
+      }
+      // v as the far corner o of the vertex across u-w.
+      if (u != kNone && w != kNone) {
+        uint32_t px = g.tri[he_prev(g.twin[hn])];
+        uint32_t x = g.vertex[px];
+        if (x != kNone && sc.known(px) == kNone) {
+          if (npara[x] < 255) ++npara[x];
+          bump(x);
+        }
+      }
+      h = he_next(g.twin[h]);
+    } while (h != h0 && ++guard < H);
+  };
+  uint32_t scan = 0;
+  for (;;) {
+    uint32_t v = kNone;
+    for (int b = kBuckets - 1; b >= 1 && v == kNone; --b) {
+      while (head[b] < bucket[b].size()) {
+        uint32_t x = bucket[b][head[b]++];
+        if (c.act[x] == kUnknown && prio[x] == b) {
+          v = x;
+          break;
+        }
+      }
+      if (head[b] == bucket[b].size()) {
+        bucket[b].clear();
+        head[b] = 0;
+      }
+    }
+    if (v == kNone) {  // a new component: first undecoded corner in march order
+      while (scan < H && (g.vertex[g.tri[scan]] == kNone || sc.known(g.tri[scan]) != kNone)) ++scan;
+      if (scan == H) break;
+      v = g.vertex[g.tri[scan]];
+    }
+    if (!sc.code(first_he[v], true)) return false;
+    decoded(v);
+    if ((v & 4095) == 0 && s.truncated()) return false;
+  }
+  return sc.isolated();
+}
+
+// Vertex-tree order (output ids are tree pre-order), the paper's predictor.
+template <class Sink>
+bool code_ancestors(const GeometryLayout& g, int K, const int32_t* lambda, Coder& c, Sink& s,
+                    std::vector<uint32_t>& q) {
+  const uint32_t n = g.vertex_count;
+  int64_t root[3];
+  for (int a = 0; a < 3; ++a) root[a] = (c.qmax + 1) / 2;
+  for (uint32_t v = 0; v < n; ++v) {
+    uint32_t anc[kMaxAncestors];
+    int d = 0;
+    for (uint32_t x = g.parent[v]; x != kNone && d < K; x = g.parent[x]) anc[d++] = x;
+    int64_t pred[3];
+    int cls, activity = 0;
+    if (d == 0) {
+      for (int a = 0; a < 3; ++a) pred[a] = root[a];
+      cls = 0;
+    } else {
+      activity = c.act[anc[0]];
+      if (d < K) {
+        for (int a = 0; a < 3; ++a) pred[a] = q[3 * static_cast<size_t>(anc[0]) + a];
+        cls = 1;
+      } else {
+        for (int a = 0; a < 3; ++a) {
+          int64_t sum = int64_t{1} << (kLambdaShift - 1);
+          for (int i = 0; i < K; ++i) sum += int64_t{lambda[i]} * q[3 * static_cast<size_t>(anc[i]) + a];
+          pred[a] = sum >= 0 ? sum >> kLambdaShift : -((-sum + (int64_t{1} << kLambdaShift) - 1) >> kLambdaShift);
+        }
+        cls = 2;
+      }
+    }
+    if (!c.vertex(s, q, v, pred, cls, activity)) return false;
+    if (d == 0)
+      for (int a = 0; a < 3; ++a) root[a] = q[3 * static_cast<size_t>(v) + a];
+    if ((v & 4095) == 0 && s.truncated()) return false;
+  }
+  return true;
+}
+
+// Least-squares lambda over all vertices with K ancestors (seed 004 §3.2).
+void fit_lambda(const GeometryLayout& g, const std::vector<uint32_t>& q, int K, int32_t* lambda) {
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(K, K);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(K);
+  for (uint32_t v = 0; v < g.vertex_count; ++v) {
+    uint32_t anc[kMaxAncestors];
+    int d = 0;
+    for (uint32_t x = g.parent[v]; x != kNone && d < K; x = g.parent[x]) anc[d++] = x;
+    if (d < K) continue;
+    for (int a = 0; a < 3; ++a) {
+      double y[kMaxAncestors];
+      for (int i = 0; i < K; ++i) y[i] = q[3 * static_cast<size_t>(anc[i]) + a];
+      for (int i = 0; i < K; ++i) {
+        for (int j = 0; j < K; ++j) M(i, j) += y[i] * y[j];
+        b(i) += y[i] * q[3 * static_cast<size_t>(v) + a];
+      }
+    }
+  }
+  Eigen::VectorXd l = M.ldlt().solve(b);
+  for (int i = 0; i < K; ++i) {
+    double x = std::isfinite(l(i)) ? l(i) : (i == 0 ? 1.0 : 0.0);
+    x = std::clamp(x, -256.0, 256.0);
+    lambda[i] = static_cast<int32_t>(std::lround(x * (1 << kLambdaShift)));
+  }
+}
+
+// The lattice values per axis: count, then increasing values as gaps.
+template <class Sink>
+bool code_lattice(Sink& s, Coder& c) {
+  ResidualModel count, gap;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<uint32_t>& L = c.lattice.values[a];
+    int64_t n = s.sint(count, static_cast<int64_t>(L.size()));
+    if (n < 0 || n > c.qmax + 1 || n > static_cast<int64_t>(c.act.size())) return false;
+    if constexpr (!Sink::kEncoder) L.resize(static_cast<size_t>(n));
+    int64_t prev = -1;
+    for (int64_t i = 0; i < n; ++i) {
+      int64_t x = prev + 1 + s.sint(gap, i < static_cast<int64_t>(L.size()) ? L[static_cast<size_t>(i)] - prev - 1 : 0);
+      if (x <= prev || x > c.qmax || s.truncated()) return false;
+      L[static_cast<size_t>(i)] = static_cast<uint32_t>(x);
+      prev = x;
+    }
+  }
+  return true;
+}
+
+std::string encode_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
+                        const Lattice& lattice) {
+  std::string head;
+  ByteWriter w(head);
+  w.u8(static_cast<uint8_t>(pred));
+  int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
+  if (pred == Predictor::ancestors) {
+    fit_lambda(g, q, K, lambda);
+    w.u8(static_cast<uint8_t>(K));
+    for (int i = 0; i < K; ++i) w.u32(static_cast<uint32_t>(lambda[i]));
+  }
+  Coder c;
+  c.act.assign(g.vertex_count, kUnknown);
+  c.qmax = (int64_t{1} << bits) - 1;
+  EncodeSink s;
+  c.lattice = lattice;
+  code_lattice(s, c);
+  std::vector<uint32_t> work = q;
+  if (pred == Predictor::ancestors)
+    code_ancestors(g, K, lambda, c, s, work);
+  else if (pred == Predictor::parallelograms)
+    code_greedy(g, c, s, work);
+  else
+    code_march_order(g, false, c, s, work);
+  return head + s.e.finish();
+}
 
 }  // namespace
 
-std::string encode_geometry(const std::vector<uint32_t>& q, const std::vector<uint32_t>& parent, int bits) {
-  (void)bits;
-  RangeEncoder e;
-  GeometryModels gm;
-  const size_t n = parent.size();
-  std::vector<uint8_t> cls(3 * n, 0);
-  size_t prev_root = kNone;
-  for (size_t v = 0; v < n; ++v) {
-    size_t p = parent[v] != kNone ? parent[v] : prev_root;
-    if (parent[v] == kNone) prev_root = v;
-    for (int a = 0; a < 3; ++a) {
-      int64_t pred = p != kNone ? q[3 * p + a] : 0;
-      int64_t r = static_cast<int64_t>(q[3 * v + a]) - pred;
-      int ctx = p != kNone ? cls[3 * p + a] : 0;
-      gm.axis[a][ctx].encode(e, static_cast<int32_t>(r));
-      cls[3 * v + a] = static_cast<uint8_t>(magnitude_class(r));
-    }
+std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
+  const uint32_t n = g.vertex_count;
+  std::vector<uint32_t> anchor(n, kNone);
+  std::vector<uint8_t> on_surface(n, 0);
+  for (uint32_t p : g.tri)
+    if (g.vertex[p] != kNone) on_surface[g.vertex[p]] = 1;
+  uint32_t surface = 0;
+  for (uint32_t v = 0; v < n; ++v) surface += on_surface[v];
+  if (surface == 0 || surface == n) return anchor;
+  // Cells of 2^shift steps, about one surface vertex per occupied cell.
+  int shift = bits - static_cast<int>(std::log2(std::sqrt(static_cast<double>(surface)) + 1.0));
+  shift = std::clamp(shift, 0, 30);
+  auto cell = [&](uint32_t v, int dx, int dy, int dz) -> uint64_t {
+    int64_t c[3] = {(q[3 * size_t{v}] >> shift) + dx, (q[3 * size_t{v} + 1] >> shift) + dy,
+                    (q[3 * size_t{v} + 2] >> shift) + dz};
+    return (static_cast<uint64_t>(c[0] + 4) << 42) ^ (static_cast<uint64_t>(c[1] + 4) << 21) ^
+           static_cast<uint64_t>(c[2] + 4);
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> cells;
+  cells.reserve(surface);
+  for (uint32_t v = 0; v < n; ++v)
+    if (on_surface[v]) cells.push_back({cell(v, 0, 0, 0), v});
+  std::sort(cells.begin(), cells.end());
+  for (uint32_t v = 0; v < n; ++v) {
+    if (on_surface[v]) continue;
+    uint64_t best = UINT64_MAX;
+    for (int r = 1; r <= 2 && best == UINT64_MAX; ++r)
+      for (int dx = -r; dx <= r; ++dx)
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dz = -r; dz <= r; ++dz) {
+            uint64_t key = cell(v, dx, dy, dz);
+            auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, uint32_t{0}));
+            for (; it != cells.end() && it->first == key; ++it) {
+              uint64_t d = 0;
+              for (int a = 0; a < 3; ++a) {
+                int64_t e = int64_t{q[3 * size_t{v} + a]} - q[3 * size_t{it->second} + a];
+                d += static_cast<uint64_t>(e * e);
+              }
+              if (d < best || (d == best && it->second < anchor[v])) {
+                best = d;
+                anchor[v] = it->second;
+              }
+            }
+          }
   }
-  return e.finish();
+  return anchor;
 }
 
-Status decode_geometry(const std::string& bytes, const std::vector<uint32_t>& parent, int bits,
-                       std::vector<uint32_t>& q) {
-  RangeDecoder d(bytes);
-  GeometryModels gm;
-  const size_t n = parent.size();
-  const int64_t qmax = (int64_t{1} << bits) - 1;
-  q.resize(3 * n);
-  std::vector<uint8_t> cls(3 * n, 0);
-  size_t prev_root = kNone;
-  for (size_t v = 0; v < n; ++v) {
-    if (parent[v] != kNone && parent[v] >= v) return Status(ErrorCode::corrupt_data, "geometry: bad tree parent");
-    size_t p = parent[v] != kNone ? parent[v] : prev_root;
-    if (parent[v] == kNone) prev_root = v;
-    for (int a = 0; a < 3; ++a) {
-      int64_t pred = p != kNone ? q[3 * p + a] : 0;
-      int ctx = p != kNone ? cls[3 * p + a] : 0;
-      int64_t r = gm.axis[a][ctx].decode(d);
-      int64_t x = pred + r;
-      if (x < 0 || x > qmax) return Status(ErrorCode::corrupt_data, "geometry: coordinate outside the grid");
-      q[3 * v + a] = static_cast<uint32_t>(x);
-      cls[3 * v + a] = static_cast<uint8_t>(magnitude_class(r));
+Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
+  Lattice out;
+  std::vector<uint32_t> vals(n), counts;
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // value, count
+  for (int a = 0; a < 3; ++a) {
+    for (uint32_t v = 0; v < n; ++v) vals[v] = q[3 * static_cast<size_t>(v) + a];
+    std::sort(vals.begin(), vals.end());
+    runs.clear();
+    for (size_t i = 0; i < vals.size();) {
+      size_t j = i;
+      while (j < vals.size() && vals[j] == vals[i]) ++j;
+      runs.push_back({vals[i], static_cast<uint32_t>(j - i)});
+      i = j;
     }
-    if ((v & 1023) == 0 && d.overrun() > RangeDecoder::kMaxOverrun)
-      return Status(ErrorCode::corrupt_data, "geometry stream is truncated");
+    if (runs.empty()) continue;
+    counts.resize(runs.size());
+    for (size_t i = 0; i < runs.size(); ++i) counts[i] = runs[i].second;
+    std::nth_element(counts.begin(), counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2), counts.end());
+    // A value off the planes is used about `median` times (Poisson-like);
+    // a plane far more often.
+    const double median = counts[counts.size() / 2];
+    const double threshold = median + 6.0 * std::sqrt(median) + 4.0;
+    std::vector<uint32_t>& L = out.values[a];
+    size_t covered = 0;
+    for (auto [value, count] : runs)
+      if (count >= threshold) {
+        L.push_back(value);
+        covered += count;
+      }
+    if (3 * covered < n || 8 * L.size() > n) L.clear();
   }
-  if (d.overrun() > RangeDecoder::kMaxOverrun) return Status(ErrorCode::corrupt_data, "geometry stream is truncated");
+  return out;
+}
+
+std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
+                            const Lattice* candidate, GeometryStats* stats) {
+  GeometryStats st;
+  st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
+  Lattice none;
+  std::string best = encode_with(g, q, bits, st.predictor, 0, none);
+  if (level >= 3 && candidate) {
+    // Shared coordinate planes: keep them where they make the file smaller
+    // (all candidate axes at once, then at high levels each axis alone).
+    const Lattice& found = *candidate;
+    if (!found.values[0].empty() || !found.values[1].empty() || !found.values[2].empty()) {
+      std::string alt = encode_with(g, q, bits, st.predictor, 0, found);
+      if (alt.size() < best.size()) {
+        best.swap(alt);
+        st.lattice = found;
+      }
+      if (level >= 8)
+        for (int a = 0; a < 3; ++a) {
+          Lattice trial = st.lattice;
+          if (trial.values[a].empty()) continue;
+          trial.values[a].clear();
+          alt = encode_with(g, q, bits, st.predictor, 0, trial);
+          if (alt.size() < best.size()) {
+            best.swap(alt);
+            st.lattice = trial;
+          }
+        }
+    }
+  }
+  if (level >= 7) {
+    for (int K = 1; K <= kMaxAncestors; ++K) {
+      std::string alt = encode_with(g, q, bits, Predictor::ancestors, K, st.lattice);
+      if (alt.size() < best.size()) {
+        best.swap(alt);
+        st.predictor = Predictor::ancestors;
+        st.ancestors = K;
+      }
+    }
+  }
+  for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
+  if (stats) *stats = st;
+  return best;
+}
+
+Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
+                       GeometryStats* stats) {
+  auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "geometry: " + what); };
+  ByteReader r(bytes);
+  GeometryStats st;
+  uint8_t kind;
+  if (!r.u8(kind)) return corrupt("empty section");
+  if (kind > static_cast<uint8_t>(Predictor::gate)) return corrupt("unknown predictor " + std::to_string(kind));
+  st.predictor = static_cast<Predictor>(kind);
+  int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
+  if (st.predictor == Predictor::ancestors) {
+    uint8_t K;
+    if (!r.u8(K)) return corrupt("truncated predictor header");
+    if (K < 1 || K > kMaxAncestors) return corrupt("ancestor count " + std::to_string(K) + " out of range 1..4");
+    st.ancestors = K;
+    for (int i = 0; i < K; ++i) {
+      uint32_t x;
+      if (!r.u32(x)) return corrupt("truncated predictor header");
+      lambda[i] = static_cast<int32_t>(x);
+      if (lambda[i] < -(256 << kLambdaShift) || lambda[i] > (256 << kLambdaShift))
+        return corrupt("ancestor weight out of range");
+    }
+  }
+  const size_t at = r.offset();
+  Coder c;
+  c.act.assign(g.vertex_count, kUnknown);
+  c.qmax = (int64_t{1} << bits) - 1;
+  DecodeSink s;
+  s.d.init(bytes.substr(at));
+  if (!code_lattice(s, c)) return corrupt("bad lattice");
+  for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(c.lattice.values[a].size());
+  q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
+  bool ok;
+  if (st.predictor == Predictor::ancestors) {
+    for (uint32_t v = 0; v < g.vertex_count; ++v)
+      if (g.parent[v] != kNone && g.parent[v] >= v) return corrupt("bad vertex tree parent");
+    ok = code_ancestors(g, st.ancestors, lambda, c, s, q);
+  } else {
+    ok = st.predictor == Predictor::parallelograms ? code_greedy(g, c, s, q) : code_march_order(g, false, c, s, q);
+  }
+  if (!ok) return corrupt(s.truncated() ? "stream is truncated" : "coordinate outside the grid");
+  if (s.truncated()) return corrupt("stream is truncated");
+  if (stats) *stats = st;
   return Status::Ok();
 }
 

@@ -1,17 +1,63 @@
-// Internal: geometry coding (seed 004 §3.2; design notes §6).
+// Internal: geometry coding (seed 004 §3.2; design notes §6, §9).
 #pragma once
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "tsm/compare.hpp"
+#include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
 namespace tsm {
 
-// Quantized positions (3 per vertex, in decoded vertex order), predicted from
-// the vertex-tree parent, residuals range coded.
-std::string encode_geometry(const std::vector<uint32_t>& q, const std::vector<uint32_t>& parent, int bits);
-Status decode_geometry(const std::string& bytes, const std::vector<uint32_t>& parent, int bits,
-                       std::vector<uint32_t>& q);
+// The decoded surface as the geometry coder sees it. The connectivity encoder
+// and decoder build it identically, so the predictors see the same mesh.
+struct GeometryLayout {
+  std::vector<uint32_t> tri;     // 3 per triangle: cut-surface position, in decode order, ccw
+  std::vector<uint32_t> twin;    // per half-edge 3k+e (corner e -> e+1): the half-edge across it
+  std::vector<uint32_t> vertex;  // per position: output vertex id, kNone for a virtual vertex
+  std::vector<uint32_t> parent;  // per output vertex: its vertex-tree parent (kNone at roots)
+  std::vector<uint32_t> anchor;  // encoder: per output vertex on no triangle, a surface vertex near it (or kNone)
+  uint32_t vertex_count = 0;     // output vertices
+};
+
+// Predictors, stored as the first byte of the geometry section.
+enum class Predictor : uint8_t {
+  ancestors = 0,      // seed 004 §3.2: sum lambda_i v_{n-i} over K tree ancestors, vertex-tree order
+  parallelograms = 1, // march order; average of every parallelogram around the new vertex
+  gate = 2,           // march order; the single parallelogram across the gate (fast)
+};
+
+// Per axis, the sorted coordinate values many vertices share (the voxel
+// planes of a marching-cubes surface, a CAD grid); empty when not used.
+struct Lattice {
+  std::vector<uint32_t> values[3];
+};
+
+struct GeometryStats {
+  Predictor predictor = Predictor::parallelograms;
+  int ancestors = 0;  // K for the ancestor predictor
+  Lattice lattice;
+  uint32_t lattice_planes[3] = {0, 0, 0};
+};
+
+// Per output vertex on no triangle, the nearest surface vertex within two
+// cells of a grid with about one surface vertex per cell (kNone if none or
+// on a triangle). q: 3 quantized coordinates per output vertex.
+std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits);
+
+// Candidate lattice planes, per axis: the quantized values used far more
+// often than a typical value (median + 6 sqrt(median) + 4 times); an axis is
+// dropped when its planes hold under a third of the coordinates or number
+// more than one per eight vertices. Depends on q only (canonical re-encode).
+Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
+
+// q: 3 quantized coordinates per output vertex. The encoder picks the
+// predictor by level, and the lattice (if a candidate is given) by size.
+std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
+                            const Lattice* candidate, GeometryStats* stats = nullptr);
+Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
+                       GeometryStats* stats = nullptr);
 
 }  // namespace tsm

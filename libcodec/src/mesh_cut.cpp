@@ -95,7 +95,7 @@ PreparedInput prepare_input(const Mesh& mesh) {
   return kept;
 }
 
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count) {
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const std::vector<uint32_t>* isolated_key) {
   CutMesh m;
   const uint32_t nh = static_cast<uint32_t>(in.tri.size());
   m.tri = in.tri;
@@ -187,17 +187,35 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count) {
   }
   m.vertex_count = static_cast<uint32_t>(m.source.size());
 
-  // 4. Components, ordered by their smallest vertex id (never virtual), which is the root.
+  // 4. Components: those with triangles first, ordered by their smallest
+  // vertex id (never virtual), which is the root; then the vertices on no
+  // triangle, by `isolated_key` when given (else by id).
   UnionFind comp(m.vertex_count);
-  for (uint32_t h = 0; h < m.tri.size(); ++h) comp.unite(m.tri[h], m.tri[he_next(h)]);
+  std::vector<uint8_t> on_triangle(m.vertex_count, 0);
+  for (uint32_t h = 0; h < m.tri.size(); ++h) {
+    comp.unite(m.tri[h], m.tri[he_next(h)]);
+    on_triangle[m.tri[h]] = 1;
+  }
   m.vertex_component.assign(m.vertex_count, kNone);
+  std::vector<uint32_t> isolated;
   for (uint32_t v = 0; v < m.vertex_count; ++v) {
     uint32_t r = comp.find(v);  // the smallest id of the set (unite keeps the minimum)
     if (r == v) {
+      if (!on_triangle[v]) {
+        isolated.push_back(v);
+        continue;
+      }
       m.vertex_component[v] = static_cast<uint32_t>(m.component_root.size());
       m.component_root.push_back(v);
     }
     m.vertex_component[v] = m.vertex_component[r];
+  }
+  if (isolated_key)
+    std::stable_sort(isolated.begin(), isolated.end(),
+                     [&](uint32_t a, uint32_t b) { return (*isolated_key)[a] < (*isolated_key)[b]; });
+  for (uint32_t v : isolated) {
+    m.vertex_component[v] = static_cast<uint32_t>(m.component_root.size());
+    m.component_root.push_back(v);
   }
   return m;
 }

@@ -136,23 +136,74 @@ struct BitTreeModel {
   }
 };
 
+inline int bit_length(uint64_t x) { return x ? 64 - __builtin_clzll(x) : 0; }
+
 // An adaptive model for unsigned integers up to 2^32 - 2: the bit length of
 // v + 1 as a 6-bit tree symbol, then the bits below the leading one; the top
-// kModelled of them are modelled per length, the rest are direct bits.
-struct UIntModel {
-  static constexpr int kModelled = 2;
+// M of them are modelled per length (a binary tree of contexts, so spiky
+// distributions such as multiples of a lattice spacing are learned), the
+// rest are direct bits.
+template <int M>
+struct UIntModelT {
+  static constexpr int kModelled = M;
   BitTreeModel<6> length;
-  Prob mantissa[33][1 << kModelled];
-  void encode(RangeEncoder& e, uint32_t v);
-  uint32_t decode(RangeDecoder& d);  // returns 0xFFFFFFFF on an impossible length
+  Prob mantissa[33][1 << M];
+  void encode(RangeEncoder& e, uint32_t v) {
+    uint64_t x = static_cast<uint64_t>(v) + 1;
+    int n = bit_length(x) - 1;  // 0..32
+    length.encode(e, static_cast<uint32_t>(n));
+    int top = n < M ? n : M;
+    uint32_t ctx = 1;
+    for (int i = 0; i < top; ++i) {
+      int b = static_cast<int>((x >> (n - 1 - i)) & 1);
+      e.bit(mantissa[n][ctx], b);
+      ctx = (ctx << 1) | static_cast<uint32_t>(b);
+    }
+    int rest = n - top;
+    if (rest > 0) e.direct(static_cast<uint32_t>(x & ((uint64_t{1} << rest) - 1)), rest);
+  }
+  // Returns 0xFFFFFFFF on an impossible length.
+  uint32_t decode(RangeDecoder& d) {
+    int n = static_cast<int>(length.decode(d));
+    if (n > 32) return 0xFFFFFFFFu;
+    uint64_t x = 1;
+    int top = n < M ? n : M;
+    uint32_t ctx = 1;
+    for (int i = 0; i < top; ++i) {
+      int b = d.bit(mantissa[n][ctx]);
+      ctx = (ctx << 1) | static_cast<uint32_t>(b);
+      x = (x << 1) | static_cast<uint64_t>(b);
+    }
+    int rest = n - top;
+    if (rest > 0) x = (x << rest) | d.direct(rest);
+    uint64_t v = x - 1;
+    return v >= 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<uint32_t>(v);
+  }
 };
 
 // Signed integers: zero flag, sign, magnitude - 1.
-struct SIntModel {
+template <int M>
+struct SIntModelT {
   Prob zero, sign;
-  UIntModel magnitude;
-  void encode(RangeEncoder& e, int32_t v);
-  int32_t decode(RangeDecoder& d);
+  UIntModelT<M> magnitude;
+  void encode(RangeEncoder& e, int32_t v) {
+    e.bit(zero, v != 0);
+    if (v == 0) return;
+    e.bit(sign, v < 0);
+    uint32_t mag = v < 0 ? static_cast<uint32_t>(-static_cast<int64_t>(v)) : static_cast<uint32_t>(v);
+    magnitude.encode(e, mag - 1);
+  }
+  int32_t decode(RangeDecoder& d) {
+    if (!d.bit(zero)) return 0;
+    int neg = d.bit(sign);
+    uint32_t m = magnitude.decode(d);
+    if (m >= 0x7FFFFFFFu) m = 0x7FFFFFFEu;  // out of range on corrupt data; callers validate
+    int32_t v = static_cast<int32_t>(m + 1);
+    return neg ? -v : v;
+  }
 };
+
+using UIntModel = UIntModelT<2>;
+using SIntModel = SIntModelT<2>;
 
 }  // namespace tsm

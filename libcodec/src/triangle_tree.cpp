@@ -86,7 +86,8 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
 }
 
 Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<uint32_t>& tri_pos,
-                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge) {
+                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge,
+                            std::vector<uint32_t>& edge_loop) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "triangle tree: " + what); };
   const size_t nr = runs.march.size();
   if (L < 4 || runs.root >= L) return corrupt("bad loop length or root position");
@@ -114,6 +115,7 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
   tri_pos.resize(3 * static_cast<size_t>(T));
   parent.resize(T);
   parent_edge.resize(T);
+  edge_loop.assign(3 * static_cast<size_t>(T), kNone);
   auto fwd = [L](uint32_t p, uint32_t d) { return (p + d) % L; };
   auto bwd = [L](uint32_t p, uint32_t d) { return (p + L - d) % L; };
   uint32_t k = 0;
@@ -127,6 +129,8 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
   };
   const uint32_t r = runs.root;
   emit(bwd(r, 1), r, fwd(r, 1), kNone, 0);
+  edge_loop[0] = bwd(r, 1);
+  edge_loop[1] = r;
   struct Gate {
     uint32_t a, b, par;
     uint8_t slot;
@@ -143,17 +147,21 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
       if (runs.bits[bit++] == 0) {
         uint32_t x = fwd(cur.b, 1);
         uint32_t t = emit(cur.a, cur.b, x, cur.par, cur.slot);
+        edge_loop[3 * static_cast<size_t>(t) + 1] = cur.b;
         cur = {cur.a, x, t, 2};
       } else {
         uint32_t x = bwd(cur.a, 1);
         uint32_t t = emit(cur.a, cur.b, x, cur.par, cur.slot);
+        edge_loop[3 * static_cast<size_t>(t) + 2] = x;
         cur = {x, cur.b, t, 1};
       }
     }
     uint32_t span = (cur.a + L - cur.b) % L;
     if (!runs.branch[ri]) {
       if (span != 2) return corrupt("a leaf triangle does not close its polygon");
-      emit(cur.a, cur.b, fwd(cur.b, 1), cur.par, cur.slot);
+      uint32_t t = emit(cur.a, cur.b, fwd(cur.b, 1), cur.par, cur.slot);
+      edge_loop[3 * static_cast<size_t>(t) + 1] = cur.b;
+      edge_loop[3 * static_cast<size_t>(t) + 2] = fwd(cur.b, 1);
       if (stack.empty()) {
         if (ri + 1 != nr) return corrupt("runs left after the last polygon closed");
         break;
