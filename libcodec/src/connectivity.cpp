@@ -27,7 +27,7 @@ struct TriangleTreeModels {
   UIntModel root;
   UIntModel march[2];  // by previous run's end type
   Prob end[2][2];      // [previous end][march == 0]
-  Prob bit[3][4];      // [position in run, clipped to 2][last two bits]
+  Prob bit[kMarchContexts];  // see MarchBitSource
   Prob diagonal[2];    // by previous flag
 };
 
@@ -68,7 +68,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const st
   }
   std::vector<uint8_t> cut_he = f.tree_he;
   std::vector<uint32_t> local(m.triangle_count()), corner_pos(m.tri.size());
-  std::vector<uint32_t> comp_tris;
+  std::vector<uint32_t> comp_tris, scratch_pos, scratch_parent, scratch_edge;
+  std::vector<uint8_t> scratch_slot;
   // Per pre-order position: which triangle corners reference it, filled as we go.
   std::vector<uint32_t> pos_of(m.vertex_count);
   for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
@@ -128,16 +129,32 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const st
         if (m.tri[3 * t + j] == first) rot[t] = j;
     }
     tm.root.encode(et, tr.root);
-    size_t bit = 0;
     int prev_end = 1;
     for (size_t r = 0; r < tr.march.size(); ++r) {
       tm.march[prev_end].encode(et, tr.march[r]);
-      for (uint32_t i = 0; i < tr.march[r]; ++i, ++bit) {
-        uint32_t ctx = (bit > 0 && i > 0 ? tr.bits[bit - 1] : 0) | (bit > 1 && i > 1 ? tr.bits[bit - 2] << 1 : 0);
-        et.bit(tm.bit[std::min(i, 2u)][ctx], tr.bits[bit]);
-      }
       et.bit(tm.end[prev_end][tr.march[r] == 0], tr.branch[r]);
       prev_end = tr.branch[r];
+    }
+    {  // Marching bits, coded during the same walk the decoder makes.
+      struct Source : MarchBitSource {
+        RangeEncoder& e;
+        Prob* probs;
+        const std::vector<uint8_t>& bits;
+        size_t next = 0;
+        Source(RangeEncoder& enc, Prob* p, const std::vector<uint8_t>& b) : e(enc), probs(p), bits(b) {}
+        int bit(int ctx) override {
+          int b = next < bits.size() ? bits[next] : 0;
+          ++next;
+          e.bit(probs[ctx], b);
+          return b;
+        }
+      } source(et, tm.bit, tr.bits);
+      std::vector<uint32_t> local_loop(cl.loop.size());
+      for (size_t p = 0; p < cl.loop.size(); ++p) local_loop[p] = pos_of[cl.loop[p]] - start;
+      uint64_t used = 0;
+      TSM_RETURN_IF_ERROR(decode_triangle_tree(static_cast<uint32_t>(cl.loop.size()), tr, local_loop, end - start,
+                                               source, scratch_pos, scratch_parent, scratch_slot, scratch_edge, used));
+      if (used != tr.bits.size()) return Status(ErrorCode::internal, "marching bits: the walk used another count");
     }
     st.triangle_runs += tr.march.size();
     st.marching_bits += tr.bits.size();
@@ -322,11 +339,6 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       if (overrun()) return corrupt("triangle tree stream is truncated");
       uint32_t march = tm.march[prev_end].decode(dt);
       if (march == 0xFFFFFFFFu || total + static_cast<uint64_t>(march) + 1 > L) return corrupt("triangle run too long");
-      for (uint32_t i = 0; i < march; ++i) {
-        size_t b = tr.bits.size();
-        uint32_t ctx = (b > 0 && i > 0 ? tr.bits[b - 1] : 0) | (b > 1 && i > 1 ? tr.bits[b - 2] << 1 : 0);
-        tr.bits.push_back(static_cast<uint8_t>(dt.bit(tm.bit[std::min(i, 2u)][ctx])));
-      }
       int br = dt.bit(tm.end[prev_end][march == 0]);
       tr.march.push_back(march);
       tr.branch.push_back(static_cast<uint8_t>(br));
@@ -337,8 +349,16 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       if (leaves == branches + 1) break;
     }
     st.triangle_runs += tr.march.size();
-    st.marching_bits += tr.bits.size();
-    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, tri_pos, tparent, tslot, edge_loop));
+    struct Source : MarchBitSource {
+      RangeDecoder& d;
+      Prob* probs;
+      Source(RangeDecoder& dec, Prob* p) : d(dec), probs(p) {}
+      int bit(int ctx) override { return d.bit(probs[ctx]); }
+    } source(dt, tm.bit);
+    uint64_t used = 0;
+    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, loop, n, source, tri_pos, tparent, tslot, edge_loop, used));
+    st.marching_bits += used;
+    if (overrun()) return corrupt("triangle tree stream is truncated");
     const uint32_t T = L - 2, base = static_cast<uint32_t>(tri_parent.size());
     // Half-edges across: parent and child share the gate; each loop edge
     // meets the loop edge that walks the same cut edge the other way.

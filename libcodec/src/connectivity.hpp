@@ -134,15 +134,28 @@ struct TriangleRuns {
 // `corner_pos` is scratch with one entry per half-edge of the mesh.
 Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vector<uint32_t>& corner_pos,
                             TriangleRuns& out);
-// Decoder: triangles as loop-position triples, in decode order; each
-// non-root triangle's first edge is the one shared with its parent.
-// parent[k] is the decode index of triangle k's parent (kNone for the root).
-// edge_loop[3k + e] is the loop position p when edge e of triangle k is loop
-// edge p (loop[p] -> loop[p+1]), kNone when it is shared with a triangle of
-// the same tree.
-Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, std::vector<uint32_t>& tri_pos,
+// The marching bits, asked for during the walk with their context: the
+// numbers of triangles already emitted around the gate's two vertices
+// (valence so far, capped at 7) and the previous bit of the run. The encoder
+// answers from its bits, the decoder from the range coder.
+constexpr int kMarchContexts = 8 * 8 * 3;
+struct MarchBitSource {
+  virtual int bit(int ctx) = 0;
+  virtual ~MarchBitSource() = default;
+};
+
+// Decoder (and encoder, to share the contexts): triangles as loop-position
+// triples, in decode order; each non-root triangle's first edge is the one
+// shared with its parent. parent[k] is the decode index of triangle k's
+// parent (kNone for the root). edge_loop[3k + e] is the loop position p
+// when edge e of triangle k is loop edge p (loop[p] -> loop[p+1]), kNone
+// when it is shared with a triangle of the same tree. runs.bits is unused:
+// bits come from `bits`; loop maps loop positions to the component's local
+// vertices (n of them), for the valence contexts.
+Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, const std::vector<uint32_t>& loop,
+                            uint32_t n, MarchBitSource& bits, std::vector<uint32_t>& tri_pos,
                             std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge,
-                            std::vector<uint32_t>& edge_loop);
+                            std::vector<uint32_t>& edge_loop, uint64_t& bit_count);
 
 // Stage 5: the whole connectivity, coded.
 struct ConnectivityStats {

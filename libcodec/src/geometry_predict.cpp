@@ -95,6 +95,31 @@ struct Coder {
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
   int64_t qmax = 0;
   Lattice lattice;
+  std::vector<uint32_t> nearest[3];  // per axis, per grid value: nearest plane (when qmax < 2^18)
+
+  // Nearest plane to a grid value (the lower one on a tie).
+  size_t nearest_plane(int a, uint32_t p) const {
+    if (!nearest[a].empty()) return nearest[a][p];
+    const std::vector<uint32_t>& L = lattice.values[a];
+    size_t j = static_cast<size_t>(std::lower_bound(L.begin(), L.end(), p) - L.begin());
+    if (j == L.size() || (j > 0 && p - L[j - 1] <= L[j] - p)) j = j == 0 ? 0 : j - 1;
+    return j;
+  }
+  void build_nearest() {
+    for (int a = 0; a < 3; ++a) {
+      const std::vector<uint32_t>& L = lattice.values[a];
+      nearest[a].clear();
+      if (L.empty() || qmax >= (int64_t{1} << 18)) continue;
+      nearest[a].resize(static_cast<size_t>(qmax) + 1);
+      size_t j = 0;
+      for (uint32_t p = 0; p <= qmax; ++p) {
+        while (j + 1 < L.size() && L[j + 1] <= p) ++j;  // L[j] <= p < L[j+1], or p below L[0]
+        size_t k = j;
+        if (j + 1 < L.size() && L[j] <= p && L[j + 1] - p < p - L[j]) k = j + 1;
+        nearest[a][p] = static_cast<uint32_t>(k);
+      }
+    }
+  }
 
   template <class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity) {
@@ -108,9 +133,7 @@ struct Coder {
       const std::vector<uint32_t>& L = lattice.values[a];
       bool coded = false;
       if (!L.empty()) {
-        // Nearest plane to the prediction (the lower one on a tie).
-        size_t j = static_cast<size_t>(std::lower_bound(L.begin(), L.end(), static_cast<uint32_t>(p)) - L.begin());
-        if (j == L.size() || (j > 0 && p - L[j - 1] <= L[j] - p)) j = j == 0 ? 0 : j - 1;
+        const size_t j = nearest_plane(a, static_cast<uint32_t>(p));
         size_t jx = 0;
         int on = 0;
         if constexpr (Sink::kEncoder) {
@@ -448,6 +471,7 @@ std::string encode_with(const GeometryLayout& g, const std::vector<uint32_t>& q,
   EncodeSink s;
   c.lattice = lattice;
   code_lattice(s, c);
+  c.build_nearest();
   std::vector<uint32_t> work = q;
   if (pred == Predictor::ancestors)
     code_ancestors(g, K, lambda, c, s, work);
@@ -616,6 +640,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");
+  c.build_nearest();
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(c.lattice.values[a].size());
   q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
   bool ok;

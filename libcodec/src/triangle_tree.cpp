@@ -85,9 +85,10 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
   return Status::Ok();
 }
 
-Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<uint32_t>& tri_pos,
-                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge,
-                            std::vector<uint32_t>& edge_loop) {
+Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vector<uint32_t>& loop, uint32_t n,
+                            MarchBitSource& bits, std::vector<uint32_t>& tri_pos, std::vector<uint32_t>& parent,
+                            std::vector<uint8_t>& parent_edge, std::vector<uint32_t>& edge_loop,
+                            uint64_t& bit_count) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "triangle tree: " + what); };
   const size_t nr = runs.march.size();
   if (L < 4 || runs.root >= L) return corrupt("bad loop length or root position");
@@ -118,8 +119,15 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
   edge_loop.assign(3 * static_cast<size_t>(T), kNone);
   auto fwd = [L](uint32_t p, uint32_t d) { return (p + d) % L; };
   auto bwd = [L](uint32_t p, uint32_t d) { return (p + L - d) % L; };
+  if (loop.size() != L) return corrupt("loop length mismatch");
+  std::vector<uint32_t> valence(n, 0);  // triangles emitted so far around each vertex
+  for (uint32_t p = 0; p < L; ++p)
+    if (loop[p] >= n) return corrupt("loop vertex out of range");
   uint32_t k = 0;
   auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) {
+    ++valence[loop[a]];
+    ++valence[loop[b]];
+    ++valence[loop[x]];
     tri_pos[3 * k] = a;
     tri_pos[3 * k + 1] = b;
     tri_pos[3 * k + 2] = x;
@@ -137,14 +145,18 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
   };
   std::vector<Gate> stack;
   Gate cur{bwd(r, 1), fwd(r, 1), 0, 2};
-  size_t bit = 0;
+  bit_count = 0;
   for (size_t ri = 0; ri < nr; ++ri) {
     // Edges in this polygon besides the gate: (a - b) mod L.
+    int prev = 2;
     for (uint32_t i = 0; i < runs.march[ri]; ++i) {
       uint32_t span = (cur.a + L - cur.b) % L;
       if (span < 3) return corrupt("a march step leaves no room for the rest of the run");
-      if (bit >= runs.bits.size()) return corrupt("marching bits run out");
-      if (runs.bits[bit++] == 0) {
+      const int ctx = (static_cast<int>(std::min<uint32_t>(valence[loop[cur.a]], 7)) * 8 +
+                       static_cast<int>(std::min<uint32_t>(valence[loop[cur.b]], 7))) * 3 + prev;
+      prev = bits.bit(ctx);
+      ++bit_count;
+      if (prev == 0) {
         uint32_t x = fwd(cur.b, 1);
         uint32_t t = emit(cur.a, cur.b, x, cur.par, cur.slot);
         edge_loop[3 * static_cast<size_t>(t) + 1] = cur.b;
@@ -177,7 +189,7 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, std::vector<ui
       cur = {x, cur.b, t, 1};
     }
   }
-  if (k != T || bit != runs.bits.size()) return corrupt("triangle count or marching bits do not match the loop");
+  if (k != T) return corrupt("triangle count does not match the loop");
   return Status::Ok();
 }
 
