@@ -1,11 +1,11 @@
 // The vertex spanning tree (seed 004 §3.1; design notes §3): the layered
 // construction. Breadth-first rings around a root; Kruskal (union-find) over
-// the edges with the root's reference edge first, then every same-ring edge,
-// inner rings before outer, then
-// the ring-to-ring edges, then edges to virtual vertices (which so become
-// leaves), polygon diagonals last (so they are never cut). Each ring becomes
-// one path and rings are joined by single edges: a spiral with few, long
-// runs. The tree is linearized in pre-order with the children of a node in
+// the edges with the root's reference edge first, then the same-ring edges,
+// inner rings before outer, each vertex taking at most two of them (so a
+// ring becomes paths, not branching trees), then the ring-to-ring edges,
+// those that join path ends first, then edges to virtual vertices (which so
+// become leaves), polygon diagonals last (so they are never cut). Rings are
+// paths joined by single edges: a spiral with few, long runs. The tree is linearized in pre-order with the children of a node in
 // clockwise order starting from the edge to its parent.
 #include <algorithm>
 #include <numeric>
@@ -77,7 +77,7 @@ VertexForest build_vertex_tree(const CutMesh& m) {
 
   // Edges (each once), keyed by class and ring, Kruskal.
   struct Edge {
-    uint64_t key;   // class (4 bits) | ring (28 bits) | rank of the first endpoint (32 bits)
+    uint64_t key;   // class (4 bits) | path-end preference (2) | ring (26 bits) | rank of the first endpoint (32)
     uint32_t rb;    // rank of the second endpoint
     uint32_t h;     // last resort, only between parallel edges
   };
@@ -108,13 +108,52 @@ VertexForest build_vertex_tree(const CutMesh& m) {
       cls = 2;
       ring = std::min(dist[a], dist[b]);
     }
-    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 28) - 1) << 32) | ra, rb, h});
+    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, rb, h});
   }
-  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+  auto by_key = [](const Edge& x, const Edge& y) {
+    return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
+  };
+  std::sort(edges.begin(), edges.end(), by_key);
+  UnionFind uf(nv);
+  // Phase 1: the reference edges and same-ring edges, each ring a set of
+  // paths (a vertex takes at most two same-ring tree edges).
+  std::vector<uint8_t> ring_deg(nv, 0);
+  size_t i = 0;
+  for (; i < edges.size() && (edges[i].key >> 60) <= 1; ++i) {
+    const Edge& e = edges[i];
+    uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
+    const bool same_ring = (e.key >> 60) == 1;
+    if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) continue;
+    if (uf.unite(a, b)) {
+      f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
+      if (same_ring) {
+        ++ring_deg[a];
+        ++ring_deg[b];
+      }
+    }
+  }
+  // Phase 2: the rest; ring-to-ring edges that join path ends first (a
+  // path attached at its end continues a run instead of branching).
+  for (size_t j = i; j < edges.size(); ++j) {
+    Edge& e = edges[j];
+    if ((e.key >> 60) != 2) continue;
+    uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
+    uint32_t inner = dist[a] < dist[b] ? a : b, outer = inner == a ? b : a;
+    uint64_t ends = (ring_deg[outer] >= 2 ? 2u : 0u) + (ring_deg[inner] >= 2 ? 1u : 0u);
+    e.key = (e.key & ~(uint64_t{3} << 58)) | (ends << 58);
+  }
+  std::sort(edges.begin() + static_cast<std::ptrdiff_t>(i), edges.end(), [](const Edge& x, const Edge& y) {
+    // class, then ring, then path-end preference, then ranks
+    uint64_t cx = x.key >> 60, cy = y.key >> 60;
+    if (cx != cy) return cx < cy;
+    uint64_t rx = (x.key >> 32) & ((1u << 26) - 1), ry = (y.key >> 32) & ((1u << 26) - 1);
+    if (rx != ry) return rx < ry;
+    uint64_t ex = (x.key >> 58) & 3, ey = (y.key >> 58) & 3;
+    if (ex != ey) return ex < ey;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
   });
-  UnionFind uf(nv);
-  for (const Edge& e : edges) {
+  for (; i < edges.size(); ++i) {
+    const Edge& e = edges[i];
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
   }
@@ -148,7 +187,7 @@ VertexForest build_vertex_tree(const CutMesh& m) {
         } while (h != start);
       }
       f.child_count.push_back(static_cast<uint32_t>(kids.size()));
-      for (size_t i = kids.size(); i-- > 0;) stack.push_back(kids[i]);
+      for (size_t k = kids.size(); k-- > 0;) stack.push_back(kids[k]);
     }
   }
   f.component_start.push_back(static_cast<uint32_t>(f.order.size()));
