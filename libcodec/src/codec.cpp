@@ -202,6 +202,16 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.virtual_vertices = st.virtual_vertices;
   info.side_faces = st.side_faces;
   info.marching_bits = st.marching_bits;
+  const Section* geo = find_section(sections, kSectionGeometry);
+  if (!geo) return corrupt("the geometry section is missing");
+  std::vector<uint32_t> q;
+  GeometryStats gs;
+  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, layout, h.quantization_bits, q, &gs));
+  info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
+                            : gs.predictor == Predictor::gate    ? "gate"
+                                                                 : "parallelograms";
+  info.ancestors = gs.ancestors;
+  for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();
 }
 

@@ -454,7 +454,9 @@ bool code_lattice(Sink& s, Coder& c) {
   return true;
 }
 
-std::string encode_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
+}  // namespace
+
+std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
                         const Lattice& lattice) {
   std::string head;
   ByteWriter w(head);
@@ -482,7 +484,6 @@ std::string encode_with(const GeometryLayout& g, const std::vector<uint32_t>& q,
   return head + s.e.finish();
 }
 
-}  // namespace
 
 std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
   const uint32_t n = g.vertex_count;
@@ -571,13 +572,13 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   Lattice none;
-  std::string best = encode_with(g, q, bits, st.predictor, 0, none);
+  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, none);
   if (level >= 3 && candidate) {
     // Shared coordinate planes: keep them where they make the file smaller
     // (all candidate axes at once, then at high levels each axis alone).
     const Lattice& found = *candidate;
     if (!found.values[0].empty() || !found.values[1].empty() || !found.values[2].empty()) {
-      std::string alt = encode_with(g, q, bits, st.predictor, 0, found);
+      std::string alt = encode_geometry_as(g, q, bits, st.predictor, 0, found);
       if (alt.size() < best.size()) {
         best.swap(alt);
         st.lattice = found;
@@ -587,7 +588,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
           Lattice trial = st.lattice;
           if (trial.values[a].empty()) continue;
           trial.values[a].clear();
-          alt = encode_with(g, q, bits, st.predictor, 0, trial);
+          alt = encode_geometry_as(g, q, bits, st.predictor, 0, trial);
           if (alt.size() < best.size()) {
             best.swap(alt);
             st.lattice = trial;
@@ -597,7 +598,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   if (level >= 7) {
     for (int K = 1; K <= kMaxAncestors; ++K) {
-      std::string alt = encode_with(g, q, bits, Predictor::ancestors, K, st.lattice);
+      std::string alt = encode_geometry_as(g, q, bits, Predictor::ancestors, K, st.lattice);
       if (alt.size() < best.size()) {
         best.swap(alt);
         st.predictor = Predictor::ancestors;

@@ -60,8 +60,14 @@ struct FileInfo {
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, marching_bits = 0;
   uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;  // stored bytes by kind
+  // Geometry (from decoding the geometry stream): "parallelograms", "gate"
+  // or "ancestors" (with K), and the lattice planes per axis (0 = unused).
+  std::string geometry_predictor;
+  int ancestors = 0;
+  uint32_t lattice_planes[3] = {0, 0, 0};
 };
-// Parses the header and section table (checksums verified), not the payload.
+// Parses the header and section table (checksums verified) and decodes the
+// streams for the figures above (so it also validates the whole file).
 Status inspect(std::string_view bytes, FileInfo& info);
 
 const char* version_string();

@@ -1,0 +1,218 @@
+// Geometry coding (geometry_predict.cpp): every predictor round trips on
+// every family, the lattice is found and used on marching-cubes-like meshes
+// (and not on others), vertices on no triangle are predicted from a nearby
+// surface vertex, re-encoding is canonical, and damaged geometry sections
+// are refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "connectivity.hpp"
+#include "geometry_predict.hpp"
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/tsm.hpp"
+
+namespace {
+
+using tsm::Mesh;
+
+// A sphere whose vertices sit on the edges of a voxel grid, as marching
+// cubes leaves them: two coordinates on grid planes, the third free.
+Mesh voxel_sphere(int level, float voxel) {
+  Mesh m = tsm_test::icosphere(level);
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    float* p = &m.positions[3 * v];
+    int free_axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (std::fabs(p[a]) > std::fabs(p[free_axis])) free_axis = a;
+    for (int a = 0; a < 3; ++a)
+      if (a != free_axis) p[a] = std::round(p[a] / voxel) * voxel;
+  }
+  return m;
+}
+
+// A sphere plus points scattered just off its surface, on no face.
+Mesh sphere_with_strays(int level, int strays) {
+  Mesh m = tsm_test::icosphere(level);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<size_t> pick(0, m.vertex_count() - 1);
+  std::uniform_real_distribution<float> jitter(-0.003f, 0.003f);
+  const size_t n = m.vertex_count();
+  for (int i = 0; i < strays; ++i) {
+    const float* p = &m.positions[3 * pick(rng)];
+    m.add_vertex(p[0] + jitter(rng), p[1] + jitter(rng), p[2] + jitter(rng));
+  }
+  (void)n;
+  return m;
+}
+
+tsm::FileInfo info_of(const std::string& bytes) {
+  tsm::FileInfo fi;
+  tsm::Status s = tsm::inspect(bytes, fi);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return fi;
+}
+
+std::string encode(const Mesh& m, int q, int level) {
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{q, level}, bytes);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return bytes;
+}
+
+void expect_round_trip(const Mesh& m, const std::string& bytes, int q, const std::string& what) {
+  Mesh back;
+  tsm::Status s = tsm::decode(bytes, back);
+  ASSERT_TRUE(s.ok()) << what << ": " << s.to_string();
+  tsm::CompareResult r = tsm::compare_meshes(m, back, q);
+  EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+  EXPECT_LE(r.max_position_error, 0.5 + 1e-3) << what;
+  // Canonical: the decoded mesh encodes to the same bytes.
+  std::string again;
+  ASSERT_TRUE(tsm::encode(back, tsm::EncodeOptions{q, info_of(bytes).level}, again).ok());
+  EXPECT_EQ(again, bytes) << what << ": re-encoding gives other bytes";
+}
+
+// The layout and quantized positions the encoder would use, for forcing a
+// predictor.
+struct Prepared {
+  tsm::ConnectivityEncoding ce;
+  std::vector<uint32_t> q;
+};
+
+Prepared prepare(const Mesh& m, int bits) {
+  Prepared p;
+  EXPECT_TRUE(tsm::encode_connectivity(m, p.ce).ok());
+  tsm::Grid grid = tsm::Grid::for_mesh(m, bits);
+  const int64_t qmax = (int64_t{1} << bits) - 1;
+  p.q.resize(3 * m.vertex_count());
+  for (size_t v = 0; v < p.ce.vertex_order.size(); ++v)
+    for (int a = 0; a < 3; ++a) {
+      int64_t x = grid.quantize(m.positions[3 * static_cast<size_t>(p.ce.vertex_order[v]) + a], a);
+      p.q[3 * v + a] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
+    }
+  return p;
+}
+
+TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
+  std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"icosphere(3)", tsm_test::icosphere(3)},
+      {"genus_surface(2)", tsm_test::genus_surface(2)},
+      {"grid_with_holes(10,3)", tsm_test::grid_with_holes(10, 3)},
+      {"moebius(12)", tsm_test::moebius(12)},
+      {"book(4)", tsm_test::book(4)},
+      {"random_soup(200,300)", tsm_test::random_soup(200, 300, 3)},
+      {"cube_quads", tsm_test::cube_quads()},
+      {"voxel_sphere", voxel_sphere(3, 0.05f)},
+      {"sphere_with_strays", sphere_with_strays(2, 30)},
+  };
+  using tsm::Predictor;
+  for (auto& [name, m] : meshes) {
+    for (int bits : {4, 11, 20}) {
+      Prepared p = prepare(m, bits);
+      tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
+      for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::parallelograms, 0}, {Predictor::ancestors, 1},
+                             {Predictor::ancestors, 3}, {Predictor::ancestors, 4}}) {
+        for (bool use_lattice : {false, true}) {
+          SCOPED_TRACE(name + " bits=" + std::to_string(bits) + " predictor=" + std::to_string(int(pred)) +
+                       " K=" + std::to_string(K) + " lattice=" + std::to_string(use_lattice));
+          std::string bytes =
+              tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, use_lattice ? lattice : tsm::Lattice());
+          std::vector<uint32_t> back;
+          tsm::GeometryStats st;
+          tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
+          ASSERT_TRUE(s.ok()) << s.to_string();
+          EXPECT_EQ(back, p.q);
+          EXPECT_EQ(st.predictor, pred);
+          EXPECT_EQ(st.ancestors, K);
+        }
+      }
+    }
+  }
+}
+
+TEST(Geometry, LatticeFoundOnVoxelMeshesOnly) {
+  const Mesh vox = voxel_sphere(5, 0.02f);
+  for (int q : {11, 14, 16}) {
+    std::string bytes = encode(vox, q, 6);
+    tsm::FileInfo fi = info_of(bytes);
+    EXPECT_GT(fi.lattice_planes[0] + fi.lattice_planes[1] + fi.lattice_planes[2], 0u) << "q=" << q;
+    expect_round_trip(vox, bytes, q, "voxel sphere q=" + std::to_string(q));
+    // The lattice pays: without it (level 2 codes no lattice) the file is larger.
+    EXPECT_LT(bytes.size(), encode(vox, q, 2).size()) << "q=" << q;
+  }
+  const Mesh smooth = tsm_test::icosphere(5);
+  for (int q : {11, 16}) {
+    tsm::FileInfo fi = info_of(encode(smooth, q, 6));
+    EXPECT_EQ(fi.lattice_planes[0] + fi.lattice_planes[1] + fi.lattice_planes[2], 0u) << "q=" << q;
+  }
+}
+
+TEST(Geometry, StrayVerticesPredictedFromTheSurface) {
+  const int strays = 400;
+  const Mesh m = sphere_with_strays(4, strays);
+  const Mesh bare = tsm_test::icosphere(4);
+  for (int q : {11, 16}) {
+    std::string with = encode(m, q, 6), without = encode(bare, q, 6);
+    expect_round_trip(m, with, q, "strays q=" + std::to_string(q));
+    // Each stray lies within 0.003 of a surface vertex: far cheaper than three
+    // free coordinates (3q bits) even with the anchor's index.
+    double bits_each = 8.0 * static_cast<double>(with.size() - without.size()) / strays;
+    EXPECT_LT(bits_each, 0.7 * 3 * q) << "q=" << q;
+  }
+}
+
+TEST(Geometry, EveryLevelRoundTripsAndIsCanonical) {
+  const Mesh meshes[] = {voxel_sphere(3, 0.05f), sphere_with_strays(2, 20), tsm_test::genus_surface(3),
+                         tsm_test::grid_with_holes(9, 2)};
+  for (const Mesh& m : meshes)
+    for (int level : {0, 3, 6, 9}) {
+      std::string bytes = encode(m, 12, level);
+      expect_round_trip(m, bytes, 12, "level " + std::to_string(level));
+    }
+}
+
+TEST(Geometry, HigherLevelsNeverLarger) {
+  const Mesh m = voxel_sphere(4, 0.03f);
+  size_t l3 = encode(m, 14, 3).size(), l6 = encode(m, 14, 6).size(), l9 = encode(m, 14, 9).size();
+  EXPECT_LE(l9, l6);
+  EXPECT_LE(l6, l3 + l3 / 50);  // greedy order vs march order: within 2%
+}
+
+TEST(Geometry, DamagedSectionsRefused) {
+  Prepared p = prepare(tsm_test::icosphere(2), 12);
+  std::string good = tsm::encode_geometry_as(p.ce.layout, p.q, 12, tsm::Predictor::ancestors, 2, tsm::Lattice());
+  std::vector<uint32_t> back;
+  ASSERT_TRUE(tsm::decode_geometry(good, p.ce.layout, 12, back).ok());
+  auto refused = [&](std::string bytes, const char* what) {
+    tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, 12, back);
+    EXPECT_EQ(s.code(), tsm::ErrorCode::corrupt_data) << what;
+  };
+  refused("", "empty");
+  std::string bad = good;
+  bad[0] = 7;
+  refused(bad, "unknown predictor");
+  bad = good;
+  bad[1] = 0;
+  refused(bad, "K = 0");
+  bad[1] = 5;
+  refused(bad, "K = 5");
+  bad = good;
+  bad[5] = static_cast<char>(0x7f);  // lambda far out of range
+  refused(bad, "lambda out of range");
+  refused(good.substr(0, 4), "truncated lambdas");
+  refused(good.substr(0, good.size() / 2), "truncated stream");
+  // Random damage: an error or (rarely) other coordinates, never a crash.
+  std::mt19937 rng(11);
+  for (int i = 0; i < 2000; ++i) {
+    std::string d = good;
+    d[rng() % d.size()] ^= static_cast<char>(1 + rng() % 255);
+    (void)tsm::decode_geometry(d, p.ce.layout, 12, back);
+  }
+}
+
+}  // namespace
