@@ -112,7 +112,9 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   };
 
   ConnectivityEncoding ce;
-  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce));
+  CutHints hints;
+  hints.qpos = &qin;
+  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
   std::vector<uint32_t> q = reorder(ce);
   // Vertices on no triangle go last, ordered by a nearby surface vertex
   // that predicts them: a second pass with those anchors.
@@ -121,7 +123,8 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
     for (size_t v = 0; v < anchor.size(); ++v) by_input[ce.vertex_order[v]] = anchor[v];
     ce = ConnectivityEncoding();
-    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, &by_input));
+    hints.anchor = &by_input;
+    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
     q = reorder(ce);
   }
   const Lattice lattice = find_lattice(q, static_cast<uint32_t>(mesh.vertex_count()));

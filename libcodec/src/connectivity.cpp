@@ -40,12 +40,12 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 
 }  // namespace
 
-Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const std::vector<uint32_t>* anchor) {
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
   out = ConnectivityEncoding();
   if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
     return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
   const PreparedInput prep = prepare_input(mesh);
-  const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), anchor);
+  const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), hints);
   const VertexForest f = build_vertex_tree(m);
 
   RangeEncoder ev, et, eo;
@@ -200,8 +200,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const st
       g.parent[out_id[p]] = f.parent[p] == kNone ? kNone : out_id[f.parent[p]];
   g.vertex = out_id;
   g.anchor.assign(g.vertex_count, kNone);
-  if (anchor)
-    for (uint32_t v = 0; v < g.vertex_count; ++v) g.anchor[v] = (*anchor)[out.vertex_order[v]];
+  if (hints.anchor)
+    for (uint32_t v = 0; v < g.vertex_count; ++v) g.anchor[v] = (*hints.anchor)[out.vertex_order[v]];
   if (dec_tri.size() != m.triangle_count()) return Status(ErrorCode::internal, "triangle trees lost triangles");
   g.tri.resize(3 * dec_tri.size());
   g.twin.resize(3 * dec_tri.size());

@@ -75,9 +75,18 @@ struct PreparedInput {
 };
 
 PreparedInput prepare_input(const Mesh& mesh);
-// isolated_key (optional, per input vertex) orders the vertices on no triangle.
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count,
-                 const std::vector<uint32_t>* isolated_key = nullptr);
+// What the encoder may know beyond the faces (all optional, per input vertex).
+struct CutHints {
+  // For a vertex on no triangle: the output id of a nearby surface vertex
+  // (kNone if none); orders those vertices and predicts them.
+  const std::vector<uint32_t>* anchor = nullptr;
+  // Quantized positions (3 per vertex): the uses of an edge with more than
+  // two faces are paired in the order of their third corner's position, so
+  // a decoded mesh cuts the same way again (canonical re-encoding).
+  const std::vector<uint32_t>* qpos = nullptr;
+};
+
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
 
 // Stage 2: the vertex spanning forest, in pre-order.
 struct VertexForest {
@@ -180,11 +189,7 @@ struct ConnectivityEncoding {
   ConnectivityStats stats;
 };
 
-// anchor (optional, per input vertex): for a vertex on no triangle, the
-// output id of a nearby surface vertex (kNone if none), which orders those
-// vertices and lets the geometry coder predict them from it.
-Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out,
-                           const std::vector<uint32_t>* anchor = nullptr);
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints = CutHints());
 // Fills out.face_offsets / out.indices (positions are the geometry stage's
 // job) and the layout the geometry decoder walks. The counts come from the
 // header and are checked against what the streams say.

@@ -95,29 +95,44 @@ PreparedInput prepare_input(const Mesh& mesh) {
   return kept;
 }
 
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const std::vector<uint32_t>* isolated_key) {
+CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints) {
+  const std::vector<uint32_t>* isolated_key = hints.anchor;
   CutMesh m;
   const uint32_t nh = static_cast<uint32_t>(in.tri.size());
   m.tri = in.tri;
   m.diagonal = in.tri_diagonal;
   m.twin.assign(nh, kNone);
 
-  // 1. Pair half-edges: exactly two uses of an edge, in opposite directions.
+  // 1. Pair half-edges: the uses of an edge in one direction with those in
+  // the other, in order (two opposite uses: a manifold edge; more: sheets
+  // meeting at an edge, kept as pairs so only unmatched uses are cut).
   auto edges = sorted_edges(in.tri);
+  std::vector<uint32_t> forward, backward;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-    if (j - i == 2) {
-      uint32_t h0 = edges[i].second, h1 = edges[i + 1].second;
-      if (in.tri[h0] == in.tri[he_next(h1)]) {
-        m.twin[h0] = h1;
-        m.twin[h1] = h0;
-      } else {
-        ++m.cut_edges;
-      }
-    } else if (j - i > 2) {
-      ++m.cut_edges;
+    forward.clear();
+    backward.clear();
+    for (size_t k = i; k < j; ++k) {
+      uint32_t h = edges[k].second;
+      (in.tri[h] < in.tri[he_next(h)] ? forward : backward).push_back(h);
     }
+    if (hints.qpos && j - i > 2) {
+      // By the third corner's quantized position (then half-edge order).
+      auto third = [&](uint32_t h) { return &(*hints.qpos)[3 * static_cast<size_t>(in.tri[he_prev(h)])]; };
+      auto less = [&](uint32_t x, uint32_t y) {
+        const uint32_t *a = third(x), *b = third(y);
+        return std::lexicographical_compare(a, a + 3, b, b + 3);
+      };
+      std::stable_sort(forward.begin(), forward.end(), less);
+      std::stable_sort(backward.begin(), backward.end(), less);
+    }
+    const size_t pairs = std::min(forward.size(), backward.size());
+    for (size_t k = 0; k < pairs; ++k) {
+      m.twin[forward[k]] = backward[k];
+      m.twin[backward[k]] = forward[k];
+    }
+    if (j - i != 2 * pairs || j - i > 2) ++m.cut_edges;
     i = j;
   }
 
