@@ -212,3 +212,29 @@ TEST(Connectivity, CorpusRoundTrips) {
     expect_round_trip(m, name, 11, std::string(name) == "bun_zipper.ply");
   }
 }
+
+TEST(Connectivity, MidpointKruskalTreeRoundTrips) {
+  // The midpoint-distance variant of the vertex tree (the encoder keeps it at
+  // level 9 when smaller): the decoder needs nothing new, the tree is coded.
+  for (const Mesh& m : {icosphere(3), genus_surface(2, 2), grid_with_holes(12, 3), book(4), moebius(10)}) {
+    std::vector<uint32_t> qpos(m.positions.size());
+    Grid grid = Grid::for_mesh(m, 12);
+    for (size_t i = 0; i < qpos.size(); ++i)
+      qpos[i] = static_cast<uint32_t>(std::max<int64_t>(0, grid.quantize(m.positions[i], static_cast<int>(i % 3))));
+    for (bool midpoint : {false, true}) {
+      CutHints hints;
+      hints.qpos = &qpos;
+      hints.midpoint_tree = midpoint;
+      ConnectivityEncoding ce;
+      ASSERT_TRUE(encode_connectivity(m, ce, hints).ok());
+      Mesh back;
+      GeometryLayout layout;
+      ASSERT_TRUE(decode_connectivity(ce.streams, m.vertex_count(), m.face_count(), m.corner_count(), back, layout).ok());
+      back.positions.resize(m.positions.size());
+      for (size_t v = 0; v < ce.vertex_order.size(); ++v)
+        for (int a = 0; a < 3; ++a) back.positions[3 * v + a] = m.positions[3 * size_t{ce.vertex_order[v]} + a];
+      CompareResult r = compare_meshes(m, back, 12);
+      EXPECT_TRUE(r.equal) << "midpoint " << midpoint << ": " << r.difference;
+    }
+  }
+}

@@ -115,6 +115,17 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   CutHints hints;
   hints.qpos = &qin;
   TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+  if (options.level >= 9) {
+    // The midpoint-distance Kruskal tree instead of the layered spiral, kept
+    // if its connectivity is smaller (on the corpus it never is).
+    ConnectivityEncoding alt;
+    hints.midpoint_tree = true;
+    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, alt, hints));
+    if (alt.stats.bytes < ce.stats.bytes)
+      ce = std::move(alt);
+    else
+      hints.midpoint_tree = false;
+  }
   std::vector<uint32_t> q = reorder(ce);
   // Vertices on no triangle go last, ordered by a nearby surface vertex
   // that predicts them: a second pass with those anchors.

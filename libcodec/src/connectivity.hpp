@@ -84,6 +84,9 @@ struct CutHints {
   // two faces are paired in the order of their third corner's position, so
   // a decoded mesh cuts the same way again (canonical re-encoding).
   const std::vector<uint32_t>* qpos = nullptr;
+  // The vertex tree: the midpoint-distance Kruskal variant (needs qpos)
+  // instead of the layered spiral.
+  bool midpoint_tree = false;
 };
 
 CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
@@ -101,7 +104,10 @@ struct VertexForest {
   std::vector<uint8_t> tree_he;         // per half-edge: 1 if it is a tree edge (both directions)
 };
 
-VertexForest build_vertex_tree(const CutMesh& m);
+// midpoint: the Kruskal variant over edges by their midpoint's distance from
+// the root (needs qpos, quantized positions per input vertex); else the
+// layered spiral.
+VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos = nullptr, bool midpoint = false);
 
 // Stage 3: bounding loop of one component (encoder side: with half-edges).
 struct JumpEndpoint {

@@ -14,7 +14,7 @@
 
 namespace tsm {
 
-VertexForest build_vertex_tree(const CutMesh& m) {
+VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos, bool midpoint) {
   const uint32_t nv = m.vertex_count;
   const uint32_t nh = static_cast<uint32_t>(m.tri.size());
   VertexForest f;
@@ -78,6 +78,7 @@ VertexForest build_vertex_tree(const CutMesh& m) {
   // Edges (each once), keyed by class and ring, Kruskal.
   struct Edge {
     uint64_t key;   // class (4 bits) | path-end preference (2) | ring (26 bits) | rank of the first endpoint (32)
+    double dist;    // midpoint variant: squared distance of the edge's midpoint from the root
     uint32_t rb;    // rank of the second endpoint
     uint32_t h;     // last resort, only between parallel edges
   };
@@ -108,9 +109,24 @@ VertexForest build_vertex_tree(const CutMesh& m) {
       cls = 2;
       ring = std::min(dist[a], dist[b]);
     }
-    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, rb, h});
+    double d = 0;
+    if (midpoint && (cls == 1 || cls == 2)) {
+      cls = 1;
+      ring = 0;
+      const uint32_t root = m.component_root[m.vertex_component[a]];
+      const uint32_t* pa = &(*qpos)[3 * static_cast<size_t>(m.source[a])];
+      const uint32_t* pb = &(*qpos)[3 * static_cast<size_t>(m.source[b])];
+      const uint32_t* pr = &(*qpos)[3 * static_cast<size_t>(m.source[root])];
+      for (int k = 0; k < 3; ++k) {
+        double e = static_cast<double>(pa[k]) + pb[k] - 2.0 * pr[k];
+        d += e * e;
+      }
+    }
+    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, d, rb, h});
   }
   auto by_key = [](const Edge& x, const Edge& y) {
+    if ((x.key >> 60) != (y.key >> 60)) return x.key < y.key;
+    if (x.dist != y.dist) return x.dist < y.dist;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
   };
   std::sort(edges.begin(), edges.end(), by_key);
@@ -122,7 +138,7 @@ VertexForest build_vertex_tree(const CutMesh& m) {
   for (; i < edges.size() && (edges[i].key >> 60) <= 1; ++i) {
     const Edge& e = edges[i];
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
-    const bool same_ring = (e.key >> 60) == 1;
+    const bool same_ring = (e.key >> 60) == 1 && !midpoint;
     if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) continue;
     if (uf.unite(a, b)) {
       f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
