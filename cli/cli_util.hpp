@@ -33,6 +33,8 @@ std::string json_escape(const std::string& s);
 // 1234567 -> "1,234,567"
 std::string thousands(unsigned long long n);
 std::string fixed(double v, int decimals);
+// printf into a std::string.
+std::string strf(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
 // The corpus folder beside the source tree (TSM_CORPUS overrides), or "".
 std::string default_corpus_dir();

@@ -1,14 +1,20 @@
 // The `tsm` command-line tool, run as a separate process (TSM_CLI_PATH):
 // every command, exit codes, messages, and the promises about files (never
 // overwrite the input, never clobber without -f, never leave partial output).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mesh_gen.hpp"
@@ -50,9 +56,15 @@ class Cli : public ::testing::Test {
 
   // Runs `tsm <args>` with stdout and stderr captured in files of the temp dir
   // (kept outside the folder the tests inspect for leftovers).
-  Result tsm(const std::string& args) {
+  Result tsm(const std::string& args) { return sh("$TSM " + args + " </dev/null"); }
+
+  // Runs a shell command line in which $TSM is the tool, with stdout and
+  // stderr captured (unless the line redirects them itself).
+  Result sh(const std::string& line) {
     const std::string out = logs.file("stdout"), err = logs.file("stderr");
-    const std::string cmd = quote(TSM_CLI_PATH) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
+    fs::remove(out);
+    fs::remove(err);
+    const std::string cmd = "TSM=" + quote(TSM_CLI_PATH) + "; { " + line + " ; } >" + quote(out) + " 2>" + quote(err);
     int status = std::system(cmd.c_str());
     Result r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
@@ -176,8 +188,13 @@ TEST_F(Cli, DefaultOutputNamesAndOverwriteRules) {
   r = tsm("encode " + q("in.ply") + " -o " + q("other.obj"));
   EXPECT_EQ(r.code, 3);
   EXPECT_EQ(slurp(file("other.obj")), "v 0 0 0\n");
-  // ...but a previous .tsm is simply replaced.
+  // ...nor a previous .tsm (it may be the only copy left): -f replaces it.
+  const std::string previous = slurp(file("in.tsm"));
   r = tsm("encode " + q("in.ply") + " -q 6 --quiet");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("in.tsm: already exists; pass -f"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(file("in.tsm")), previous);
+  r = tsm("encode " + q("in.ply") + " -q 6 --quiet -f");
   EXPECT_EQ(r.code, 0) << r.err;
   tsm::FileInfo fi;
   ASSERT_TRUE(tsm::inspect(slurp(file("in.tsm")), fi).ok());
@@ -303,6 +320,547 @@ TEST_F(Cli, BenchOnASmallMesh) {
   r = tsm("bench " + q("bad.ply") + " --runs 1 -q 8 --quiet");
   EXPECT_EQ(r.code, 3) << r.out << r.err;
   EXPECT_NE(r.err.find("bad.ply"), std::string::npos) << r.err;
+}
+
+// ---------------------------------------------------------------- many files, pipes, safety
+
+// Lines of a text.
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// A pseudo-terminal: the tool sees a terminal on the side we give it.
+struct Pty {
+  int master = -1;
+  std::string slave;
+  Pty() {
+    master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master >= 0 && grantpt(master) == 0 && unlockpt(master) == 0) slave = ptsname(master);
+  }
+  ~Pty() {
+    if (master >= 0) close(master);
+  }
+  bool ok() const { return !slave.empty(); }
+  // What the tool wrote (it has exited).
+  std::string drain() const {
+    std::string out;
+    char buf[4096];
+    while (poll_readable()) {
+      ssize_t n = read(master, buf, sizeof buf);
+      if (n <= 0) break;
+      out.append(buf, static_cast<size_t>(n));
+    }
+    return out;
+  }
+
+ private:
+  bool poll_readable() const {
+    struct pollfd p = {master, POLLIN, 0};
+    return poll(&p, 1, 50) > 0 && (p.revents & POLLIN);
+  }
+};
+
+class CliBatch : public Cli {
+ protected:
+  // Three small meshes in three formats: a.ply, b.obj, c.off.
+  std::vector<tsm::Mesh> write_three() {
+    std::vector<tsm::Mesh> m = {tsm_test::icosphere(2), tsm_test::cube_quads(), tsm_test::book(4)};
+    EXPECT_TRUE(tsm::write_mesh(file("a.ply"), m[0]).ok());
+    EXPECT_TRUE(tsm::write_mesh(file("b.obj"), m[1]).ok());
+    std::ostringstream off;
+    off << "OFF\n" << m[2].vertex_count() << " " << m[2].face_count() << " 0\n";
+    for (size_t v = 0; v < m[2].vertex_count(); ++v)
+      off << m[2].positions[3 * v] << " " << m[2].positions[3 * v + 1] << " " << m[2].positions[3 * v + 2] << "\n";
+    for (size_t f = 0; f < m[2].face_count(); ++f) {
+      off << m[2].face_size(f);
+      for (uint32_t c = 0; c < m[2].face_size(f); ++c) off << " " << m[2].face(f)[c];
+      off << "\n";
+    }
+    spit(file("c.off"), off.str());
+    return m;
+  }
+
+  // Files (not folders) under the work folder, recursively, whose name contains ".tmp-".
+  int temporaries_anywhere() const {
+    int n = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir.path))
+      if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
+    return n;
+  }
+
+  void expect_same_mesh(const tsm::Mesh& original, const std::string& path, int q) {
+    tsm::Mesh back;
+    tsm::Status s = tsm::read_mesh(path, back);
+    ASSERT_TRUE(s.ok()) << path << ": " << s.to_string();
+    auto c = tsm::compare_meshes(original, back, q);
+    EXPECT_TRUE(c.equal) << path << ": " << c.difference;
+  }
+};
+
+TEST_F(CliBatch, HelpShowsTheNewOptionsWithExamples) {
+  struct Expect {
+    const char* cmd;
+    std::vector<const char*> options;
+  };
+  for (const Expect& e : {Expect{"encode", {"--jobs", "--input-format", "--json", "--force", "--quiet", "-o"}},
+                          Expect{"decode", {"--jobs", "--format", "--json", "--force", "--quiet", "--ascii"}},
+                          Expect{"info", {"--jobs", "--json"}}}) {
+    Result r = tsm(std::string(e.cmd) + " --help");
+    ASSERT_EQ(r.code, 0) << e.cmd << ": " << r.err;
+    for (const char* o : e.options) EXPECT_NE(r.out.find(o), std::string::npos) << e.cmd << " " << o << ":\n" << r.out;
+    EXPECT_NE(r.out.find("Examples:\n  tsm " + std::string(e.cmd)), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(CliBatch, EncodeAndDecodeManyFilesIntoFolders) {
+  std::vector<tsm::Mesh> m = write_three();
+  Result r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " " + q("c.off") + " -o " + q("packed") + " -q 12 -j 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // One report per file, in input order whatever the order they finished in; a summary on stderr.
+  std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 3u) << r.out;
+  EXPECT_EQ(lines[0].rfind(file("a.ply") + ": 162 vertices", 0), 0u) << lines[0];
+  EXPECT_NE(lines[0].find("packed/a.tsm"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[1].rfind(file("b.obj") + ":", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind(file("c.off") + ":", 0), 0u) << lines[2];
+  EXPECT_NE(r.err.find("encoded 3 of 3 files"), std::string::npos) << r.err;
+  for (const char* name : {"a", "b", "c"}) ASSERT_TRUE(fs::is_regular_file(file("packed/" + std::string(name) + ".tsm")));
+
+  // decode: to a folder (created), PLY by default; OBJ with --format.
+  const std::string tsms = q("packed/a.tsm") + " " + q("packed/b.tsm") + " " + q("packed/c.tsm");
+  r = tsm("decode " + tsms + " -o " + q("back/") + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "");
+  r = tsm("decode " + tsms + " -o " + q("objs") + " --format obj --quiet -j 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const char* names[] = {"a", "b", "c"};
+  for (int i = 0; i < 3; ++i) {
+    expect_same_mesh(m[static_cast<size_t>(i)], file("back/" + std::string(names[i]) + ".ply"), 12);
+    expect_same_mesh(m[static_cast<size_t>(i)], file("objs/" + std::string(names[i]) + ".obj"), 12);
+  }
+  // A single file into an existing folder keeps its name.
+  r = tsm("decode " + q("packed/b.tsm") + " -o " + q("objs") + " --format ply --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_same_mesh(m[1], file("objs/b.ply"), 12);
+  // Without -o: beside each input.
+  r = tsm("decode " + tsms + " --format obj --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* name : names) EXPECT_TRUE(fs::exists(file("packed/" + std::string(name) + ".obj")));
+  // info takes many files too.
+  r = tsm("info " + tsms);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("a.tsm: tsm format version"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("c.tsm: tsm format version"), std::string::npos) << r.out;
+  EXPECT_LT(r.out.find("a.tsm: tsm"), r.out.find("b.tsm: tsm"));
+  EXPECT_EQ(temporaries_anywhere(), 0);
+}
+
+TEST_F(CliBatch, OneBrokenFileDoesNotStopTheOthers) {
+  write_three();
+  spit(file("broken.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
+  Result r = tsm("encode " + q("a.ply") + " " + q("broken.ply") + " " + q("b.obj") + " -o " + q("out") + " -j 2");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(fs::exists(file("out/a.tsm")));
+  EXPECT_TRUE(fs::exists(file("out/b.tsm")));
+  EXPECT_FALSE(fs::exists(file("out/broken.tsm")));
+  EXPECT_EQ(lines_of(r.out).size(), 2u) << r.out;
+  // The failure is reported when it happens and listed again at the end.
+  const size_t summary = r.err.find("1 of 3 files failed:");
+  ASSERT_NE(summary, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("broken.ply", summary), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("encoded 2 of 3 files"), std::string::npos) << r.err;
+
+  // --json: one object per input, in order, the failure included.
+  r = tsm("encode " + q("a.ply") + " " + q("broken.ply") + " " + q("b.obj") + " -o " + q("json") + " --json --quiet");
+  EXPECT_EQ(r.code, 3) << r.err;
+  std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 3u) << r.out;
+  EXPECT_NE(lines[0].find("\"status\": \"ok\""), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find("\"input\": \"" + file("broken.ply") + "\""), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find("\"status\": \"error\", \"exit_code\": 3, \"error\": \""), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find("line 3"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find("\"status\": \"ok\""), std::string::npos) << lines[2];
+
+  // decode: a corrupt file (bad input, 3) and an output that cannot be
+  // written (I/O, 4) beside good files: the exit code is the worst class.
+  std::string damaged = slurp(file("out/a.tsm"));
+  damaged[damaged.size() / 2] = static_cast<char>(damaged[damaged.size() / 2] ^ 0x10);
+  fs::create_directories(file("in"));
+  spit(file("in/damaged.tsm"), damaged);
+  fs::copy_file(file("out/a.tsm"), file("in/good.tsm"));
+  fs::copy_file(file("out/b.tsm"), file("in/blocked.tsm"));
+  fs::create_directories(file("dec/blocked.ply/sub"));  // a folder where the output should go
+  r = tsm("decode " + q("in/damaged.tsm") + " " + q("in/good.tsm") + " " + q("in/blocked.tsm") + " -o " + q("dec") +
+          " -f --quiet");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(file("dec/good.ply")));
+  EXPECT_FALSE(fs::exists(file("dec/damaged.ply")));
+  EXPECT_NE(r.err.find("2 of 3 files failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("damaged.tsm"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("blocked.ply"), std::string::npos) << r.err;
+  EXPECT_EQ(temporaries_anywhere(), 0);
+}
+
+TEST_F(CliBatch, ParallelRunsGiveTheSameBytesAsSerialRuns) {
+  const std::vector<tsm::Mesh> meshes = {tsm_test::icosphere(3), tsm_test::genus_surface(2), tsm_test::grid_with_holes(20, 3),
+                                         tsm_test::random_soup(300, 500, 7), tsm_test::moebius(30), tsm_test::bowtie()};
+  std::string inputs;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string name = "m" + std::to_string(i) + (i % 2 ? ".obj" : ".ply");
+    ASSERT_TRUE(tsm::write_mesh(file(name), meshes[i]).ok());
+    inputs += " " + q(name);
+  }
+  Result r = tsm("encode" + inputs + " -o " + q("serial") + " -j 1 -q 11 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string serial_json = r.out;
+  r = tsm("encode" + inputs + " -o " + q("parallel") + " -j 2 -q 11 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(lines_of(r.out).size(), meshes.size());
+  std::string tsms_serial, tsms_parallel;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string name = "m" + std::to_string(i);
+    const std::string a = slurp(file("serial/" + name + ".tsm")), b = slurp(file("parallel/" + name + ".tsm"));
+    EXPECT_FALSE(a.empty()) << name;
+    EXPECT_EQ(a, b) << name;
+    tsms_serial += " " + q("serial/" + name + ".tsm");
+    tsms_parallel += " " + q("parallel/" + name + ".tsm");
+    // The JSON lines come in input order in both runs.
+    EXPECT_NE(lines_of(r.out)[i].find("\"input\": \"" + file(name)), std::string::npos) << r.out;
+    EXPECT_NE(lines_of(serial_json)[i].find("\"input\": \"" + file(name)), std::string::npos) << serial_json;
+  }
+  ASSERT_EQ(tsm("decode" + tsms_serial + " -o " + q("dec1") + " -j 1 --quiet").code, 0);
+  ASSERT_EQ(tsm("decode" + tsms_parallel + " -o " + q("dec2") + " -j 2 --quiet").code, 0);
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string name = "m" + std::to_string(i) + ".ply";
+    EXPECT_EQ(slurp(file("dec1/" + name)), slurp(file("dec2/" + name))) << name;
+    expect_same_mesh(meshes[i], file("dec2/" + name), 11);
+  }
+}
+
+TEST_F(CliBatch, NeverOverwritesWithoutForce) {
+  write_three();
+  fs::create_directories(file("out"));
+  spit(file("out/b.tsm"), "keep me");
+  Result r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " " + q("c.off") + " -o " + q("out") + " --quiet");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find(file("out/b.tsm") + ": already exists; pass -f (--force) to overwrite it"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(slurp(file("out/b.tsm")), "keep me");
+  EXPECT_TRUE(fs::exists(file("out/a.tsm")));  // the others are written
+  EXPECT_TRUE(fs::exists(file("out/c.tsm")));
+  r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " " + q("c.off") + " -o " + q("out") + " --quiet -f");
+  EXPECT_EQ(r.code, 0) << r.err;
+  tsm::FileInfo fi;
+  EXPECT_TRUE(tsm::inspect(slurp(file("out/b.tsm")), fi).ok());
+
+  // Same for decode.
+  fs::create_directories(file("dec"));
+  spit(file("dec/c.ply"), "keep me too");
+  r = tsm("decode " + q("out/a.tsm") + " " + q("out/c.tsm") + " -o " + q("dec") + " --quiet");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find(file("dec/c.ply") + ": already exists; pass -f"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(file("dec/c.ply")), "keep me too");
+  EXPECT_TRUE(fs::exists(file("dec/a.ply")));
+  r = tsm("decode " + q("out/a.tsm") + " " + q("out/c.tsm") + " -o " + q("dec") + " --quiet -f");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(slurp(file("dec/c.ply")), "keep me too");
+  EXPECT_EQ(temporaries_anywhere(), 0);
+}
+
+TEST_F(CliBatch, TwoInputsOntoOneOutputAreRefused) {
+  write_three();
+  fs::create_directories(file("x"));
+  fs::copy_file(file("a.ply"), file("x/b.ply"));
+  Result r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " " + q("x/b.ply") + " -o " + q("out"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(file("b.obj") + " and " + file("x/b.ply") + " would both be written to"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(file("out")));  // refused before anything is done
+  // The same file twice is the same clash.
+  r = tsm("encode " + q("a.ply") + " " + q("a.ply") + " -o " + q("out"));
+  EXPECT_EQ(r.code, 2) << r.err;
+}
+
+TEST_F(CliBatch, StdinStdoutPipeRoundTrip) {
+  tsm::Mesh m = tsm_test::icosphere(2);
+  ASSERT_TRUE(tsm::write_mesh(file("in.obj"), m).ok());
+  ASSERT_TRUE(tsm::write_mesh(file("in.ply"), m).ok());
+  // OBJ has no signature: --input-format says what stdin is.
+  Result r = sh("$TSM encode - --input-format obj -q 12 <" + q("in.obj") + " | $TSM decode - --format ply >" +
+                q("back.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_same_mesh(m, file("back.ply"), 12);
+  // The reports go to stderr when stdout carries the data; --quiet silences them.
+  EXPECT_NE(r.err.find("<stdin>: 162 vertices, 320 faces -> <stdout>"), std::string::npos) << r.err;
+  r = sh("$TSM encode - --input-format obj -q 12 --quiet <" + q("in.obj") + " | $TSM decode - --format obj --quiet >" +
+         q("back.obj"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  expect_same_mesh(m, file("back.obj"), 12);
+
+  // PLY is recognized from its content; the bytes equal those of a file-to-file run.
+  ASSERT_EQ(tsm("encode " + q("in.ply") + " -o " + q("ref.tsm") + " --quiet").code, 0);
+  r = sh("$TSM encode - --quiet <" + q("in.ply") + " >" + q("piped.tsm"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(slurp(file("piped.tsm")), slurp(file("ref.tsm")));
+  // -o - with a file input, and stdin to a file.
+  r = sh("$TSM encode " + q("in.ply") + " -o - --quiet | $TSM decode - -o " + q("back2.ply") + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_same_mesh(m, file("back2.ply"), tsm::kDefaultQuantizationBits);
+  // info reads stdin too.
+  r = sh("$TSM info - --json <" + q("ref.tsm"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"file\": \"-\", \"status\": \"ok\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"vertices\": 162"), std::string::npos) << r.out;
+
+  // An OBJ on stdin without --input-format, an empty stdin, junk: bad input, said clearly.
+  r = sh("$TSM encode - <" + q("in.obj") + " >" + q("x.tsm"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("<stdin>: cannot tell the mesh format"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--input-format"), std::string::npos) << r.err;
+  r = sh("$TSM encode - </dev/null >" + q("x.tsm"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("stdin was empty"), std::string::npos) << r.err;
+  r = sh("$TSM decode - <" + q("in.obj") + " >" + q("x.ply"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("<stdin>: "), std::string::npos) << r.err;
+  EXPECT_EQ(temporaries_anywhere(), 0);
+}
+
+TEST_F(CliBatch, StdinAndStdoutMisuseIsRefused) {
+  write_three();
+  struct Case {
+    std::string args, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"encode " + q("a.ply") + " " + q("b.obj") + " -o -", "single input"},
+           {"encode - " + q("a.ply") + " -o " + q("out"), "only input"},
+           {"encode " + q("a.ply") + " -o - --json", "--json"},
+           {"decode - -o " + q("folder/"), "stdin has no name"}}) {
+    Result r = sh("$TSM " + c.args + " <" + q("a.ply") + " >" + q("sink"));
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(slurp(file("sink")), "") << c.args;
+  }
+  // Binary data is not written to a terminal; text is.
+  Pty pty;
+  ASSERT_TRUE(pty.ok());
+  ASSERT_EQ(tsm("encode " + q("b.obj") + " -o " + q("b.tsm") + " --quiet").code, 0);
+  Result r = sh("$TSM encode " + q("a.ply") + " -o - >" + quote(pty.slave));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("refusing to write binary .tsm data to a terminal"), std::string::npos) << r.err;
+  r = sh("$TSM decode - <" + q("b.tsm") + " >" + quote(pty.slave));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("binary PLY to a terminal"), std::string::npos) << r.err;
+  r = sh("$TSM decode " + q("b.tsm") + " -o - --format obj --quiet >" + quote(pty.slave));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(pty.drain().find("v "), std::string::npos);
+  // "-" with a terminal on stdin would wait for typing: refused.
+  r = sh("$TSM decode - -o " + q("x.ply") + " <" + quote(pty.slave));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("stdin is a terminal"), std::string::npos) << r.err;
+}
+
+TEST_F(CliBatch, BadBatchArgumentsExitTwo) {
+  write_three();
+  spit(file("plain"), "x");
+  for (const std::string& args : std::vector<std::string>{
+           "encode " + q("a.ply") + " -j -1", "encode " + q("a.ply") + " -j x", "encode " + q("a.ply") + " --input-format fbx",
+           "decode " + q("a.ply") + " --format stl", "decode " + q("a.ply") + " -o " + q("x.ply") + " --format obj",
+           "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("plain"), "info " + q("a.ply") + " " + q("missing.tsm"),
+           "encode " + q("a.ply") + " " + q("missing.ply") + " -o " + q("out")}) {
+    Result r = tsm(args);
+    EXPECT_EQ(r.code, 2) << "tsm " << args << "\n" << r.out << r.err;
+    EXPECT_FALSE(r.err.empty()) << "tsm " << args << ": says nothing";
+  }
+  EXPECT_FALSE(fs::exists(file("out")));
+  EXPECT_EQ(slurp(file("plain")), "x");
+}
+
+TEST_F(CliBatch, JsonResultsForEveryCommand) {
+  write_three();
+  Result r = tsm("encode " + q("a.ply") + " -o " + q("a.tsm") + " -q 10 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string size = std::to_string(fs::file_size(file("a.tsm")));
+  for (const std::string& field :
+       {"{\"input\": \"" + file("a.ply") + "\", \"output\": \"" + file("a.tsm") + "\", \"status\": \"ok\", \"exit_code\": 0, \"error\": null",
+        std::string("\"input_format\": \"ply\""), "\"bytes_in\": " + std::to_string(fs::file_size(file("a.ply"))),
+        "\"bytes_out\": " + size, std::string("\"vertices\": 162"), std::string("\"faces\": 320"),
+        std::string("\"bits_per_vertex\": "), std::string("\"quantization_bits\": 10"), std::string("\"ms\": ")})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << "\n" << r.out;
+  EXPECT_EQ(r.out.back(), '\n');
+  EXPECT_EQ(lines_of(r.out).size(), 1u);
+  EXPECT_EQ(r.out.substr(r.out.size() - 2), "}\n");
+
+  r = tsm("decode " + q("a.tsm") + " -o " + q("a.obj") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string& field : {std::string("\"status\": \"ok\""), std::string("\"output_format\": \"obj\""),
+                                   "\"bytes_in\": " + size, "\"bytes_out\": " + std::to_string(fs::file_size(file("a.obj"))),
+                                   std::string("\"vertices\": 162"), std::string("\"decode_ms\": ")})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << "\n" << r.out;
+
+  // A failure is a JSON line too, and info gives one line per file.
+  spit(file("junk.tsm"), "junk");
+  r = tsm("info " + q("a.tsm") + " " + q("junk.tsm") + " --json");
+  EXPECT_EQ(r.code, 3) << r.err;
+  std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 2u) << r.out;
+  EXPECT_EQ(lines[0].rfind("{\"file\": \"" + file("a.tsm") + "\", \"status\": \"ok\"", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("{\"file\": \"" + file("junk.tsm") + "\", \"status\": \"error\", \"exit_code\": 3", 0), 0u)
+      << lines[1];
+  r = tsm("decode " + q("junk.tsm") + " -o " + q("j.ply") + " --json");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.out.find("\"status\": \"error\""), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("junk.tsm"), std::string::npos) << r.err;
+}
+
+TEST_F(CliBatch, ProgressBarOnlyOnATerminalAndNotWhenQuiet) {
+  write_three();
+  const std::string inputs = q("a.ply") + " " + q("b.obj") + " " + q("c.off");
+  // Not a terminal (a file): no bar, whatever the delay.
+  Result r = sh("TSM_PROGRESS_AFTER_MS=0 $TSM encode " + inputs + " -o " + q("o1") + " </dev/null");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("[1/3]"), std::string::npos) << r.err;
+  // A terminal: "[k/3] name" lines, erased before anything else is printed.
+  Pty pty;
+  ASSERT_TRUE(pty.ok());
+  r = sh("TSM_PROGRESS_AFTER_MS=0 $TSM encode " + inputs + " -o " + q("o2") + " </dev/null 2>" + quote(pty.slave));
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::string seen = pty.drain();
+  EXPECT_NE(seen.find("/3] ["), std::string::npos) << seen;
+  EXPECT_NE(seen.find("\r\x1b[K"), std::string::npos) << seen;
+  EXPECT_NE(seen.find("encoded 3 of 3 files"), std::string::npos) << seen;
+  // --quiet: nothing at all.
+  r = sh("TSM_PROGRESS_AFTER_MS=0 $TSM encode " + inputs + " -o " + q("o3") + " --quiet </dev/null 2>" +
+         quote(pty.slave));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(pty.drain(), "");
+  // Work shorter than the delay (default about a second) shows no bar.
+  r = sh("$TSM encode " + inputs + " -o " + q("o4") + " </dev/null 2>" + quote(pty.slave));
+  ASSERT_EQ(r.code, 0) << r.err;
+  seen = pty.drain();
+  EXPECT_EQ(seen.find("/3]"), std::string::npos) << seen;
+}
+
+// Starts the tool with stdin from a pipe (returned in *to_stdin) and stdout
+// and stderr into files; returns the child's pid.
+pid_t spawn_tsm(const std::vector<std::string>& args, int* to_stdin, const std::string& out, const std::string& err) {
+  int fds[2];
+  if (pipe(fds) != 0) return -1;
+  std::vector<std::string> all = {TSM_CLI_PATH};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = fork();
+  if (pid == 0) {
+    // As from an interactive shell: default signal actions, nothing blocked.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) signal(sig, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fds[0], 0);
+    dup2(o, 1);
+    dup2(e, 2);
+    close(fds[0]);
+    close(fds[1]);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(fds[0]);
+  *to_stdin = fds[1];
+  return pid;
+}
+
+// waitpid with a deadline (a hung child is killed and reported).
+bool wait_child(pid_t pid, int& status) {
+  for (int i = 0; i < 1000; ++i) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return false;
+}
+
+TEST_F(CliBatch, KilledDecodeLeavesNoOutputAndNoTemporary) {
+  // The decode is stopped half-way through its input (the pipe feeding it
+  // stays open), then killed: by SIGKILL, and by the signals a user or a
+  // build system sends (SIGTERM, SIGINT), which also end it by that signal.
+  write_input();
+  ASSERT_EQ(tsm("encode " + q("in.ply") + " -o " + q("in.tsm") + " --quiet").code, 0);
+  const std::string bytes = slurp(file("in.tsm"));
+  for (int sig : {SIGKILL, SIGTERM, SIGINT}) {
+    int to_stdin = -1;
+    pid_t pid = spawn_tsm({"decode", "-", "-o", file("out.ply")}, &to_stdin, logs.file("out"), logs.file("err"));
+    ASSERT_GT(pid, 0);
+    ASSERT_EQ(write(to_stdin, bytes.data(), bytes.size() / 2), static_cast<ssize_t>(bytes.size() / 2));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    kill(pid, sig);
+    int status = 0;
+    EXPECT_TRUE(wait_child(pid, status)) << "signal " << sig << ": the tool did not end";
+    close(to_stdin);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "signal " << sig << ", status " << status;
+    EXPECT_FALSE(fs::exists(file("out.ply"))) << "signal " << sig;
+    EXPECT_EQ(temporaries(), 0) << "signal " << sig;
+  }
+}
+
+TEST_F(CliBatch, InterruptedBatchLeavesOnlyWholeFiles) {
+  // A batch of decodes interrupted at different moments: whatever was being
+  // done (reading, decoding, writing), every output is absent or complete,
+  // and no temporary file is left, because the tool lets a write in progress
+  // finish (or not start) before it ends.
+  const tsm::Mesh big = tsm_test::copies(tsm_test::icosphere(4), 8);
+  std::string packed;
+  ASSERT_TRUE(tsm::encode(big, tsm::EncodeOptions{}, packed).ok());
+  std::vector<std::string> args = {"decode"};
+  for (int i = 0; i < 6; ++i) {
+    spit(file("m" + std::to_string(i) + ".tsm"), packed);
+    args.push_back(file("m" + std::to_string(i) + ".tsm"));
+  }
+  ASSERT_EQ(tsm("decode " + q("m0.tsm") + " -o " + q("reference.ply") + " --quiet").code, 0);
+  const std::string reference = slurp(file("reference.ply"));
+  args.insert(args.end(), {"-o", file("out"), "-j", "2", "-f", "--quiet"});
+  for (int delay_ms : {0, 5, 15, 30, 60}) {
+    int to_stdin = -1;
+    pid_t pid = spawn_tsm(args, &to_stdin, logs.file("out"), logs.file("err"));
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    kill(pid, SIGTERM);
+    int status = 0;
+    EXPECT_TRUE(wait_child(pid, status)) << "after " << delay_ms << " ms: the tool did not end";
+    close(to_stdin);
+    EXPECT_TRUE((WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) || (WIFEXITED(status) && WEXITSTATUS(status) == 0))
+        << "after " << delay_ms << " ms: status " << status;
+    EXPECT_EQ(temporaries_anywhere(), 0) << "after " << delay_ms << " ms";
+    if (fs::is_directory(file("out"))) {
+      for (const auto& e : fs::directory_iterator(file("out"))) {
+        EXPECT_TRUE(slurp(e.path().string()) == reference) << e.path() << " after " << delay_ms << " ms is not whole";
+      }
+    }
+    fs::remove_all(file("out"));
+  }
+}
+
+TEST_F(CliBatch, AWriteThatFailsLeavesNothing) {
+  // A file size limit hit while the temporary is written (the process would
+  // otherwise be killed by SIGXFSZ mid-write): a clean I/O error, exit 4, no
+  // output, no temporary. The temporary's name is the output's + ".tmp-XXXXXX".
+  write_input();
+  ASSERT_EQ(tsm("encode " + q("in.ply") + " -o " + q("in.tsm") + " --quiet").code, 0);
+  Result r = sh("ulimit -f 2; $TSM decode " + q("in.tsm") + " -o " + q("out.ply") + " --ascii </dev/null");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find(file("out.ply") + ": write failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing was written"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(file("out.ply")));
+  EXPECT_EQ(temporaries(), 0);
 }
 
 }  // namespace

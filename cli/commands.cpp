@@ -1,0 +1,514 @@
+// encode, decode and info for one file or many: output names, the rules that
+// keep files safe (never the input, never an existing file without -f, never
+// a partial file), stdin/stdout, and the per-file jobs run by run_batch.
+#include "commands.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "batch.hpp"
+#include "cli_util.hpp"
+
+namespace tsm::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "tsm: error: %s\n", message.c_str());
+  return kExitUsage;
+}
+
+// "-" as it appears in messages.
+std::string shown_input(const std::string& p) { return p == "-" ? std::string("<stdin>") : p; }
+std::string shown_output(const std::string& p) { return p == "-" ? std::string("<stdout>") : p; }
+
+std::string with_extension(const std::string& path, const std::string& ext) {
+  fs::path p(path);
+  return p.replace_extension(ext).string();
+}
+
+unsigned effective_jobs(unsigned jobs) {
+  if (jobs > 0) return jobs;
+  unsigned cores = std::thread::hardware_concurrency();
+  return cores > 0 ? cores : 1;
+}
+
+struct FileId {
+  dev_t dev = 0;
+  ino_t ino = 0;
+  bool operator<(const FileId& o) const { return dev != o.dev ? dev < o.dev : ino < o.ino; }
+};
+
+bool file_id(const std::string& path, FileId& id) {
+  struct stat st = {};
+  if (::stat(path.c_str(), &st) != 0) return false;
+  id.dev = st.st_dev;
+  id.ino = st.st_ino;
+  return true;
+}
+
+// Something (file, folder, even a dangling link) is at this path.
+bool occupied(const std::string& path) {
+  struct stat st = {};
+  return ::lstat(path.c_str(), &st) == 0;
+}
+
+// One input file and where its result goes.
+struct Job {
+  std::string input;   // path or "-"
+  std::string output;  // path or "-"
+  Status refused;      // set when the file must not be processed (the reason)
+};
+
+// "-" may only be the only input, and stdin must not be a terminal.
+int check_stdin_input(const std::vector<std::string>& inputs, const char* what) {
+  const bool has_stdin = std::find(inputs.begin(), inputs.end(), "-") != inputs.end();
+  if (!has_stdin) return kExitOk;
+  if (inputs.size() > 1) return usage_error("'-' (stdin) can only be the only input; name the files instead");
+  if (is_terminal(stdin))
+    return usage_error(std::string("'-' reads ") + what +
+                       " from stdin, but stdin is a terminal; pipe or redirect it (tsm ... - < FILE)");
+  return kExitOk;
+}
+
+// Works out every output name and refuses what would lose data. Returns 0,
+// or the exit code when the whole command is refused (message printed).
+// Files that must not be written get Job::refused; the others still run.
+int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, const std::string& ext, bool force,
+                 const char* what_in, std::vector<Job>& jobs) {
+  if (int rc = check_stdin_input(inputs, what_in)) return rc;
+  const size_t n = inputs.size();
+  const bool has_stdin = n == 1 && inputs[0] == "-";
+  if (o == "-" && n > 1)
+    return usage_error("-o - (stdout) takes a single input; for several files give a folder, e.g. -o out/");
+  std::error_code ec;
+  const bool dir_mode = !o.empty() && o != "-" && (n > 1 || o.back() == '/' || fs::is_directory(o, ec));
+  if (dir_mode && occupied(o) && !fs::is_directory(o, ec))
+    return usage_error(o + ": is a file, but with several inputs -o names a folder (created if missing), e.g. -o out/");
+  if (dir_mode && has_stdin)
+    return usage_error("-o " + o + " is a folder, and stdin has no name to derive a file name from; give -o FILE or -o -");
+
+  jobs.assign(n, Job());
+  for (size_t i = 0; i < n; ++i) {
+    Job& j = jobs[i];
+    j.input = inputs[i];
+    if (inputs[i] == "-")
+      j.output = o.empty() ? "-" : o;
+    else if (o.empty())
+      j.output = with_extension(inputs[i], ext);
+    else if (dir_mode)
+      j.output = (fs::path(o) / fs::path(inputs[i]).filename().replace_extension(ext)).string();
+    else
+      j.output = o;
+  }
+
+  // Two inputs must not write the same file (a.ply and a.obj, or x/a.ply and y/a.ply, into one folder).
+  std::map<std::string, size_t> claimed;
+  std::vector<std::string> clashes;
+  for (size_t i = 0; i < n; ++i) {
+    if (jobs[i].output == "-") continue;
+    fs::path key = fs::weakly_canonical(fs::absolute(jobs[i].output, ec), ec);
+    if (ec) key = fs::path(jobs[i].output).lexically_normal();
+    auto [it, fresh] = claimed.emplace(key.string(), i);
+    if (!fresh)
+      clashes.push_back(inputs[it->second] + " and " + inputs[i] + " would both be written to " + jobs[i].output);
+  }
+  if (!clashes.empty()) {
+    for (const std::string& c : clashes) std::fprintf(stderr, "tsm: error: %s\n", c.c_str());
+    std::fprintf(stderr, "tsm: give them separate -o folders or rename one; nothing was written\n");
+    return kExitUsage;
+  }
+
+  if (dir_mode && !fs::is_directory(o, ec)) {
+    fs::create_directories(o, ec);
+    if (ec) {
+      std::fprintf(stderr, "tsm: error: %s: cannot create the output folder: %s\n", o.c_str(), ec.message().c_str());
+      return kExitIo;
+    }
+  }
+
+  // Never an input (any input of the batch), never an existing file without -f.
+  std::map<FileId, size_t> input_ids;
+  for (size_t i = 0; i < n; ++i) {
+    FileId id;
+    if (inputs[i] != "-" && file_id(inputs[i], id)) input_ids.emplace(id, i);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    Job& j = jobs[i];
+    if (j.output == "-") continue;
+    FileId id;
+    auto it = file_id(j.output, id) ? input_ids.find(id) : input_ids.end();
+    if (it != input_ids.end()) {
+      j.refused = Status(ErrorCode::invalid_argument,
+                         it->second == i ? j.output + ": the output would overwrite the input; choose another -o"
+                                         : j.output + ": the output would overwrite " + inputs[it->second] +
+                                               ", an input of this run; choose another -o");
+    } else if (!force && occupied(j.output)) {
+      j.refused = Status(ErrorCode::invalid_argument, j.output + ": already exists; pass -f (--force) to overwrite it");
+    }
+  }
+  return kExitOk;
+}
+
+// Writes a result: stdout, or atomically to the file (checked again: the
+// file may have appeared while the job ran).
+Status write_output(const std::string& output, std::string_view bytes, bool force) {
+  if (output == "-") return write_stdout(bytes);
+  if (!force && occupied(output))
+    return Status(ErrorCode::invalid_argument,
+                  output + ": already exists (it appeared while tsm was working); pass -f (--force) to overwrite it");
+  return guarded_write_file(output, bytes);
+}
+
+Status read_input(const std::string& input, std::string& bytes) {
+  return input == "-" ? read_stdin(bytes) : read_file(input, bytes);
+}
+
+MeshFormat parse_format(const std::string& s) {
+  if (s == "ply") return MeshFormat::ply;
+  if (s == "obj") return MeshFormat::obj;
+  if (s == "stl") return MeshFormat::stl;
+  if (s == "off") return MeshFormat::off;
+  return MeshFormat::unknown;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+// A mesh from bytes: the format the user named, else content, else extension.
+Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
+                  const ReadOptions& ro, ReadInfo& info) {
+  const std::string name = shown_input(input);
+  if (forced == MeshFormat::unknown) {
+    if (input == "-" && bytes.empty())
+      return Status(ErrorCode::parse_error, name + ": no data (stdin was empty)");
+    if (input == "-" && sniff_format(bytes) == MeshFormat::unknown)
+      return Status(ErrorCode::parse_error, name + ": cannot tell the mesh format from the content (OBJ has no "
+                                                   "signature); pass --input-format ply|obj|stl|off");
+    return read_mesh_from_memory(bytes, name, mesh, ro, &info, format_from_extension(input));
+  }
+  info = ReadInfo();
+  info.format = forced;
+  mesh.clear();
+  switch (forced) {
+    case MeshFormat::ply: return read_ply(bytes, name, mesh, ro, &info);
+    case MeshFormat::obj: return read_obj(bytes, name, mesh, ro, &info);
+    case MeshFormat::stl: return read_stl(bytes, name, mesh, ro, &info);
+    case MeshFormat::off: return read_off(bytes, name, mesh, ro, &info);
+    case MeshFormat::unknown: break;
+  }
+  return Status(ErrorCode::internal, name + ": no reader for the format");
+}
+
+double bits_per_vertex(uint64_t bytes, uint64_t vertices) {
+  return vertices ? 8.0 * static_cast<double>(bytes) / static_cast<double>(vertices) : 0.0;
+}
+
+// Fields every per-file JSON object starts with.
+JsonObject json_head(const Job& j, const Status& s) {
+  JsonObject o;
+  o.str("input", j.input).str("output", j.output).str("status", s.ok() ? "ok" : "error");
+  o.num("exit_code", static_cast<unsigned long long>(exit_code_for(s)));
+  o.str_or_null("error", s.message());
+  return o;
+}
+
+// ---------------------------------------------------------------- encode
+
+FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phase& phase) {
+  Stopwatch total;
+  uint64_t bytes_in = 0, bytes_out = 0;
+  double read_ms = 0, encode_ms = 0, write_ms = 0;
+  Mesh mesh;
+  ReadInfo info;
+  FileResult r;
+  auto finish = [&](const Status& s) {
+    r.status = s;
+    JsonObject o = json_head(j, s);
+    o.str("input_format", info.format == MeshFormat::unknown ? std::string() : lower(mesh_format_name(info.format)));
+    o.num("bytes_in", static_cast<unsigned long long>(bytes_in)).num("bytes_out", static_cast<unsigned long long>(bytes_out));
+    o.num("vertices", static_cast<unsigned long long>(mesh.vertex_count()));
+    o.num("faces", static_cast<unsigned long long>(mesh.face_count()));
+    o.num("bits_per_vertex", bits_per_vertex(bytes_out, mesh.vertex_count()), 4);
+    o.num("quantization_bits", static_cast<unsigned long long>(a.qbits)).num("level", static_cast<unsigned long long>(a.level));
+    o.num("read_ms", read_ms, 1).num("encode_ms", encode_ms, 1).num("write_ms", write_ms, 1).num("ms", total.ms(), 1);
+    r.json = o.done();
+    return r;
+  };
+  if (!j.refused.ok()) return finish(j.refused);
+
+  phase.set("reading");
+  Stopwatch sw;
+  std::string in_bytes;
+  Status s = read_input(j.input, in_bytes);
+  if (!s.ok()) return finish(s);
+  bytes_in = in_bytes.size();
+  ReadOptions ro;
+  ro.allow_nonfinite = a.allow_nonfinite;
+  s = parse_mesh(in_bytes, j.input, forced, mesh, ro, info);
+  if (!s.ok()) return finish(s);
+  std::string().swap(in_bytes);
+  read_ms = sw.ms();
+
+  phase.set("encoding");
+  sw.reset();
+  EncodeOptions eo;
+  eo.quantization_bits = a.qbits;
+  eo.level = a.level;
+  std::string bytes;
+  s = encode(mesh, eo, bytes);
+  if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
+  encode_ms = sw.ms();
+
+  phase.set("writing");
+  sw.reset();
+  s = write_output(j.output, bytes, a.force);
+  if (!s.ok()) return finish(s);
+  write_ms = sw.ms();
+  bytes_out = bytes.size();
+
+  if (!info.notes.empty()) r.note = shown_input(j.input) + ": " + info.notes;
+  r.text = strf("%s: %s vertices, %s faces -> %s: %s bytes, %s bits/vertex (q=%d, level %d), read %s ms, encode %s ms",
+                shown_input(j.input).c_str(), thousands(mesh.vertex_count()).c_str(),
+                thousands(mesh.face_count()).c_str(), shown_output(j.output).c_str(), thousands(bytes.size()).c_str(),
+                fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(), a.qbits, a.level,
+                fixed(read_ms, 1).c_str(), fixed(encode_ms, 1).c_str());
+  return finish(Status::Ok());
+}
+
+// ---------------------------------------------------------------- decode
+
+FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phase& phase) {
+  Stopwatch total;
+  uint64_t bytes_in = 0, bytes_out = 0;
+  double read_ms = 0, decode_ms = 0, write_ms = 0;
+  Mesh mesh;
+  FileResult r;
+  auto finish = [&](const Status& s) {
+    r.status = s;
+    JsonObject o = json_head(j, s);
+    o.str("output_format", lower(mesh_format_name(format)));
+    o.num("bytes_in", static_cast<unsigned long long>(bytes_in)).num("bytes_out", static_cast<unsigned long long>(bytes_out));
+    o.num("vertices", static_cast<unsigned long long>(mesh.vertex_count()));
+    o.num("faces", static_cast<unsigned long long>(mesh.face_count()));
+    o.num("bits_per_vertex", bits_per_vertex(bytes_in, mesh.vertex_count()), 4);
+    o.num("read_ms", read_ms, 1).num("decode_ms", decode_ms, 1).num("write_ms", write_ms, 1).num("ms", total.ms(), 1);
+    r.json = o.done();
+    return r;
+  };
+  if (!j.refused.ok()) return finish(j.refused);
+
+  phase.set("reading");
+  Stopwatch sw;
+  std::string bytes;
+  Status s = read_input(j.input, bytes);
+  if (!s.ok()) return finish(s);
+  bytes_in = bytes.size();
+  read_ms = sw.ms();
+
+  phase.set("decoding");
+  sw.reset();
+  DecodeOptions d;
+  d.max_vertices = a.max_vertices;
+  d.max_faces = a.max_faces;
+  s = decode(bytes, mesh, d);
+  if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
+  decode_ms = sw.ms();
+  std::string().swap(bytes);
+
+  phase.set("writing");
+  sw.reset();
+  std::string why;
+  if (!mesh.valid(&why))
+    return finish(Status(ErrorCode::internal, shown_input(j.input) + ": decoded mesh is invalid: " + why));
+  std::string out;
+  if (format == MeshFormat::obj) {
+    s = write_obj(mesh, out);
+  } else {
+    WriteOptions wo;
+    wo.ascii = a.ascii;
+    s = write_ply(mesh, wo, out);
+  }
+  if (!s.ok()) return finish(Status(s.code(), shown_output(j.output) + ": " + s.message()));
+  s = write_output(j.output, out, a.force);
+  if (!s.ok()) return finish(s);
+  write_ms = sw.ms();
+  bytes_out = out.size();
+
+  r.text = strf("%s: %s bytes -> %s: %s vertices, %s faces, decode %s ms", shown_input(j.input).c_str(),
+                thousands(bytes_in).c_str(), shown_output(j.output).c_str(), thousands(mesh.vertex_count()).c_str(),
+                thousands(mesh.face_count()).c_str(), fixed(decode_ms, 1).c_str());
+  return finish(Status::Ok());
+}
+
+// ---------------------------------------------------------------- info
+
+FileResult info_one(const std::string& input) {
+  FileResult r;
+  const std::string name = shown_input(input);
+  auto failed = [&](const Status& s) {
+    r.status = s;
+    JsonObject o;
+    o.str("file", input).str("status", "error");
+    o.num("exit_code", static_cast<unsigned long long>(exit_code_for(s))).str("error", s.message());
+    r.json = o.done();
+    return r;
+  };
+  std::string bytes;
+  Status s = read_input(input, bytes);
+  if (!s.ok()) return failed(s);
+  FileInfo fi;
+  s = inspect(bytes, fi);
+  if (!s.ok()) return failed(Status(s.code(), name + ": " + s.message()));
+
+  const double v = fi.vertex_count ? static_cast<double>(fi.vertex_count) : 1.0;
+  auto per_vertex = [v](uint64_t n) { return 8.0 * static_cast<double>(n) / v; };
+  const double bpv = per_vertex(fi.file_bytes);
+  const uint64_t side = fi.file_bytes - fi.connectivity_bytes - fi.geometry_bytes;  // header, framing, side sections
+  using ull = unsigned long long;
+  r.json = strf("{\"file\": \"%s\", \"status\": \"ok\", \"format_version\": %u, \"bytes\": %llu, \"vertices\": %llu, "
+                "\"faces\": %llu, \"corners\": %llu, \"quantization_bits\": %d, \"level\": %d, \"segments\": %u, "
+                "\"bbox_min\": [%.9g, %.9g, %.9g], \"step\": %.9g, \"bits_per_vertex\": %.4f, "
+                "\"connectivity_bits_per_vertex\": %.4f, \"geometry_bits_per_vertex\": %.4f, "
+                "\"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
+                "\"triangle_runs\": %llu, \"marching_bits\": %llu, \"jump_edges\": %llu, \"stitches\": %llu, "
+                "\"virtual_vertices\": %llu, \"side_faces\": %llu, \"geometry_predictor\": \"%s\", "
+                "\"ancestors\": %d, \"lattice_planes\": [%u, %u, %u], \"sections\": [",
+                json_escape(input).c_str(), fi.format_version, static_cast<ull>(fi.file_bytes),
+                static_cast<ull>(fi.vertex_count), static_cast<ull>(fi.face_count), static_cast<ull>(fi.corner_count),
+                fi.quantization_bits, fi.level, fi.segment_count, fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2],
+                fi.step, bpv, per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side),
+                static_cast<ull>(fi.components), static_cast<ull>(fi.vertex_runs), static_cast<ull>(fi.triangle_runs),
+                static_cast<ull>(fi.marching_bits), static_cast<ull>(fi.jump_edges), static_cast<ull>(fi.stitches),
+                static_cast<ull>(fi.virtual_vertices), static_cast<ull>(fi.side_faces),
+                json_escape(fi.geometry_predictor).c_str(), fi.ancestors, fi.lattice_planes[0], fi.lattice_planes[1],
+                fi.lattice_planes[2]);
+  for (size_t i = 0; i < fi.sections.size(); ++i) {
+    const SectionInfo& si = fi.sections[i];
+    r.json += strf("%s{\"id\": %u, \"name\": \"%s\", \"codec\": \"%s\", \"stored_bytes\": %llu, \"raw_bytes\": %llu}",
+                   i ? ", " : "", si.id, json_escape(si.name).c_str(), json_escape(si.codec).c_str(),
+                   static_cast<ull>(si.stored_bytes), static_cast<ull>(si.raw_bytes));
+  }
+  r.json += "]}";
+
+  std::string& t = r.text;
+  t = strf("%s: tsm format version %u, %s bytes\n", name.c_str(), fi.format_version, thousands(fi.file_bytes).c_str());
+  t += strf("  vertices %s, faces %s, corners %s, segments %u\n", thousands(fi.vertex_count).c_str(),
+            thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
+  t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
+  t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,
+            per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side));
+  t += strf("  topology: %s components, %s vertex runs, %s triangle runs, %s marching bits, %s jump edges,\n"
+            "            %s stitches, %s virtual vertices, %s side faces\n",
+            thousands(fi.components).c_str(), thousands(fi.vertex_runs).c_str(), thousands(fi.triangle_runs).c_str(),
+            thousands(fi.marching_bits).c_str(), thousands(fi.jump_edges).c_str(), thousands(fi.stitches).c_str(),
+            thousands(fi.virtual_vertices).c_str(), thousands(fi.side_faces).c_str());
+  t += strf("  geometry: %s predictor", fi.geometry_predictor.c_str());
+  if (fi.ancestors) t += strf(" (K = %d)", fi.ancestors);
+  if (fi.lattice_planes[0] + fi.lattice_planes[1] + fi.lattice_planes[2])
+    t += strf(", lattice planes x %s, y %s, z %s", thousands(fi.lattice_planes[0]).c_str(),
+              thousands(fi.lattice_planes[1]).c_str(), thousands(fi.lattice_planes[2]).c_str());
+  t += "\n";
+  t += strf("  %-18s %-6s %12s %12s", "section", "codec", "stored", "raw");
+  for (const SectionInfo& si : fi.sections)
+    t += strf("\n  %-18s %-6s %12s %12s", si.name.c_str(), si.codec.c_str(), thousands(si.stored_bytes).c_str(),
+              thousands(si.raw_bytes).c_str());
+  return r;
+}
+
+std::vector<std::string> shown_inputs(const std::vector<std::string>& inputs) {
+  std::vector<std::string> out;
+  out.reserve(inputs.size());
+  for (const std::string& s : inputs) out.push_back(shown_input(s));
+  return out;
+}
+
+}  // namespace
+
+int cmd_encode(const EncodeArgs& a) {
+  install_signal_guard();
+  std::vector<Job> jobs;
+  if (int rc = plan_outputs(a.inputs, a.output, ".tsm", a.force, "a mesh", jobs)) return rc;
+  const bool to_stdout = jobs.size() == 1 && jobs[0].output == "-";
+  if (to_stdout && a.json)
+    return usage_error("--json prints to stdout, which already carries the .tsm data; give -o FILE or drop --json");
+  if (to_stdout && is_terminal(stdout))
+    return usage_error("refusing to write binary .tsm data to a terminal; redirect stdout (> out.tsm), pipe it, "
+                       "or give -o FILE");
+  const MeshFormat forced = parse_format(lower(a.input_format));
+  BatchOptions bo;
+  bo.jobs = effective_jobs(a.jobs);
+  bo.quiet = a.quiet;
+  bo.json = a.json;
+  bo.text_to_stderr = to_stdout;
+  bo.verb = "encoded";
+  return run_batch(shown_inputs(a.inputs), bo,
+                   [&](size_t i, Phase& phase) { return encode_one(a, jobs[i], forced, phase); });
+}
+
+int cmd_decode(const DecodeArgs& a) {
+  install_signal_guard();
+  const MeshFormat wanted = parse_format(lower(a.format));
+  const std::string ext = wanted == MeshFormat::obj ? ".obj" : ".ply";
+  std::vector<Job> jobs;
+  if (int rc = plan_outputs(a.inputs, a.output, ext, a.force, "a .tsm file", jobs)) return rc;
+  // One output format for the run: --format, else the extension of -o FILE, else PLY.
+  MeshFormat format = wanted == MeshFormat::unknown ? MeshFormat::ply : wanted;
+  for (Job& j : jobs) {
+    if (j.output == "-") continue;
+    const MeshFormat by_name = format_from_extension(j.output);
+    if (wanted != MeshFormat::unknown) {
+      if (by_name != MeshFormat::unknown && by_name != wanted)
+        return usage_error(j.output + ": the name says " + mesh_format_name(by_name) + " but --format says " +
+                           mesh_format_name(wanted) + "; drop one of them");
+    } else if (by_name == MeshFormat::ply || by_name == MeshFormat::obj) {
+      format = by_name;  // only a single -o FILE can name another format than .ply
+    } else {
+      j.refused = Status(ErrorCode::invalid_argument,
+                         j.output + ": output must end in .ply or .obj (or pass --format ply|obj)");
+    }
+  }
+  const bool to_stdout = jobs.size() == 1 && jobs[0].output == "-";
+  if (to_stdout && a.json)
+    return usage_error("--json prints to stdout, which already carries the mesh; give -o FILE or drop --json");
+  if (to_stdout && format == MeshFormat::ply && !a.ascii && is_terminal(stdout))
+    return usage_error("refusing to write binary PLY to a terminal; redirect stdout (> out.ply), pipe it, or pass "
+                       "--ascii or --format obj for text");
+  BatchOptions bo;
+  bo.jobs = effective_jobs(a.jobs);
+  bo.quiet = a.quiet;
+  bo.json = a.json;
+  bo.text_to_stderr = to_stdout;
+  bo.verb = "decoded";
+  return run_batch(shown_inputs(a.inputs), bo,
+                   [&](size_t i, Phase& phase) { return decode_one(a, jobs[i], format, phase); });
+}
+
+int cmd_info(const InfoArgs& a) {
+  install_signal_guard();
+  if (int rc = check_stdin_input(a.inputs, "a .tsm file")) return rc;
+  BatchOptions bo;
+  bo.jobs = effective_jobs(a.jobs);
+  bo.quiet = a.quiet;
+  bo.json = a.json;
+  bo.verb = "inspected";
+  return run_batch(shown_inputs(a.inputs), bo, [&](size_t i, Phase& phase) {
+    phase.set("reading");
+    return info_one(a.inputs[i]);
+  });
+}
+
+}  // namespace tsm::cli

@@ -1,0 +1,40 @@
+// The tool's file commands: encode, decode, info (one file or many).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tsm/tsm.hpp"
+
+namespace tsm::cli {
+
+// Common to the commands that take many files.
+struct BatchArgs {
+  std::vector<std::string> inputs;  // paths; "-" is stdin (alone only)
+  unsigned jobs = 0;                // worker threads; 0 = number of cores
+  bool json = false;                // JSON lines on stdout, one per input
+  bool quiet = false;               // no reports, notes, progress bar or summary
+};
+
+struct EncodeArgs : BatchArgs {
+  std::string output;               // file, folder (DIR/), "-" (stdout), or "" (beside the input)
+  std::string input_format;         // "", ply, obj, stl, off
+  int qbits = kDefaultQuantizationBits;
+  int level = kDefaultLevel;
+  bool force = false, allow_nonfinite = false;
+};
+
+struct DecodeArgs : BatchArgs {
+  std::string output;
+  std::string format;               // "", ply, obj
+  bool ascii = false, force = false;
+  uint64_t max_vertices = 0, max_faces = 0;
+};
+
+struct InfoArgs : BatchArgs {};
+
+int cmd_encode(const EncodeArgs& a);
+int cmd_decode(const DecodeArgs& a);
+int cmd_info(const InfoArgs& a);
+
+}  // namespace tsm::cli
