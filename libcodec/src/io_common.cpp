@@ -111,6 +111,32 @@ Status read_file(const std::string& path, std::string& out) {
   return Status::Ok();
 }
 
+namespace {
+// The process umask, read once: from /proc where it is shown (no window in
+// which other threads would create files with a zero umask), else by setting
+// and restoring it (thread-safe static initialization, once).
+mode_t process_umask() {
+  static const mode_t mask = [] {
+    if (FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned value = 0;
+      bool found = false;
+      while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "Umask: %o", &value) == 1) {
+          found = true;
+          break;
+        }
+      std::fclose(f);
+      if (found) return static_cast<mode_t>(value);
+    }
+    mode_t m = umask(0);
+    umask(m);
+    return m;
+  }();
+  return mask;
+}
+}  // namespace
+
 Status write_file_atomic(const std::string& path, std::string_view bytes) {
   std::string tmpl = path + ".tmp-XXXXXX";
   int fd = mkstemp(tmpl.data());
@@ -131,9 +157,7 @@ Status write_file_atomic(const std::string& path, std::string_view bytes) {
     left -= static_cast<size_t>(w);
   }
   // mkstemp creates 0600; give the file the usual permissions (umask applies).
-  mode_t mask = umask(0);
-  umask(mask);
-  fchmod(fd, 0666 & ~mask);
+  fchmod(fd, 0666 & ~process_umask());
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     std::string why = errno_text();
     ::unlink(tmpl.c_str());
