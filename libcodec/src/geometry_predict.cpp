@@ -23,6 +23,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 #include "byte_io.hpp"
@@ -39,10 +40,14 @@ constexpr int kActivity = 14;  // activity contexts
 constexpr uint8_t kUnknown = 0xFF;
 constexpr int kMaxAncestors = 4;
 constexpr int kLambdaShift = 16;
+constexpr int kAlphaShift = 12;
+constexpr int32_t kAlphaOne = 1 << kAlphaShift;
 
 int bitlen(uint64_t x) { return bit_length(x); }
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
+
+int64_t floor_shift(int64_t x, int s) { return x >= 0 ? x >> s : -((-x + (int64_t{1} << s) - 1) >> s); }
 
 int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
   int64_t num = 2 * sum + n, den = 2 * n;
@@ -81,6 +86,15 @@ struct EncodeSink {
   bool truncated() const { return false; }
 };
 
+// The encoder's first pass: the same walk, nothing coded (statistics only).
+struct CollectSink {
+  static constexpr bool kEncoder = true;
+  int bit(Prob&, int b) { return b; }
+  int32_t sint(ResidualModel&, int64_t v) { return static_cast<int32_t>(v); }
+  uint32_t uint(UIntModel&, uint32_t v) { return v; }
+  bool truncated() const { return false; }
+};
+
 struct DecodeSink {
   static constexpr bool kEncoder = false;
   RangeDecoder d;
@@ -95,6 +109,12 @@ struct Coder {
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
   int64_t qmax = 0;
   Lattice lattice;
+  // Per parallelogram class (1, 2, 3+ parallelograms): the weight of the
+  // parallelogram average against the neighbour average, 4.12 fixed point
+  // (4096 = parallelograms only), fitted per mesh by least squares.
+  int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
+  bool collect = false;
+  std::vector<std::pair<int64_t, int64_t>> samples[3];  // encoder's fit: (P - N, x - N) per coordinate
   std::vector<uint32_t> nearest[3];  // per axis, per grid value: nearest plane (when qmax < 2^18)
 
   // Nearest plane to a grid value (the lower one on a tie).
@@ -223,8 +243,14 @@ struct SurfaceCoder {
     }
     int cls;
     if (npara) {
-      for (int a = 0; a < 3; ++a) pred[a] = div_round(para[a], npara);
       cls = 1 + std::min(npara, 3);
+      const int k = cls - 2;
+      for (int a = 0; a < 3; ++a) {
+        const int64_t P = div_round(para[a], npara), N = div_round(nb[a], nnb);
+        if constexpr (Sink::kEncoder)
+          if (c.collect) c.samples[k].push_back({P - N, static_cast<int64_t>(at(v)[a]) - N});
+        pred[a] = N + floor_shift(c.alpha[k] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+      }
     } else if (nnb) {
       for (int a = 0; a < 3; ++a) pred[a] = div_round(nb[a], nnb);
       cls = 1;
@@ -456,8 +482,56 @@ bool code_lattice(Sink& s, Coder& c) {
 
 }  // namespace
 
-std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
-                        const Lattice& lattice) {
+// The weight (of 16ths, 0 .. 1.5) that minimizes an estimate of the coded
+// size, sum log2(1 + |residual|), over a sample of the coordinates.
+int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
+  if (samples.empty()) return kAlphaOne;
+  const size_t stride = std::max<size_t>(1, samples.size() / 200000);
+  int32_t best = kAlphaOne;
+  double best_cost = -1;
+  for (int32_t a16 = 0; a16 <= 24; ++a16) {
+    const int32_t alpha = a16 << (kAlphaShift - 4);
+    double cost = 0;
+    for (size_t i = 0; i < samples.size(); i += stride) {
+      int64_t r = samples[i].second - floor_shift(alpha * samples[i].first + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+      cost += std::log2(1.0 + static_cast<double>(r < 0 ? -r : r));
+    }
+    if (best_cost < 0 || cost < best_cost) {
+      best_cost = cost;
+      best = alpha;
+    }
+  }
+  return best;
+}
+
+// The parallelogram weights for a predictor: fitted per class by least
+// squares and by the size estimate (fit_alpha); the caller codes both.
+void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                int32_t lsq[3], int32_t est[3]) {
+  Coder fit;
+  fit.act.assign(g.vertex_count, kUnknown);
+  fit.qmax = (int64_t{1} << bits) - 1;
+  fit.collect = true;
+  CollectSink cs;
+  std::vector<uint32_t> work = q;
+  if (pred == Predictor::parallelograms)
+    code_greedy(g, fit, cs, work);
+  else
+    code_march_order(g, false, fit, cs, work);
+  for (int k = 0; k < 3; ++k) {
+    est[k] = fit_alpha(fit.samples[k]);
+    double num = 0, den = 0;
+    for (auto [d, e] : fit.samples[k]) {
+      num += static_cast<double>(d) * static_cast<double>(e);
+      den += static_cast<double>(d) * static_cast<double>(d);
+    }
+    lsq[k] = den > 0 ? static_cast<int32_t>(std::clamp(std::round(kAlphaOne * num / den), 0.0, 2.0 * kAlphaOne))
+                     : kAlphaOne;
+  }
+}
+
+std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                               int K, const Lattice& lattice, const int32_t* weights) {
   std::string head;
   ByteWriter w(head);
   w.u8(static_cast<uint8_t>(pred));
@@ -470,6 +544,11 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   Coder c;
   c.act.assign(g.vertex_count, kUnknown);
   c.qmax = (int64_t{1} << bits) - 1;
+  if (pred != Predictor::ancestors)
+    for (int k = 0; k < 3; ++k) {
+      c.alpha[k] = weights ? weights[k] : kAlphaOne;
+      w.u16(static_cast<uint16_t>(static_cast<int16_t>(c.alpha[k])));
+    }
   EncodeSink s;
   c.lattice = lattice;
   code_lattice(s, c);
@@ -571,40 +650,42 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
                             const Lattice* candidate, GeometryStats* stats) {
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
-  Lattice none;
-  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, none);
+  int32_t lsq[3], est[3];
+  fit_alphas(g, q, bits, st.predictor, lsq, est);
+  const int32_t* weights = est;
+  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est);
+  auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w) {
+    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w);
+    if (alt.size() >= best.size()) return false;
+    best.swap(alt);
+    st.predictor = pred;
+    st.ancestors = K;
+    st.lattice = lattice;
+    weights = w;
+    return true;
+  };
   if (level >= 3 && candidate) {
     // Shared coordinate planes: keep them where they make the file smaller
     // (all candidate axes at once, then at high levels each axis alone).
     const Lattice& found = *candidate;
     if (!found.values[0].empty() || !found.values[1].empty() || !found.values[2].empty()) {
-      std::string alt = encode_geometry_as(g, q, bits, st.predictor, 0, found);
-      if (alt.size() < best.size()) {
-        best.swap(alt);
-        st.lattice = found;
-      }
+      consider(st.predictor, 0, found, weights);
       if (level >= 8)
         for (int a = 0; a < 3; ++a) {
           Lattice trial = st.lattice;
           if (trial.values[a].empty()) continue;
           trial.values[a].clear();
-          alt = encode_geometry_as(g, q, bits, st.predictor, 0, trial);
-          if (alt.size() < best.size()) {
-            best.swap(alt);
-            st.lattice = trial;
-          }
+          consider(st.predictor, 0, trial, weights);
         }
     }
   }
+  // The least-squares weights instead of the size estimate's.
+  if (level >= 3 && std::memcmp(lsq, est, sizeof lsq) != 0) consider(st.predictor, 0, st.lattice, lsq);
   if (level >= 7) {
-    for (int K = 1; K <= kMaxAncestors; ++K) {
-      std::string alt = encode_geometry_as(g, q, bits, Predictor::ancestors, K, st.lattice);
-      if (alt.size() < best.size()) {
-        best.swap(alt);
-        st.predictor = Predictor::ancestors;
-        st.ancestors = K;
-      }
-    }
+    const Predictor surface = st.predictor;
+    const Lattice lattice = st.lattice;
+    for (int K = 1; K <= kMaxAncestors; ++K) consider(Predictor::ancestors, K, lattice, nullptr);
+    (void)surface;
   }
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
@@ -634,10 +715,18 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
         return corrupt("ancestor weight out of range");
     }
   }
+  int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
+  if (st.predictor != Predictor::ancestors)
+    for (int k = 0; k < 3; ++k) {
+      uint16_t x;
+      if (!r.u16(x)) return corrupt("truncated predictor header");
+      alpha[k] = static_cast<int16_t>(x);
+    }
   const size_t at = r.offset();
   Coder c;
   c.act.assign(g.vertex_count, kUnknown);
   c.qmax = (int64_t{1} << bits) - 1;
+  for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");

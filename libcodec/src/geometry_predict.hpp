@@ -57,9 +57,11 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 // predictor by level, and the lattice (if a candidate is given) by size.
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
                             const Lattice* candidate, GeometryStats* stats = nullptr);
-// One predictor and lattice, no search (tests and experiments).
+// One predictor, lattice and set of parallelogram weights (per class of 1,
+// 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
+// experiments).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int ancestors, const Lattice& lattice);
+                               int ancestors, const Lattice& lattice, const int32_t* weights = nullptr);
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
                        GeometryStats* stats = nullptr);
 
