@@ -575,7 +575,7 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
   if (surface == 0 || surface == n) return anchor;
   // Cells of 2^shift steps, about one surface vertex per occupied cell.
   int shift = bits - static_cast<int>(std::log2(std::sqrt(static_cast<double>(surface)) + 1.0));
-  shift = std::clamp(shift, 0, 30);
+  shift = std::clamp(shift, std::max(0, bits - 20), 30);  // cell coordinates fit the 21-bit fields of the key
   auto cell = [&](uint32_t v, int dx, int dy, int dz) -> uint64_t {
     int64_t c[3] = {(q[3 * size_t{v}] >> shift) + dx, (q[3 * size_t{v} + 1] >> shift) + dy,
                     (q[3 * size_t{v} + 2] >> shift) + dz};
@@ -681,6 +681,15 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   // The least-squares weights instead of the size estimate's.
   if (level >= 3 && std::memcmp(lsq, est, sizeof lsq) != 0) consider(st.predictor, 0, st.lattice, lsq);
+  // Averaging every parallelogram loses where some of them are poor (across
+  // the rows of a latitude-longitude grid, say): the gate's alone, in march
+  // order, with its own weights.
+  int32_t gate_lsq[3], gate_est[3];
+  if (level >= 3) {
+    fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est);
+    const Lattice lattice = st.lattice;
+    consider(Predictor::gate, 0, lattice, gate_est);
+  }
   if (level >= 7) {
     const Predictor surface = st.predictor;
     const Lattice lattice = st.lattice;

@@ -1,0 +1,1316 @@
+#!/usr/bin/env python3
+"""An independent decoder for .tsm files (format version 1), written from
+format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
+no third-party modules (zstd-compressed sections, codec 1, need the optional
+`zstandard` module; the reference encoder never writes them).
+
+Usage:
+  reference_decoder.py FILE.tsm                      print a summary
+  reference_decoder.py FILE.tsm --compare OUT.ply    compare with `tsm decode FILE.tsm -o OUT.ply`
+                                                     (binary or ASCII PLY): faces and float bits
+  reference_decoder.py FILE.tsm --dump               print faces, grid indices and positions
+  reference_decoder.py FILE.tsm --trace              also trace the geometry decoding
+
+Exit status: 0 decoded (and equal, with --compare), 1 differs, 2 corrupt/unsupported.
+"""
+import math
+import struct
+import sys
+
+NONE = 0xFFFFFFFF          # kNone
+INVALID = 0xFFFFFFFF
+UNKNOWN = 255              # act[v] before v is decoded
+FLT_MAX = struct.unpack('<f', b'\xff\xff\x7f\x7f')[0]
+
+
+class Corrupt(Exception):
+    pass
+
+
+class Unsupported(Exception):
+    pass
+
+
+def reject(why):
+    raise Corrupt(why)
+
+
+# ---------------------------------------------------------------- §1 conventions
+
+def xxh32(data, seed=0):
+    P1, P2, P3, P4, P5 = 2654435761, 2246822519, 3266489917, 668265263, 374761393
+    M = 0xFFFFFFFF
+
+    def rotl(x, r):
+        return ((x << r) | (x >> (32 - r))) & M
+
+    def rnd(acc, lane):
+        acc = (acc + lane * P2) & M
+        return (rotl(acc, 13) * P1) & M
+
+    n = len(data)
+    i = 0
+    if n >= 16:
+        v1 = (seed + P1 + P2) & M
+        v2 = (seed + P2) & M
+        v3 = seed & M
+        v4 = (seed - P1) & M
+        while i + 16 <= n:
+            a, b, c, d = struct.unpack_from('<4I', data, i)
+            v1, v2, v3, v4 = rnd(v1, a), rnd(v2, b), rnd(v3, c), rnd(v4, d)
+            i += 16
+        h = (rotl(v1, 1) + rotl(v2, 7) + rotl(v3, 12) + rotl(v4, 18)) & M
+    else:
+        h = (seed + P5) & M
+    h = (h + n) & M
+    while i + 4 <= n:
+        h = (h + struct.unpack_from('<I', data, i)[0] * P3) & M
+        h = (rotl(h, 17) * P4) & M
+        i += 4
+    while i < n:
+        h = (h + data[i] * P5) & M
+        h = (rotl(h, 11) * P1) & M
+        i += 1
+    h ^= h >> 15
+    h = (h * P2) & M
+    h ^= h >> 13
+    h = (h * P3) & M
+    h ^= h >> 16
+    return h
+
+
+def read_varint(buf, pos, end):
+    """§1: unsigned LEB128, at most 10 bytes, the 10th only 0x00 or 0x01."""
+    v = 0
+    for i in range(10):
+        if pos >= end:
+            reject('varint runs past the end')
+        b = buf[pos]
+        pos += 1
+        if i == 9:
+            if b > 1:
+                reject('bad 10th varint byte')
+            return v | (b << 63), pos
+        v |= (b & 0x7F) << (7 * i)
+        if not b & 0x80:
+            return v, pos
+    reject('unreachable')
+
+
+# ---------------------------------------------------------------- §2-§4 container
+
+MAGIC = b'TSM\x1a'
+
+
+def read_container(data):
+    n = len(data)
+    if n < 4 or data[:4] != MAGIC:
+        reject('not a .tsm file')                                   # step 1
+    if n < 8:
+        reject('truncated preamble')                                # step 2
+    version, flags = struct.unpack_from('<HH', data, 4)
+    if version != 1:
+        raise Unsupported('version %d' % version)                   # step 3
+    if flags != 0:
+        reject('flags')                                             # step 4
+    hlen, pos = read_varint(data, 8, n)                             # step 5
+    if hlen > n - pos:
+        reject('header length')
+    hstart = pos
+    hend = pos + hlen
+    if n - hend < 4:
+        reject('header checksum missing')                           # step 6
+    if struct.unpack_from('<I', data, hend)[0] != xxh32(data[:hend]):
+        reject('header checksum')                                   # step 7
+    h = {}
+    p = hstart                                                      # step 8
+    h['vertex_count'], p = read_varint(data, p, hend)
+    h['face_count'], p = read_varint(data, p, hend)
+    h['corner_count'], p = read_varint(data, p, hend)
+    if hend - p < 2 + 12 + 8:
+        reject('header fields')
+    h['bits'] = data[p]
+    h['level'] = data[p + 1]
+    p += 2
+    h['origin'] = list(struct.unpack_from('<3f', data, p))
+    p += 12
+    h['extent'] = struct.unpack_from('<d', data, p)[0]
+    p += 8
+    h['segment_count'], p = read_varint(data, p, hend)
+    if not 1 <= h['segment_count'] <= 0xFFFFFFFF:
+        reject('segment count')                                     # step 9
+    if not all(math.isfinite(o) for o in h['origin']):
+        reject('origin')                                            # step 10
+    e = h['extent']
+    if not (math.isfinite(e) and e >= 0 and e <= 6.9e38):
+        reject('extent')                                            # step 11
+    if not 1 <= h['bits'] <= 30:
+        reject('quantization bits')                                 # step 12
+    sections = {}
+    order = []
+    pos = hend + 4
+    while True:
+        if n - pos < 2:
+            reject('no end marker')                                 # step 13
+        sid = struct.unpack_from('<H', data, pos)[0]
+        pos += 2
+        if sid == 0:                                                # step 14
+            break
+        if n - pos < 1:
+            reject('section header')                                # step 15
+        codec = data[pos]
+        pos += 1
+        stored, pos = read_varint(data, pos, n)
+        raw, pos = read_varint(data, pos, n)
+        if n - pos < 4:
+            reject('section checksum missing')
+        cks = struct.unpack_from('<I', data, pos)[0]
+        pos += 4
+        if codec > 1:
+            reject('codec')                                         # step 16
+        if stored > n - pos:
+            reject('stored length')                                 # step 17
+        if codec == 0 and raw != stored:
+            reject('raw length')                                    # step 18
+        if codec == 1 and raw > stored * 1024:
+            reject('expansion')
+        body = data[pos:pos + stored]
+        pos += stored
+        if xxh32(body) != cks:
+            reject('section checksum')                              # step 19
+        if sid in sections:
+            reject('duplicate section id')                          # step 20
+        if codec == 1:                                              # step 21
+            try:
+                import zstandard
+            except ImportError:
+                raise Unsupported('zstd section (install the zstandard module)')
+            try:
+                body = zstandard.ZstdDecompressor().decompress(body, max_output_size=raw)
+            except Exception:
+                reject('zstd')
+            if len(body) != raw:
+                reject('zstd length')
+        sections[sid] = bytes(body)
+        order.append(sid)
+        if len(order) > 4096:
+            reject('too many sections')                             # step 22
+    if pos != n:
+        reject('bytes after the end marker')                        # step 23
+    return h, sections
+
+
+# ---------------------------------------------------------------- §8.1 range decoder and models
+
+class RangeDecoder:
+    def __init__(self, data):
+        self.s = data
+        self.pos = 0
+        self.overrun = 0
+        self.range = 0xFFFFFFFF
+        self.code = 0
+        for _ in range(4):
+            self.code = ((self.code << 8) | self.next_byte()) & 0xFFFFFFFF
+
+    def next_byte(self):
+        if self.pos < len(self.s):
+            b = self.s[self.pos]
+            self.pos += 1
+            return b
+        self.overrun += 1
+        return 0
+
+    def normalize(self):
+        while self.range < (1 << 24):
+            self.range = (self.range << 8) & 0xFFFFFFFF
+            self.code = ((self.code << 8) | self.next_byte()) & 0xFFFFFFFF
+
+    def bit(self, probs, i):
+        """probs: a list of probabilities, i: index of the one to use and adapt."""
+        p = probs[i]
+        bound = (self.range >> 12) * p
+        if self.code < bound:
+            self.range = bound
+            probs[i] = p + ((4096 - p) >> 5)
+            b = 0
+        else:
+            self.code -= bound
+            self.range -= bound
+            probs[i] = p - (p >> 5)
+            b = 1
+        self.normalize()
+        return b
+
+    def direct(self, n):
+        v = 0
+        for _ in range(n):
+            self.range >>= 1
+            b = 1 if self.code >= self.range else 0
+            if b:
+                self.code -= self.range
+            v = (v << 1) | b
+            self.normalize()
+        return v
+
+    def truncated(self):
+        return self.overrun > 8
+
+
+def probs(n):
+    return [2048] * n
+
+
+class BitTree:
+    def __init__(self, k):
+        self.k = k
+        self.p = probs(1 << k)
+
+    def decode(self, d):
+        node = 1
+        for _ in range(self.k):
+            node = (node << 1) | d.bit(self.p, node)
+        return node - (1 << self.k)
+
+
+class UIntModel:
+    def __init__(self, m=2):
+        self.m = m
+        self.length = BitTree(6)
+        self.mantissa = [probs(1 << m) for _ in range(33)]
+
+    def decode(self, d):
+        n = self.length.decode(d)
+        if n > 32:
+            return INVALID
+        x = 1
+        node = 1
+        top = min(n, self.m)
+        mp = self.mantissa[n]
+        for _ in range(top):
+            b = d.bit(mp, node)
+            node = (node << 1) | b
+            x = (x << 1) | b
+        rest = n - top
+        if rest > 0:
+            x = (x << rest) | d.direct(rest)
+        v = x - 1
+        return INVALID if v >= 0xFFFFFFFF else v
+
+
+class SIntModel:
+    def __init__(self, m=2):
+        self.p = probs(2)          # [zero, sign]
+        self.magnitude = UIntModel(m)
+
+    def decode(self, d):
+        if d.bit(self.p, 0) == 0:
+            return 0
+        neg = d.bit(self.p, 1)
+        m = self.magnitude.decode(d)
+        if m >= 0x7FFFFFFF:
+            m = 0x7FFFFFFE
+        v = m + 1
+        return -v if neg else v
+
+
+# ---------------------------------------------------------------- §8.6 bounding loop
+
+def bounding_loop(lparent, jumps):
+    """lparent: local parents (lparent[0] = NONE); jumps: list of [corner, partner].
+    Returns loop (local vertices) and loop_twin."""
+    n = len(lparent)
+    nj = len(jumps)
+    children = [[] for _ in range(n)]
+    for v in range(1, n):                                   # step 1
+        if lparent[v] == NONE or lparent[v] >= v:
+            reject('loop: parent after child')
+        children[lparent[v]].append(v)                      # increasing position
+    slots = []                                              # step 2: tree slots
+    for v in range(n):
+        sl = ([lparent[v]] if v != 0 else []) + children[v]
+        slots.append(sl)
+    deg = [len(s) for s in slots]
+
+    def slot_back(v, w):      # the slot of w pointing back to v
+        if w != 0 and lparent[w] == v:
+            return 0
+        base = 1 if w != 0 else 0
+        for i in range(base, deg[w]):
+            if slots[w][i] == v:
+                return i
+        return None
+
+    tour = 2 * (n - 1)                                      # step 3
+    corner_v = [0] * tour
+    corner_s = [0] * tour
+    v, s = 0, 0
+    for step in range(tour):
+        w = slots[v][s]
+        back = slot_back(v, w)
+        if back is None:
+            reject('loop: tree slot without a way back')
+        qq = (step + 1) % tour
+        corner_v[qq] = w
+        corner_s[qq] = back
+        v = w
+        s = (back + 1) % deg[w]
+    for i in range(nj):                                     # step 4
+        c, pt = jumps[i]
+        if c >= tour or pt >= nj or pt == i or jumps[pt][1] != i:
+            reject('loop: bad jump endpoint')
+        if i > 0 and jumps[i - 1][0] > c:
+            reject('loop: jump corners decrease')
+    # step 5: full slots: entries ('t', tree slot index) or ('j', endpoint)
+    at_corner = {}
+    for i in range(nj):
+        c = jumps[i][0]
+        at_corner.setdefault((corner_v[c], corner_s[c]), []).append(i)
+    full = []                  # full[v] = list of slot descriptors
+    jump_slot = [None] * nj    # endpoint -> (v, index in full[v])
+    tree_slot = []             # tree_slot[v][s] -> index in full[v]
+    for v in range(n):
+        fl = []
+        ts = []
+        for s in range(deg[v]):
+            ts.append(len(fl))
+            fl.append(('t', s))
+            for i in at_corner.get((v, s), []):
+                jump_slot[i] = (v, len(fl))
+                fl.append(('j', i))
+        full.append(fl)
+        tree_slot.append(ts)
+
+    def reverse(v, k):         # (owner, index) of the reverse of full slot k of v
+        kind, x = full[v][k]
+        if kind == 't':
+            w = slots[v][x]
+            ws = slot_back(v, w)
+            if ws is None:
+                reject('loop: no reverse slot')
+            return w, tree_slot[w][ws]
+        return jump_slot[jumps[x][1]]
+
+    L = 2 * (n - 1) + nj
+    loop = []
+    left_at = {}
+    slot_of = []
+    cur = (0, 0)                                            # step 6
+    while True:
+        if len(loop) >= L or cur in left_at:
+            reject('loop: walk does not close')
+        left_at[cur] = len(loop)
+        slot_of.append(cur)
+        loop.append(cur[0])
+        w, r = reverse(*cur)
+        nxt = r + 1 if r + 1 < len(full[w]) else 0
+        cur = (w, nxt)
+        if cur == (0, 0):
+            break
+    if len(loop) != L:
+        reject('loop: wrong length')
+    loop_twin = []                                          # step 7
+    for p in range(L):
+        r = reverse(*slot_of[p])
+        if r not in left_at:
+            reject('loop: slot never left')
+        loop_twin.append(left_at[r])
+    return loop, loop_twin
+
+
+# ---------------------------------------------------------------- §8.8 triangle tree walk (+ §8.10 step 1 marks)
+
+def triangle_walk(L, root, march, branch, loop, n, read_bit):
+    """read_bit(va, vb, prev) reads one marching bit with context bit[va][vb][prev]."""
+    nr = len(march)
+    if L < 4 or root >= L:
+        reject('walk: L or root')
+    if nr < 1:
+        reject('walk: no runs')
+    t1 = [0] * nr
+    stack = []
+    for i in range(nr - 1, -1, -1):                          # step 2
+        s = march[i] + 1
+        if branch[i]:
+            if len(stack) < 2:
+                reject('walk: branch lacks subtrees')
+            s1 = stack.pop()
+            s2 = stack.pop()
+            t1[i] = s1
+            s += s1 + s2
+        if s > L:
+            reject('walk: subtree too big')
+        stack.append(s)
+    if len(stack) != 1 or stack[0] != L - 3:
+        reject('walk: sizes')
+
+    def fwd(p, d):
+        return (p + d) % L
+
+    def bwd(p, d):
+        return (p + L - d) % L
+
+    tris = []       # (a, b, x) loop positions
+    parent = []
+    slot = []
+    marks = []      # per triangle: [mark edge0, edge1, edge2] (loop edge or None)
+    val = [0] * n   # valences so far, per local vertex
+
+    class Tris(list):
+        def append(self, t):
+            for c in t:
+                val[loop[c]] += 1
+            list.append(self, t)
+    tris = Tris()
+    r = root
+    tris.append((bwd(r, 1), r, fwd(r, 1)))                   # step 3
+    parent.append(NONE)
+    slot.append(0)
+    marks.append([bwd(r, 1), r, None])
+    gate = (bwd(r, 1), fwd(r, 1), 0, 2)                      # a, b, owner, slot
+    gstack = []
+    for i in range(nr):                                      # step 4
+        prev = 2
+        for _ in range(march[i]):
+            a, b, par, sl = gate
+            span = (a - b) % L
+            if span < 3:
+                reject('walk: march step without room')
+            bit = read_bit(min(val[loop[a]], 7), min(val[loop[b]], 7), prev)
+            prev = bit
+            k = len(tris)
+            if bit == 0:
+                x = fwd(b, 1)
+                tris.append((a, b, x))
+                marks.append([None, b, None])
+                gate = (a, x, k, 2)
+            else:
+                x = bwd(a, 1)
+                tris.append((a, b, x))
+                marks.append([None, None, x])
+                gate = (x, b, k, 1)
+            parent.append(par)
+            slot.append(sl)
+        a, b, par, sl = gate
+        span = (a - b) % L
+        k = len(tris)
+        if not branch[i]:
+            if span != 2:
+                reject('walk: leaf does not close')
+            tris.append((a, b, fwd(b, 1)))
+            marks.append([None, b, fwd(b, 1)])
+            parent.append(par)
+            slot.append(sl)
+            if not gstack:
+                if i != nr - 1:
+                    reject('walk: runs left over')
+                break
+            gate = gstack.pop()
+        else:
+            off = t1[i] + 1
+            if off + 2 > span:
+                reject('walk: Y-vertex outside')
+            x = fwd(b, off)
+            tris.append((a, b, x))
+            marks.append([None, None, None])
+            parent.append(par)
+            slot.append(sl)
+            gstack.append((a, x, k, 2))
+            gate = (x, b, k, 1)
+    if len(tris) != L - 2:
+        reject('walk: triangle count')                       # step 5
+    return tris, parent, slot, marks
+
+
+# ---------------------------------------------------------------- §8.3 connectivity
+
+def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
+    dv, dt, do = RangeDecoder(s3), RangeDecoder(s4), RangeDecoder(s5)
+    # §8.2 models
+    v_length = [UIntModel(), UIntModel()]
+    v_leaf = probs(2)
+    v_last = probs(1)
+    t_root = UIntModel()
+    t_march = [UIntModel(), UIntModel()]
+    t_end = [probs(2), probs(2)]
+    t_bit = probs(8 * 8 * 3)       # bit[va][vb][prev] at (8 va + vb) 3 + prev
+    t_diag = probs(2)
+    o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
+    o_has_poly = probs(1)
+
+    def overrun():
+        return dv.overrun > 8 or dt.overrun > 8 or do.overrun > 8
+
+    max_positions = vertex_count + 2 * corner_count
+    C = o_count.decode(do)
+    polygons = do.bit(o_has_poly, 0)
+    if C > max_positions:
+        reject('component count')
+    parent = []           # global pre-order parents
+    tri = []              # §8.10 tri[]: 3 positions per global triangle
+    tparent = []          # global parent triangle
+    tslot = []
+    glued = []
+    twin = []
+    prev_leaf = 1
+    info = {'components': C, 'jump_edges': 0}
+    for c in range(C):
+        start = len(parent)
+        # -- vertex tree §8.4
+        stack = []
+        root_run = True
+        while True:
+            if overrun():
+                reject('vertex tree truncated')
+            ln = v_length[prev_leaf].decode(dv)
+            if ln == INVALID or len(parent) + ln + 1 > max_positions:
+                reject('vertex run length')
+            leaf = dv.bit(v_leaf, prev_leaf)
+            prev_leaf = leaf
+            par = NONE
+            if not root_run:
+                if not stack:
+                    reject('run without parent')
+                par = stack[-1]
+                if dv.bit(v_last, 0) == 1:
+                    stack.pop()
+            root_run = False
+            for _ in range(ln + 1):
+                parent.append(par)
+                par = len(parent) - 1
+            if leaf == 0:
+                stack.append(par)
+            if leaf == 1 and not stack:
+                break
+        n = len(parent) - start
+        if n < 2:
+            continue
+        if n == 2:
+            reject('two-vertex component')
+        # -- jump edges (stream 5)
+        nj = o_count.decode(do)
+        if nj > 2 * n + 8 or nj % 2 or overrun():
+            reject('jump count')
+        jumps = []
+        corner = 0
+        for i in range(nj):
+            d = o_corner.decode(do)
+            if d > 2 * n:
+                reject('jump corner')
+            corner += d
+            jumps.append([corner, NONE])
+        for i in range(nj):
+            if jumps[i][1] != NONE:
+                continue
+            d = o_partner.decode(do)
+            if d >= nj or i + 1 + d >= nj or jumps[i + 1 + d][1] != NONE:
+                reject('jump partner')
+            jumps[i][1] = i + 1 + d
+            jumps[i + 1 + d][1] = i
+        info['jump_edges'] += nj // 2
+        if overrun():
+            reject('topology truncated')
+        lparent = [NONE if parent[start + i] == NONE else parent[start + i] - start for i in range(n)]
+        loop, loop_twin = bounding_loop(lparent, jumps)
+        L = len(loop)
+        # -- triangle tree (stream 4)
+        root = t_root.decode(dt)
+        total = 0
+        leaves = branches = 0
+        prev_end = 1
+        march, branch = [], []
+        while True:
+            if overrun():
+                reject('triangle tree truncated')
+            m = t_march[prev_end].decode(dt)
+            if m == INVALID or total + m + 1 > L:
+                reject('march count')
+            br = dt.bit(t_end[prev_end], 1 if m == 0 else 0)
+            march.append(m)
+            branch.append(br)
+            prev_end = br
+            total += m + 1
+            if br:
+                branches += 1
+            else:
+                leaves += 1
+            if leaves == branches + 1:
+                break
+        ltris, lpar, lslot, marks = triangle_walk(
+            L, root, march, branch, loop, n, lambda va, vb, prev: dt.bit(t_bit, (8 * va + vb) * 3 + prev))
+        if overrun():
+            reject('triangle tree truncated')
+        T = L - 2
+        base = len(tparent)
+        # -- §8.10 steps 1-3
+        twin.extend([NONE] * (3 * T))
+        loop_he = [NONE] * L
+        for k in range(T):
+            for e in range(3):
+                p = marks[k][e]
+                if p is not None:
+                    if loop_he[p] != NONE:
+                        reject('a loop edge belongs to two triangles')
+                    loop_he[p] = 3 * (base + k) + e
+        for k in range(T):
+            for e in range(3):
+                p = marks[k][e]
+                if p is not None:
+                    twin[3 * (base + k) + e] = loop_he[loop_twin[p]]
+        for k in range(1, T):
+            hp = 3 * (base + lpar[k]) + lslot[k]
+            twin[3 * (base + k)] = hp
+            twin[hp] = 3 * (base + k)
+        for k in range(T):
+            for i in range(3):
+                tri.append(start + loop[ltris[k][i]])
+            tparent.append(NONE if lpar[k] == NONE else base + lpar[k])
+            tslot.append(lslot[k])
+            g = 0
+            if polygons and k > 0:
+                g = dt.bit(t_diag, 0 if k == 1 else glued[-1])
+            glued.append(g)
+        if len(tparent) > corner_count + max_positions:
+            reject('too many triangles')
+    P = len(parent)
+    nvirt = o_count.decode(do)
+    if nvirt > P:
+        reject('virtual count')
+    virtual = [0] * P
+    at = 0
+    for i in range(nvirt):
+        d = o_position.decode(do)
+        if d > P or at + d >= P or (i > 0 and d == 0):
+            reject('virtual position')
+        at += d
+        virtual[at] = 1
+    nstitch = o_count.decode(do)
+    if nstitch > P:
+        reject('stitch count')
+    stitch_to = [NONE] * P
+    at = 0
+    for i in range(nstitch):
+        d = o_position.decode(do)
+        dist = o_distance.decode(do)
+        if overrun() or at + d >= P or (i > 0 and d == 0):
+            reject('stitch position')
+        at += d
+        if dist >= at:
+            reject('stitch target')
+        stitch_to[at] = at - dist - 1
+    # §8.7 numbering
+    ids = [NONE] * P
+    nxt = 0
+    for p in range(P):
+        if virtual[p]:
+            continue
+        if stitch_to[p] != NONE:
+            t = stitch_to[p]
+            if virtual[t] or stitch_to[t] != NONE:
+                reject('stitch to a vertex without position')
+            ids[p] = ids[t]
+        else:
+            ids[p] = nxt
+            nxt += 1
+    if nxt != vertex_count:
+        reject('vertex count')
+    # §8.10 step 4
+    H = len(twin)
+    for h in range(H):
+        t = twin[h]
+        if t >= H or twin[t] != h:
+            reject('the cut surface does not close')
+    vparent = [NONE] * vertex_count
+    for p in range(P):
+        if virtual[p] or stitch_to[p] != NONE:
+            continue
+        if parent[p] != NONE:
+            if virtual[parent[p]]:
+                reject('virtual parent')
+            vparent[ids[p]] = ids[parent[p]]
+    # §8.9 faces
+    faces = []
+    ncorners = [0]
+
+    def push(face):
+        if len(faces) >= face_count or ncorners[0] + len(face) > corner_count:
+            reject('too many faces/corners')
+        faces.append(list(face))
+        ncorners[0] += len(face)
+
+    NT = len(tparent)
+    # polygon cycles: node lists
+    nvert, nnext = [], []
+    edge_node = [NONE] * (3 * NT)
+    group = [NONE] * NT
+    first_node = [NONE] * NT
+    for k in range(NT):
+        tv = tri[3 * k:3 * k + 3]
+        if virtual[tv[0]] or virtual[tv[1]] or virtual[tv[2]]:
+            if glued[k]:
+                reject('glued virtual triangle')
+            continue
+        cc = [ids[tv[0]], ids[tv[1]], ids[tv[2]]]
+        if not polygons:
+            push(cc)
+            continue
+        if not glued[k]:
+            n0 = len(nvert)
+            nvert += cc
+            nnext += [n0 + 1, n0 + 2, n0]
+            for i in range(3):
+                edge_node[3 * k + i] = n0 + i
+            group[k] = k
+            first_node[k] = n0
+        else:
+            par = tparent[k]
+            nd = NONE if par == NONE else edge_node[3 * par + tslot[k]]
+            if nd == NONE or group[par] == NONE:
+                reject('glued to a missing edge')
+            x = len(nvert)
+            nvert.append(cc[2])
+            nnext.append(nnext[nd])
+            nnext[nd] = x
+            edge_node[3 * k + 1] = nd
+            edge_node[3 * k + 2] = x
+            edge_node[3 * par + tslot[k]] = NONE
+            group[k] = group[par]
+    if polygons:
+        members = {}
+        for k in range(NT):
+            if group[k] != NONE:
+                members.setdefault(group[k], []).append(k)
+        for k in range(NT):
+            if group[k] != k:
+                continue
+            m = len(members[k])
+            cyc = []
+            nd = first_node[k]
+            while True:
+                cyc.append(nvert[nd])
+                nd = nnext[nd]
+                if nd == first_node[k] or len(cyc) > len(nvert):
+                    break
+            if len(cyc) != m + 2:
+                reject('polygon does not close')
+            if m >= 2:
+                count = [0] * len(cyc)
+                for t in members[k]:
+                    for c3 in tri[3 * t:3 * t + 3]:
+                        oid = ids[c3]
+                        if oid in cyc:
+                            count[cyc.index(oid)] += 1
+                apex = count.index(max(count))
+                cyc = cyc[apex:] + cyc[:apex]
+            push(cyc)
+    nside = o_count.decode(do)
+    if nside > face_count:
+        reject('side face count')
+    for i in range(nside):
+        sz = o_face_size.decode(do)
+        if sz > corner_count or overrun():
+            reject('side face size')
+        face = []
+        for j in range(sz):
+            x = o_index.decode(do)
+            if x >= vertex_count:
+                reject('side face corner')
+            face.append(x)
+        push(face)
+    if overrun():
+        reject('connectivity truncated')
+    if len(faces) != face_count or ncorners[0] != corner_count:
+        reject('face/corner count mismatch')
+    layout = {'tri': tri, 'twin': twin, 'id': ids, 'vparent': vparent, 'vertex_count': vertex_count}
+    info.update(virtual=nvirt, stitches=nstitch, side_faces=nside, polygons=polygons, triangles=NT)
+    return faces, layout, info
+
+
+# ---------------------------------------------------------------- §8.5 geometry
+
+def nxt_he(h):
+    return h - 2 if h % 3 == 2 else h + 1
+
+
+def prv_he(h):
+    return h + 2 if h % 3 == 0 else h - 1
+
+
+def bit_length(x):
+    return x.bit_length()
+
+
+def floordiv(a, b):
+    return a // b    # Python's // is floor division for any sign
+
+
+def decode_geometry(payload, layout, qbits, trace=None):
+    vc = layout['vertex_count']
+    tri, twin, ids, vparent = layout['tri'], layout['twin'], layout['id'], layout['vparent']
+    H = len(tri)
+    qmax = (1 << qbits) - 1
+    # §8.5.1 header
+    if len(payload) < 1:
+        reject('geometry: empty')
+    predictor = payload[0]
+    if predictor > 2:
+        reject('geometry: predictor')
+    pos = 1
+    K = 0
+    lam = []
+    if predictor == 0:
+        if len(payload) < 2:
+            reject('geometry: K missing')
+        K = payload[1]
+        if not 1 <= K <= 4:
+            reject('geometry: K')
+        if len(payload) < 2 + 4 * K:
+            reject('geometry: lambdas missing')
+        lam = list(struct.unpack_from('<%di' % K, payload, 2))
+        for x in lam:
+            if x < -(1 << 24) or x > (1 << 24):
+                reject('geometry: lambda range')
+        pos = 2 + 4 * K
+    alpha = [4096, 4096, 4096]
+    if predictor != 0:
+        if len(payload) < 7:
+            reject('geometry: weights missing')
+        alpha = list(struct.unpack_from('<3h', payload, 1))
+        pos = 7
+    d = RangeDecoder(payload[pos:])
+    # §8.2 models
+    lattice_count, lattice_gap = SIntModel(6), SIntModel(6)
+    residual = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
+    on = [probs(3) for _ in range(3)]
+    index = [[[SIntModel(6) for _ in range(14)] for _ in range(3)] for _ in range(3)]
+    has_anchor = probs(1)
+    anchor_gap = UIntModel(2)
+    # §8.5.2 lattice
+    lattice = [[], [], []]
+    for a in range(3):
+        n = lattice_count.decode(d)
+        if n < 0 or n > qmax + 1 or n > vc:
+            reject('geometry: lattice count')
+        prev = -1
+        for _ in range(n):
+            x = prev + 1 + lattice_gap.decode(d)
+            if x <= prev or x > qmax or d.truncated():
+                reject('geometry: lattice plane')
+            lattice[a].append(x)
+            prev = x
+    q = [[0, 0, 0] for _ in range(vc)]
+    act = [UNKNOWN] * vc
+    st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0}
+    stats = {'no_triangle': 0, 'anchored': 0, 'on_plane': 0}
+
+    def nearest(L, p):
+        # the first index j with L[j] >= p
+        lo, hi = 0, len(L)
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if L[mid] < p:
+                lo = mid + 1
+            else:
+                hi = mid
+        j = lo
+        if j == len(L) or (j > 0 and p - L[j - 1] <= L[j] - p):
+            j = j - 1 if j > 0 else 0
+        return j
+
+    # §8.5.3
+    def code_vertex(v, pred, cls, activity):
+        sm = 0
+        top = 0
+        n_on = 0
+        for a in range(3):
+            ctx = activity if a == 0 else (activity + bit_length(top) + 1) // 2
+            ctx = min(ctx, 13)
+            p = min(max(pred[a], 0), qmax)
+            coded = False
+            L = lattice[a]
+            if L:
+                j = nearest(L, p)
+                if d.bit(on[a], n_on) == 1:
+                    dd = index[a][n_on][ctx].decode(d)
+                    k = j + dd
+                    if k < 0 or k >= len(L):
+                        reject('geometry: plane index')
+                    x = L[k]
+                    stats['on_plane'] += 1
+                    n_on += 1
+                    coded = True
+            if not coded:
+                r = residual[a][cls][ctx].decode(d)
+                x = p + r
+                if x < 0 or x > qmax:
+                    reject('geometry: coordinate outside the grid')
+            q[v][a] = x
+            e = abs(x - p)
+            sm += e
+            top = max(top, e)
+        act[v] = min(bit_length(sm), 254)
+        if trace is not None:
+            trace.append('v%d pred=%s cls=%d act_in=%d -> q=%s act=%d' % (v, list(pred), cls, activity, q[v], act[v]))
+
+    def point(v, pred, cls, activity):
+        code_vertex(v, pred, cls, activity)
+        st['last'] = list(q[v])
+        st['last_act'] = act[v]
+
+    def known(p):
+        v = ids[p]
+        return v if v != NONE and act[v] != UNKNOWN else NONE
+
+    def fan(h0):
+        h = h0
+        while True:
+            yield h
+            h = nxt_he(twin[h])
+            if h == h0:
+                return
+
+    def div_round(s, n):
+        return floordiv(2 * s + n, 2 * n)
+
+    # §8.5.4
+    def predict(h0, multi):
+        para = [0, 0, 0]
+        nb = [0, 0, 0]
+        cnt = {'npara': 0, 'nnb': 0, 'actsum': 0}
+
+        def neighbour(u):
+            for a in range(3):
+                nb[a] += q[u][a]
+            cnt['nnb'] += 1
+            cnt['actsum'] += act[u]
+
+        def visit(h):
+            u = known(tri[nxt_he(h)])
+            if u == NONE:
+                return
+            neighbour(u)
+            w = known(tri[prv_he(h)])
+            if w == NONE:
+                return
+            o = known(tri[prv_he(twin[nxt_he(h)])])
+            if o == NONE:
+                return
+            for a in range(3):
+                para[a] += q[u][a] + q[w][a] - q[o][a]
+            cnt['npara'] += 1
+
+        if multi:
+            for h in fan(h0):
+                visit(h)
+        else:
+            visit(h0)
+            w = known(tri[prv_he(h0)])
+            if w != NONE and cnt['npara'] == 0:
+                neighbour(w)
+        npara, nnb = cnt['npara'], cnt['nnb']
+        if npara > 0:
+            cls = 1 + min(npara, 3)
+            pred = []
+            for a in range(3):
+                P = div_round(para[a], npara)
+                N = div_round(nb[a], nnb)
+                pred.append(N + floordiv(alpha[cls - 2] * (P - N) + 2048, 4096))
+        elif nnb > 0:
+            pred = [div_round(nb[a], nnb) for a in range(3)]
+            cls = 1
+        else:
+            pred = list(st['last'])
+            cls = 0
+        activity = (cnt['actsum'] + nnb // 2) // nnb if nnb > 0 else st['last_act']
+        return pred, cls, activity
+
+    # §8.5.7
+    def on_no_triangle():
+        prev_anchor = 0
+        for v in range(vc):
+            if act[v] != UNKNOWN:
+                continue
+            stats['no_triangle'] += 1
+            if d.bit(has_anchor, 0) == 1:
+                gap = anchor_gap.decode(d)
+                if gap == INVALID or prev_anchor + gap >= vc:
+                    reject('geometry: anchor out of range')
+                anchor = prev_anchor + gap
+                if act[anchor] == UNKNOWN:
+                    reject('geometry: anchor not decoded')
+                prev_anchor = anchor
+                stats['anchored'] += 1
+                pred = list(q[anchor])
+            else:
+                pred = list(st['last'])
+            point(v, pred, 0, st['last_act'])
+            if v % 4096 == 0 and d.truncated():
+                reject('geometry: truncated')
+
+    if predictor == 2:                                       # §8.5.5
+        for h0 in range(H):
+            p = tri[h0]
+            if ids[p] == NONE or act[ids[p]] != UNKNOWN:
+                continue
+            point(ids[p], *predict(h0, False))
+            if h0 % 4096 == 0 and d.truncated():
+                reject('geometry: truncated')
+        on_no_triangle()
+    elif predictor == 1:                                     # §8.5.6
+        first_he = [NONE] * vc
+        for h in range(H - 1, -1, -1):
+            v = ids[tri[h]]
+            if v != NONE:
+                first_he[v] = h
+        npara = [0] * vc
+        nnb = [0] * vc
+        prio = [0] * vc
+        buckets = [[] for _ in range(16)]
+        heads = [0] * 16
+
+        def priority(x):
+            return 4 * min(npara[x], 3) + min(nnb[x], 3)
+
+        def bump(x):
+            pr = priority(x)
+            if pr != prio[x]:
+                prio[x] = pr
+                buckets[pr].append(x)
+
+        def update_counts(v):
+            for h in fan(first_he[v]):
+                pu = tri[nxt_he(h)]
+                pw = tri[prv_he(h)]
+                u = known(pu)
+                w = known(pw)
+                if u == NONE and ids[pu] != NONE:
+                    x = ids[pu]
+                    nnb[x] = min(nnb[x] + 1, 255)
+                    if w != NONE and known(tri[prv_he(twin[prv_he(h)])]) != NONE:
+                        npara[x] = min(npara[x] + 1, 255)
+                    bump(x)
+                if w == NONE and ids[pw] != NONE and u != NONE and known(tri[prv_he(twin[h])]) != NONE:
+                    x = ids[pw]
+                    npara[x] = min(npara[x] + 1, 255)
+                    bump(x)
+                if u != NONE and w != NONE:
+                    px = tri[prv_he(twin[nxt_he(h)])]
+                    if ids[px] != NONE and known(px) == NONE:
+                        x = ids[px]
+                        npara[x] = min(npara[x] + 1, 255)
+                        bump(x)
+
+        scan = 0
+        while True:
+            v = NONE
+            for b in range(15, 0, -1):
+                bk = buckets[b]
+                while heads[b] < len(bk):
+                    x = bk[heads[b]]
+                    heads[b] += 1
+                    if act[x] == UNKNOWN and prio[x] == b:
+                        v = x
+                        break
+                if v != NONE:
+                    break
+            if v == NONE:
+                while scan < H and (ids[tri[scan]] == NONE or act[ids[tri[scan]]] != UNKNOWN):
+                    scan += 1
+                if scan == H:
+                    break
+                v = ids[tri[scan]]
+            point(v, *predict(first_he[v], True))
+            update_counts(v)
+            if v % 4096 == 0 and d.truncated():
+                reject('geometry: truncated')
+        on_no_triangle()
+    else:                                                    # §8.5.8
+        for v in range(vc):
+            if vparent[v] != NONE and vparent[v] >= v:
+                reject('geometry: parent after child')
+        root = [(qmax + 1) // 2] * 3
+        for v in range(vc):
+            anc = []
+            x = vparent[v]
+            while x != NONE and len(anc) < K:
+                anc.append(x)
+                x = vparent[x]
+            dd = len(anc)
+            if dd == 0:
+                pred, cls, activity = list(root), 0, 0
+            else:
+                activity = act[anc[0]]
+                if dd < K:
+                    pred, cls = list(q[anc[0]]), 1
+                else:
+                    pred = [floordiv(sum(lam[i] * q[anc[i]][a] for i in range(K)) + (1 << 15), 1 << 16)
+                            for a in range(3)]
+                    cls = 2
+            code_vertex(v, pred, cls, activity)
+            if dd == 0:
+                root = list(q[v])
+            if v % 4096 == 0 and d.truncated():
+                reject('geometry: truncated')
+    if d.truncated():                                        # §8.5.9
+        reject('geometry: truncated')
+    ginfo = {'predictor': ['ancestors', 'parallelograms', 'gate'][predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
+             'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun}
+    ginfo.update(stats)
+    return q, ginfo
+
+
+# ---------------------------------------------------------------- §5 dequantization, §9 payload
+
+def f32(x):
+    return struct.unpack('<f', struct.pack('<f', x))[0]
+
+
+def decode(data, trace=None):
+    h, sections = read_container(data)
+    vc, fc, cc = h['vertex_count'], h['face_count'], h['corner_count']
+    if not (vc < 0x3FFFFFFF and cc < 0x3FFFFFFF and fc <= cc):
+        reject('counts')                                             # step 26
+    for sid in (3, 4, 5):
+        if sid not in sections:
+            reject('connectivity section missing')                   # step 27
+    if 6 not in sections:
+        reject('geometry section missing')                           # step 28
+    faces, layout, info = decode_connectivity(sections[3], sections[4], sections[5], vc, fc, cc)   # step 29
+    q, ginfo = decode_geometry(sections[6], layout, h['bits'], trace)                                # step 30
+    info.update(ginfo)
+    step = h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
+    positions = []
+    for v in range(vc):
+        pt = []
+        for a in range(3):
+            x = float(h['origin'][a]) + float(q[v][a]) * step
+            x = min(max(x, -FLT_MAX), FLT_MAX)
+            pt.append(f32(x))
+        positions.append(pt)
+    return h, faces, q, positions, info
+
+
+# ---------------------------------------------------------------- comparison with `tsm decode` output
+
+def read_ply(path):
+    data = open(path, 'rb').read()
+    end = data.index(b'end_header') + len(b'end_header')
+    if data[end:end + 1] == b'\r':
+        end += 1
+    if data[end:end + 1] == b'\n':
+        end += 1
+    header = data[:end].decode('ascii').splitlines()
+    fmt = None
+    elements = []
+    for line in header:
+        w = line.split()
+        if not w:
+            continue
+        if w[0] == 'format':
+            fmt = w[1]
+        elif w[0] == 'element':
+            elements.append([w[1], int(w[2]), []])
+        elif w[0] == 'property':
+            elements[-1][2].append(w[1:])
+    tmap = {'char': 'b', 'int8': 'b', 'uchar': 'B', 'uint8': 'B', 'short': 'h', 'int16': 'h', 'ushort': 'H',
+            'uint16': 'H', 'int': 'i', 'int32': 'i', 'uint': 'I', 'uint32': 'I', 'float': 'f', 'float32': 'f',
+            'double': 'd', 'float64': 'd'}
+    verts, faces = [], []
+    if fmt == 'ascii':
+        toks = data[end:].split()
+        ti = 0
+        for name, count, props in elements:
+            for _ in range(count):
+                rec = []
+                for pr in props:
+                    if pr[0] == 'list':
+                        k = int(toks[ti]); ti += 1
+                        rec.append([int(t) for t in toks[ti:ti + k]]); ti += k
+                    else:
+                        rec.append(float(toks[ti]) if tmap[pr[0]] in 'fd' else int(toks[ti])); ti += 1
+                if name == 'vertex':
+                    verts.append([f32(x) for x in rec[:3]])
+                elif name == 'face':
+                    faces.append(rec[0])
+    else:
+        bo = '<' if fmt == 'binary_little_endian' else '>'
+        pos = end
+        for name, count, props in elements:
+            for _ in range(count):
+                rec = []
+                for pr in props:
+                    if pr[0] == 'list':
+                        k = struct.unpack_from(bo + tmap[pr[1]], data, pos)[0]
+                        pos += struct.calcsize(tmap[pr[1]])
+                        t = tmap[pr[2]]
+                        rec.append(list(struct.unpack_from(bo + str(k) + t, data, pos)))
+                        pos += k * struct.calcsize(t)
+                    else:
+                        t = tmap[pr[0]]
+                        rec.append(struct.unpack_from(bo + t, data, pos)[0])
+                        pos += struct.calcsize(t)
+                if name == 'vertex':
+                    verts.append(rec[:3])
+                elif name == 'face':
+                    faces.append(rec[0])
+    return verts, faces
+
+
+def bits32(x):
+    return struct.unpack('<I', struct.pack('<f', x))[0]
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    path = argv[1]
+    trace = [] if '--trace' in argv else None
+    try:
+        h, faces, q, positions, info = decode(open(path, 'rb').read(), trace)
+    except Corrupt as e:
+        print('%s: corrupt_data: %s' % (path, e))
+        return 2
+    except Unsupported as e:
+        print('%s: unsupported: %s' % (path, e))
+        return 2
+    print('%s: %d vertices, %d faces, q=%d; predictor %s%s, lattice planes %s (%d coordinates on planes), '
+          '%d vertices on no triangle (%d anchored), geometry overrun %d; '
+          'components %d, jump edges %d, virtual %d, stitches %d, side faces %d, polygons %d' % (
+              path, len(q), len(faces), h['bits'], info['predictor'],
+              (' K=%d lambda=%s' % (info['K'], info['lambda'])) if info['predictor'] == 'ancestors'
+              else ' alpha=%s' % info['alpha'],
+              info['lattice_planes'], info['on_plane'], info['no_triangle'], info['anchored'], info['overrun'],
+              info['components'], info['jump_edges'], info['virtual'],
+              info['stitches'], info['side_faces'], info['polygons']))
+    if trace is not None:
+        for line in trace:
+            print('  ' + line)
+    if '--dump' in argv or trace is not None:
+        for i, f in enumerate(faces):
+            print('  face %d: %s' % (i, f))
+        for v in range(len(q)):
+            print('  vertex %d: q=%s pos=%s' % (v, q[v], ['%.9g' % x for x in positions[v]]))
+    if '--compare' in argv:
+        ref = argv[argv.index('--compare') + 1]
+        verts, rfaces = read_ply(ref)
+        ok = True
+        if len(verts) != len(positions):
+            print('vertex count differs: %d vs %d' % (len(positions), len(verts)))
+            ok = False
+        else:
+            bad = [v for v in range(len(verts))
+                   if [bits32(x) for x in verts[v]] != [bits32(x) for x in positions[v]]]
+            if bad:
+                print('%d vertices differ, first %d: %s vs %s' % (len(bad), bad[0], positions[bad[0]], verts[bad[0]]))
+                ok = False
+        if [list(f) for f in rfaces] != faces:
+            print('faces differ (%d vs %d faces)' % (len(faces), len(rfaces)))
+            ok = False
+        print('compare with %s: %s (%d vertices, %d faces)' % (ref, 'IDENTICAL' if ok else 'DIFFERENT',
+                                                              len(verts), len(rfaces)))
+        return 0 if ok else 1
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv))
