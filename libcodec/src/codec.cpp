@@ -43,7 +43,20 @@ Status read_streams(std::vector<Section>& sections, ConnectivityStreams& cs) {
   return Status::Ok();
 }
 
-Status check_limits(const Header& h, const DecodeOptions& options) {
+// A modelled binary decision costs at least -log2(4065/4096) = 0.011 bits
+// (12-bit probabilities adapted by 1/32), so a stream of n bytes (plus the 8
+// zero bytes a decoder may read past its end) holds at most 730 (n + 8)
+// decisions. Every vertex costs at least 3 in the geometry stream, every
+// triangle of the cut surface at least 1 in the triangle-tree stream (a
+// marching bit or a run's end), every side-face corner at least 6 in the
+// topology stream: counts beyond that are forged, refused before allocating.
+uint64_t decisions(const std::vector<Section>& sections, uint16_t id) {
+  for (const Section& s : sections)
+    if (s.id == id) return 730 * (static_cast<uint64_t>(s.data.size()) + 8);
+  return 0;
+}
+
+Status check_limits(const Header& h, const std::vector<Section>& sections, const DecodeOptions& options) {
   if (options.max_vertices && h.vertex_count > options.max_vertices)
     return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.vertex_count) +
                                                  " vertices, above the caller's limit of " +
@@ -52,8 +65,19 @@ Status check_limits(const Header& h, const DecodeOptions& options) {
     return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.face_count) +
                                                  " faces, above the caller's limit of " +
                                                  std::to_string(options.max_faces));
+  const uint64_t max_corners = options.max_corners ? options.max_corners : 16 * options.max_faces;
+  if (max_corners && h.corner_count > max_corners)
+    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.corner_count) +
+                                                 " face corners, above the caller's limit of " +
+                                                 std::to_string(max_corners));
   if (h.vertex_count >= 0x3FFFFFFFu || h.corner_count >= 0x3FFFFFFFu || h.face_count > h.corner_count)
     return corrupt("vertex, face or corner count out of range");
+  if (h.vertex_count > decisions(sections, kSectionGeometry) / 3)
+    return corrupt("the header's " + std::to_string(h.vertex_count) +
+                   " vertices cannot be coded in a geometry section of this size");
+  if (h.corner_count > 3 * decisions(sections, kSectionTriangleTree) + decisions(sections, kSectionTopology) / 6)
+    return corrupt("the header's " + std::to_string(h.corner_count) +
+                   " corners cannot be coded in connectivity sections of this size");
   return Status::Ok();
 }
 
@@ -61,7 +85,7 @@ Status check_limits(const Header& h, const DecodeOptions& options) {
 // the output vertices into `parent` (shared by decode and inspect).
 Status decode_topology(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
                        GeometryLayout& layout, ConnectivityStats* stats) {
-  TSM_RETURN_IF_ERROR(check_limits(h, options));
+  TSM_RETURN_IF_ERROR(check_limits(h, sections, options));
   ConnectivityStreams cs;
   TSM_RETURN_IF_ERROR(read_streams(sections, cs));
   return decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, layout, stats);

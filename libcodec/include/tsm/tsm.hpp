@@ -28,9 +28,12 @@ struct EncodeOptions {
 };
 
 struct DecodeOptions {
-  // A client bounds its memory with these (0 = only the format's own limits).
+  // A client bounds its memory with these (0 = only the format's own limits,
+  // which already tie every count to the bytes of the streams that code it).
   uint64_t max_vertices = 0;
   uint64_t max_faces = 0;
+  // Face corners; when 0 and max_faces is set, 16 x max_faces.
+  uint64_t max_corners = 0;
 };
 
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out);
