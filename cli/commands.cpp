@@ -324,6 +324,7 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   DecodeOptions d;
   d.max_vertices = a.max_vertices;
   d.max_faces = a.max_faces;
+  d.max_corners = a.max_corners;
   s = decode(bytes, mesh, d);
   if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
   decode_ms = sw.ms();

@@ -28,7 +28,7 @@ struct DecodeArgs : BatchArgs {
   std::string output;
   std::string format;               // "", ply, obj
   bool ascii = false, force = false;
-  uint64_t max_vertices = 0, max_faces = 0;
+  uint64_t max_vertices = 0, max_faces = 0, max_corners = 0;
 };
 
 struct InfoArgs : BatchArgs {};

@@ -88,6 +88,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   dec->add_option("--max-faces", da.max_faces, "Refuse files with more faces (memory bound)")
       ->check(CLI::NonNegativeNumber);
+  dec->add_option("--max-corners", da.max_corners,
+                  "Refuse files with more face corners (default with --max-faces: 16 x that)")
+      ->check(CLI::NonNegativeNumber);
   add_batch_options(dec, da, true);
   dec->footer(
       "Examples:\n"

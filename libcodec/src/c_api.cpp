@@ -47,6 +47,7 @@ int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* optio
     if (options) {
       o.max_vertices = options->max_vertices;
       o.max_faces = options->max_faces;
+      o.max_corners = options->max_corners;
     }
     auto* m = new tsm_mesh;
     tsm::Status s = tsm::decode(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, o);

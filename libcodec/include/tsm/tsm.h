@@ -34,6 +34,7 @@ typedef struct tsm_mesh tsm_mesh;
 typedef struct tsm_decode_options {
   uint64_t max_vertices; /* 0 = no limit besides the format's own */
   uint64_t max_faces;
+  uint64_t max_corners; /* 0 = 16 x max_faces when that is set */
 } tsm_decode_options;
 
 typedef struct tsm_encode_options {
