@@ -267,7 +267,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (C > max_positions) return corrupt("more components than vertices");
 
   std::vector<uint32_t> parent;       // global pre-order parent positions
-  std::vector<uint32_t> tri_vertex;   // decoded triangles, pre-order positions
+  std::vector<uint32_t>& tri_vertex = layout.tri;  // decoded triangles, pre-order positions
+  tri_vertex.clear();
   std::vector<uint32_t> tri_parent;   // global decode index of the parent triangle
   std::vector<uint8_t> tri_slot, tri_glued;
   std::vector<uint32_t> local_parent, loop, loop_twin, tri_pos, tparent, edge_loop, loop_he;
@@ -440,7 +441,6 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     }
   }
   layout.vertex = out_id;
-  layout.tri = tri_vertex;
 
   // Faces: triangles in decode order, polygons glued along flagged edges.
   out.face_offsets.assign(1, 0);
