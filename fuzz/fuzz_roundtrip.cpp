@@ -1,30 +1,93 @@
-// libFuzzer target: a mesh built from the fuzzer's bytes (vertex count, then
-// faces of 1..6 corners over those vertices) must encode, decode and compare
-// equal under the oracle.
+// libFuzzer target: a mesh built from the fuzzer's bytes must encode, decode
+// and compare equal under the oracle tsm::compare_meshes; encoding must be
+// deterministic. Any mismatch aborts.
+//
+// Input layout (make_seeds.cpp writes seeds in it):
+//   byte 0   quantization bits, 1 + b % 30
+//   byte 1   level b % 10 (low nibble), position mode (b >> 4) % 4, bit 6:
+//            also check that a second encode gives the same bytes
+//   byte 2   vertex count, 1 + b
+//   byte 3   scale exponent, b % 164 - 40 (positions are scaled by 2^e)
+//   then faces: a corner count 1 + b % 6, then that many vertex bytes (b % n).
+// Position modes: 0 a lattice of distinct points, 1 pseudo-random points,
+// 2 only three distinct points (coincident vertices), 3 the lattice far from
+// the origin (coordinates much larger than the mesh).
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "tsm/tsm.hpp"
 
+namespace {
+
+[[noreturn]] void fail(const std::string& what) {
+  std::fprintf(stderr, "fuzz_roundtrip: %s\n", what.c_str());
+  __builtin_trap();
+}
+
+uint64_t mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+void position(uint32_t i, int mode, float scale, float out[3]) {
+  const float lattice[3] = {static_cast<float>(i % 7), static_cast<float>((i * 3) % 11),
+                            static_cast<float>((i * 5) % 13)};
+  for (int a = 0; a < 3; ++a) {
+    float x = lattice[a];
+    if (mode == 1) x = static_cast<float>(mix(i * 3u + static_cast<uint32_t>(a)) >> 40) / 16777216.0f;
+    if (mode == 2) x = static_cast<float>((i % 3) * (a + 1));
+    out[a] = x * scale;
+    if (mode == 3) out[a] += 1.0e4f * scale;
+  }
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  if (size < 2) return 0;
+  if (size < 4) return 0;
+  tsm::EncodeOptions options;
+  options.quantization_bits = 1 + data[0] % 30;
+  options.level = (data[1] & 15) % 10;
+  const int mode = (data[1] >> 4) % 4;
+  const uint32_t nv = 1u + data[2];
+  const float scale = std::ldexp(1.0f, data[3] % 164 - 40);
   tsm::Mesh m;
-  uint32_t nv = 1 + data[0] % 64;
-  for (uint32_t i = 0; i < nv; ++i)
-    m.add_vertex(static_cast<float>(i % 7), static_cast<float>((i * 3) % 11), static_cast<float>((i * 5) % 13));
-  size_t at = 1;
+  for (uint32_t i = 0; i < nv; ++i) {
+    float p[3];
+    position(i, mode, scale, p);
+    m.add_vertex(p[0], p[1], p[2]);
+  }
+  size_t at = 4;
   uint32_t corners[6];
   while (at < size) {
-    uint32_t n = 1 + data[at++] % 6;
+    const uint32_t n = 1 + data[at++] % 6;
     if (at + n > size) break;
     for (uint32_t i = 0; i < n; ++i) corners[i] = data[at++] % nv;
     m.add_face(corners, n);
   }
+  if (!m.all_finite()) return 0;  // the encoder refuses those by design
   std::string bytes;
-  if (!tsm::encode(m, tsm::EncodeOptions{}, bytes).ok()) __builtin_trap();
+  tsm::Status s = tsm::encode(m, options, bytes);
+  if (!s.ok()) fail("encode refused a valid mesh: " + s.to_string());
+  std::string bytes2;
+  if ((data[1] & 0x40) && (!tsm::encode(m, options, bytes2).ok() || bytes2 != bytes))
+    fail("encoding is not deterministic");
   tsm::Mesh back;
-  if (!tsm::decode(bytes, back).ok()) __builtin_trap();
-  if (!tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits).equal) __builtin_trap();
+  s = tsm::decode(bytes, back);
+  if (!s.ok()) fail("decode refused the encoder's output: " + s.to_string());
+  std::string why;
+  if (!back.valid(&why)) fail("decoded an invalid mesh: " + why);
+  tsm::FileInfo info;
+  s = tsm::inspect(bytes, info);
+  if (!s.ok()) fail("inspect refused the encoder's output: " + s.to_string());
+  if (info.vertex_count != nv || info.face_count != m.face_count() || info.corner_count != m.corner_count())
+    fail("inspect's counts differ from the mesh");
+  tsm::CompareResult cr = tsm::compare_meshes(m, back, options.quantization_bits);
+  if (!cr.equal) fail("oracle: the decoded mesh differs: " + cr.difference);
   return 0;
 }

@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite: install, build release and ASan+UBSan, run both.
+# The whole test suite: install, build release and ASan+UBSan, run both, then
+# a short smoke run of every libFuzzer target (fuzz/run.sh; clang + libFuzzer
+# are required: without them this fails, it never skips).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -12,3 +14,6 @@ for preset in release asan; do
   echo "== $preset tests"
   ctest --preset "$preset" -j "$jobs"
 done
+fuzz_seconds=${TSM_FUZZ_SMOKE_SECONDS:-20}
+echo "== fuzz smoke run (${fuzz_seconds} s per target)"
+FUZZ_JOBS=$jobs bash fuzz/run.sh "$fuzz_seconds"

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan, the library instrumented
+# for coverage) and runs each for SECONDS with a generated seed corpus:
+#
+#   fuzz/run.sh SECONDS [TARGET...]     (targets: fuzz_decode fuzz_read_mesh fuzz_roundtrip)
+#
+# Prints, per target, the executions and the result; exits non-zero when a
+# target finds a crash, leak, timeout or out-of-memory, with the path of the
+# file that reproduces it (rerun it with: build/fuzz/fuzz/TARGET FILE).
+# Seeds are generated into build/fuzz/seeds/TARGET/ by fuzz_seeds (never
+# committed); inputs the fuzzer finds go to build/fuzz/corpus/TARGET/ and are
+# kept for the next run; full logs in build/fuzz/logs/. Runs at nice 19, one
+# target at a time, builds with -j1 (set FUZZ_JOBS to change that).
+set -euo pipefail
+
+usage() { echo "usage: fuzz/run.sh SECONDS [fuzz_decode|fuzz_read_mesh|fuzz_roundtrip]..." >&2; exit 2; }
+[ $# -ge 1 ] || usage
+secs=$1
+shift
+[[ "$secs" =~ ^[1-9][0-9]*$ ]] || usage
+all=(fuzz_decode fuzz_read_mesh fuzz_roundtrip)
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
+for t in "${targets[@]}"; do
+  [[ " ${all[*]} " == *" $t "* ]] || { echo "fuzz: unknown target '$t' (known: ${all[*]})" >&2; exit 2; }
+done
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+build=build/fuzz
+die() {
+  echo "fuzz: FAILED: $*" >&2
+  exit 1
+}
+
+# The toolchain: clang with libFuzzer. Without it there is no fuzzing, and
+# that is an error, never a silent skip.
+command -v clang++ >/dev/null 2>&1 ||
+  die "clang++ is not installed; the fuzzers need clang and libFuzzer (bash scripts/setup.sh installs clang and libclang-rt-14-dev)"
+probe_dir=$(mktemp -d)
+trap 'rm -rf "$probe_dir"' EXIT
+echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' >"$probe_dir/p.cpp"
+if ! clang++ -fsanitize=fuzzer,address,undefined "$probe_dir/p.cpp" -o "$probe_dir/p" >"$probe_dir/log" 2>&1; then
+  cat "$probe_dir/log" >&2
+  die "clang++ cannot link a libFuzzer target (-fsanitize=fuzzer): the libFuzzer runtime is missing (bash scripts/setup.sh installs libclang-rt-14-dev)"
+fi
+
+mkdir -p "$build/logs"
+if ! CXX=clang++ cmake -S . -B "$build" -G Ninja -DTSM_FUZZ=ON -DTSM_SANITIZE=ON -DTSM_BUILD_TESTS=OFF \
+  -DTSM_WITH_DRACO=OFF >"$build/logs/configure.log" 2>&1; then
+  cat "$build/logs/configure.log" >&2
+  die "configuring $build failed (if it was first configured with another compiler, remove $build)"
+fi
+if ! nice -n 19 cmake --build "$build" -j "${FUZZ_JOBS:-1}" --target tsm_fuzz >"$build/logs/build.log" 2>&1; then
+  tail -n 60 "$build/logs/build.log" >&2
+  die "building the fuzz targets failed (full log: $build/logs/build.log)"
+fi
+"$build/fuzz/fuzz_seeds" "$build/seeds" || die "the seed generator failed"
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+failed=()
+for t in "${targets[@]}"; do
+  corpus=$build/corpus/$t
+  artifacts=$build/artifacts/$t
+  log=$build/logs/$t.log
+  mkdir -p "$corpus" "$artifacts"
+  extra=()
+  [ -f "fuzz/$t.dict" ] && extra+=("-dict=fuzz/$t.dict")
+  start=$(date +%s)
+  rc=0
+  # -malloc_limit_mb: no input of a few kilobytes justifies a 512 MB block.
+  nice -n 19 "$build/fuzz/$t" -max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -malloc_limit_mb=512 \
+    -print_final_stats=1 -artifact_prefix="$artifacts/" "${extra[@]}" "$corpus" "$build/seeds/$t" \
+    >"$log" 2>&1 || rc=$?
+  took=$(($(date +%s) - start))
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  if [ -z "$execs" ]; then  # a crash ends the run before the final stats
+    execs=$(grep -o '^#[0-9]*' "$log" | tail -n 1 | tr -d '#')
+  fi
+  units=$(find "$corpus" -type f | wc -l)
+  if [ "$rc" -eq 0 ]; then
+    echo "fuzz: $t: ok, ${execs:-?} executions in ${took} s, corpus $units inputs"
+  else
+    artifact=$(sed -n "s/.*Test unit written to \(.*\)$/\1/p" "$log" | tail -n 1)
+    kind=$(grep -m1 -oE 'ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|LeakSanitizer|libFuzzer): [a-z-]+[^ ]*|runtime error: .*' "$log" || true)
+    echo "fuzz: $t: FAILED (exit $rc) after ${execs:-?} executions in ${took} s: ${kind:-see the log}"
+    echo "fuzz: $t: reproducer: ${artifact:-none written}   (rerun: $build/fuzz/$t ${artifact:-FILE})"
+    echo "fuzz: $t: log: $log; its end:"
+    tail -n 40 "$log" | sed 's/^/    /'
+    failed+=("$t")
+  fi
+done
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: FAILED: ${failed[*]}" >&2
+  exit 1
+fi
+echo "fuzz: all ${#targets[@]} targets ran ${secs} s each without a finding"
