@@ -217,10 +217,7 @@ TEST(Connectivity, MidpointKruskalTreeRoundTrips) {
   // The midpoint-distance variant of the vertex tree (the encoder keeps it at
   // level 9 when smaller): the decoder needs nothing new, the tree is coded.
   for (const Mesh& m : {icosphere(3), genus_surface(2, 2), grid_with_holes(12, 3), book(4), moebius(10)}) {
-    std::vector<uint32_t> qpos(m.positions.size());
-    Grid grid = Grid::for_mesh(m, 12);
-    for (size_t i = 0; i < qpos.size(); ++i)
-      qpos[i] = static_cast<uint32_t>(std::max<int64_t>(0, grid.quantize(m.positions[i], static_cast<int>(i % 3))));
+    const std::vector<uint32_t> qpos = tsm_test::quantized_positions(m, 12);
     for (bool midpoint : {false, true}) {
       CutHints hints;
       hints.qpos = &qpos;

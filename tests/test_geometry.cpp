@@ -41,12 +41,10 @@ Mesh sphere_with_strays(int level, int strays) {
   std::mt19937 rng(5);
   std::uniform_int_distribution<size_t> pick(0, m.vertex_count() - 1);
   std::uniform_real_distribution<float> jitter(-0.003f, 0.003f);
-  const size_t n = m.vertex_count();
   for (int i = 0; i < strays; ++i) {
     const float* p = &m.positions[3 * pick(rng)];
     m.add_vertex(p[0] + jitter(rng), p[1] + jitter(rng), p[2] + jitter(rng));
   }
-  (void)n;
   return m;
 }
 
@@ -87,14 +85,10 @@ struct Prepared {
 Prepared prepare(const Mesh& m, int bits) {
   Prepared p;
   EXPECT_TRUE(tsm::encode_connectivity(m, p.ce).ok());
-  tsm::Grid grid = tsm::Grid::for_mesh(m, bits);
-  const int64_t qmax = (int64_t{1} << bits) - 1;
-  p.q.resize(3 * m.vertex_count());
+  const std::vector<uint32_t> qin = tsm_test::quantized_positions(m, bits);  // input order
+  p.q.resize(qin.size());
   for (size_t v = 0; v < p.ce.vertex_order.size(); ++v)
-    for (int a = 0; a < 3; ++a) {
-      int64_t x = grid.quantize(m.positions[3 * static_cast<size_t>(p.ce.vertex_order[v]) + a], a);
-      p.q[3 * v + a] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
-    }
+    for (int a = 0; a < 3; ++a) p.q[3 * v + a] = qin[3 * static_cast<size_t>(p.ce.vertex_order[v]) + a];
   return p;
 }
 

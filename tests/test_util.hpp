@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tsm/compare.hpp"
 #include "tsm/mesh.hpp"
 
 namespace tsm_test {
@@ -25,6 +26,19 @@ inline Faces faces_of(const tsm::Mesh& m) {
   Faces out;
   for (size_t f = 0; f < m.face_count(); ++f) out.emplace_back(m.face(f), m.face(f) + m.face_size(f));
   return out;
+}
+
+// Grid indices of every coordinate (input vertex order) on the codec's grid
+// for `bits`, clamped to 0 .. 2^bits - 1, as the encoder quantizes them.
+inline std::vector<uint32_t> quantized_positions(const tsm::Mesh& m, int bits) {
+  const tsm::Grid grid = tsm::Grid::for_mesh(m, bits);
+  const int64_t qmax = (int64_t{1} << bits) - 1;
+  std::vector<uint32_t> q(m.positions.size());
+  for (size_t i = 0; i < q.size(); ++i) {
+    int64_t x = grid.quantize(m.positions[i], static_cast<int>(i % 3));
+    q[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
+  }
+  return q;
 }
 
 // A fresh empty folder under the system temp dir, removed by the destructor.

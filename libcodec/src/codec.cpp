@@ -51,9 +51,8 @@ Status read_streams(std::vector<Section>& sections, ConnectivityStreams& cs) {
 // marching bit or a run's end), every side-face corner at least 6 in the
 // topology stream: counts beyond that are forged, refused before allocating.
 uint64_t decisions(const std::vector<Section>& sections, uint16_t id) {
-  for (const Section& s : sections)
-    if (s.id == id) return 730 * (static_cast<uint64_t>(s.data.size()) + 8);
-  return 0;
+  const Section* s = find_section(sections, id);
+  return s ? 730 * (static_cast<uint64_t>(s->data.size()) + 8) : 0;
 }
 
 Status check_limits(const Header& h, const std::vector<Section>& sections, const DecodeOptions& options) {
@@ -81,14 +80,18 @@ Status check_limits(const Header& h, const std::vector<Section>& sections, const
   return Status::Ok();
 }
 
-// The connectivity of a parsed container: faces into `out`, tree parents of
-// the output vertices into `parent` (shared by decode and inspect).
-Status decode_topology(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
-                       GeometryLayout& layout, ConnectivityStats* stats) {
+// The payload of a parsed container (shared by decode and inspect): faces
+// into `out`, grid indices (3 per output vertex) into `q`.
+Status decode_payload(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
+                      std::vector<uint32_t>& q, ConnectivityStats* cstats, GeometryStats* gstats) {
   TSM_RETURN_IF_ERROR(check_limits(h, sections, options));
   ConnectivityStreams cs;
   TSM_RETURN_IF_ERROR(read_streams(sections, cs));
-  return decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, layout, stats);
+  const Section* geo = find_section(sections, kSectionGeometry);
+  if (!geo) return corrupt("the geometry section is missing");
+  GeometryLayout layout;
+  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, layout, cstats));
+  return decode_geometry(geo->data, layout, h.quantization_bits, q, gstats);
 }
 
 }  // namespace
@@ -179,12 +182,8 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   Header h;
   std::vector<Section> sections;
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  const Section* geo = find_section(sections, kSectionGeometry);
-  if (!geo) return corrupt("the geometry section is missing");
-  GeometryLayout layout;
-  TSM_RETURN_IF_ERROR(decode_topology(h, sections, options, out, layout, nullptr));
   std::vector<uint32_t> q;
-  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, layout, h.quantization_bits, q));
+  TSM_RETURN_IF_ERROR(decode_payload(h, sections, options, out, q, nullptr, nullptr));
   const double step = grid_step(h);
   out.positions.resize(q.size());
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
@@ -229,9 +228,10 @@ Status inspect(std::string_view bytes, FileInfo& info) {
       info.other_bytes += s.stored_bytes;
   }
   Mesh faces;
-  GeometryLayout layout;
+  std::vector<uint32_t> q;
   ConnectivityStats st;
-  TSM_RETURN_IF_ERROR(decode_topology(h, sections, DecodeOptions(), faces, layout, &st));
+  GeometryStats gs;
+  TSM_RETURN_IF_ERROR(decode_payload(h, sections, DecodeOptions(), faces, q, &st, &gs));
   info.components = st.components;
   info.vertex_runs = st.vertex_runs;
   info.triangle_runs = st.triangle_runs;
@@ -240,11 +240,6 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.virtual_vertices = st.virtual_vertices;
   info.side_faces = st.side_faces;
   info.marching_bits = st.marching_bits;
-  const Section* geo = find_section(sections, kSectionGeometry);
-  if (!geo) return corrupt("the geometry section is missing");
-  std::vector<uint32_t> q;
-  GeometryStats gs;
-  TSM_RETURN_IF_ERROR(decode_geometry(geo->data, layout, h.quantization_bits, q, &gs));
   info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
                             : gs.predictor == Predictor::gate    ? "gate"
                                                                  : "parallelograms";

@@ -43,7 +43,6 @@ constexpr int kLambdaShift = 16;
 constexpr int kAlphaShift = 12;
 constexpr int32_t kAlphaOne = 1 << kAlphaShift;
 
-int bitlen(uint64_t x) { return bit_length(x); }
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
 
@@ -105,9 +104,10 @@ struct DecodeSink {
 };
 
 struct Coder {
+  Coder(uint32_t vertex_count, int bits) : act(vertex_count, kUnknown), qmax((int64_t{1} << bits) - 1) {}
   std::unique_ptr<ResidualModels> models = std::make_unique<ResidualModels>();
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
-  int64_t qmax = 0;
+  int64_t qmax;
   Lattice lattice;
   // Per parallelogram class (1, 2, 3+ parallelograms): the weight of the
   // parallelogram average against the neighbour average, 4.12 fixed point
@@ -146,7 +146,7 @@ struct Coder {
     uint64_t sum = 0, top = 0;
     int on_count = 0;
     for (int a = 0; a < 3; ++a) {
-      int ctx = a == 0 ? activity : (activity + bitlen(top) + 1) / 2;
+      int ctx = a == 0 ? activity : (activity + bit_length(top) + 1) / 2;
       ctx = std::min(ctx, kActivity - 1);
       const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
@@ -181,7 +181,7 @@ struct Coder {
       sum += ar;
       top = std::max(top, ar);
     }
-    act[v] = static_cast<uint8_t>(std::min(bitlen(sum), 254));
+    act[v] = static_cast<uint8_t>(std::min(bit_length(sum), 254));
     return true;
   }
 };
@@ -508,9 +508,7 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
 // squares and by the size estimate (fit_alpha); the caller codes both.
 void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                 int32_t lsq[3], int32_t est[3]) {
-  Coder fit;
-  fit.act.assign(g.vertex_count, kUnknown);
-  fit.qmax = (int64_t{1} << bits) - 1;
+  Coder fit(g.vertex_count, bits);
   fit.collect = true;
   CollectSink cs;
   std::vector<uint32_t> work = q;
@@ -541,9 +539,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
     w.u8(static_cast<uint8_t>(K));
     for (int i = 0; i < K; ++i) w.u32(static_cast<uint32_t>(lambda[i]));
   }
-  Coder c;
-  c.act.assign(g.vertex_count, kUnknown);
-  c.qmax = (int64_t{1} << bits) - 1;
+  Coder c(g.vertex_count, bits);
   if (pred != Predictor::ancestors)
     for (int k = 0; k < 3; ++k) {
       c.alpha[k] = weights ? weights[k] : kAlphaOne;
@@ -691,10 +687,8 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     consider(Predictor::gate, 0, lattice, gate_est);
   }
   if (level >= 7) {
-    const Predictor surface = st.predictor;
     const Lattice lattice = st.lattice;
     for (int K = 1; K <= kMaxAncestors; ++K) consider(Predictor::ancestors, K, lattice, nullptr);
-    (void)surface;
   }
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
@@ -732,9 +726,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       alpha[k] = static_cast<int16_t>(x);
     }
   const size_t at = r.offset();
-  Coder c;
-  c.act.assign(g.vertex_count, kUnknown);
-  c.qmax = (int64_t{1} << bits) - 1;
+  Coder c(g.vertex_count, bits);
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   DecodeSink s;
   s.d.init(bytes.substr(at));
