@@ -6,7 +6,9 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -268,6 +270,9 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   EncodeOptions eo;
   eo.quantization_bits = a.qbits;
   eo.level = a.level;
+  eo.segment_faces = a.segment_faces;
+  // One file: its segments use the -j threads; several: the files do.
+  eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
   std::string bytes;
   s = encode(mesh, eo, bytes);
   if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
@@ -311,24 +316,43 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   };
   if (!j.refused.ok()) return finish(j.refused);
 
-  phase.set("reading");
-  Stopwatch sw;
-  std::string bytes;
-  Status s = read_input(j.input, bytes);
-  if (!s.ok()) return finish(s);
-  bytes_in = bytes.size();
-  read_ms = sw.ms();
-
-  phase.set("decoding");
-  sw.reset();
   DecodeOptions d;
   d.max_vertices = a.max_vertices;
   d.max_faces = a.max_faces;
   d.max_corners = a.max_corners;
-  s = decode(bytes, mesh, d);
-  if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
-  decode_ms = sw.ms();
-  std::string().swap(bytes);
+  d.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
+  Stopwatch sw;
+  Status s;
+  if (j.input == "-") {
+    // From a pipe: decode each segment as its bytes arrive (the time of
+    // reading and decoding overlaps; it is all counted as decoding).
+    phase.set("decoding");
+    StreamDecoder sd(d);
+    char buf[1 << 16];
+    size_t n;
+    while (s.ok() && (n = std::fread(buf, 1, sizeof buf, stdin)) > 0) {
+      bytes_in += n;
+      s = sd.feed(std::string_view(buf, n));
+    }
+    if (s.ok() && std::ferror(stdin))
+      return finish(Status(ErrorCode::io_error, std::string("<stdin>: read failed: ") + std::strerror(errno)));
+    if (s.ok()) s = sd.finish();
+    if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
+    mesh = sd.take_mesh();
+    decode_ms = sw.ms();
+  } else {
+    phase.set("reading");
+    std::string bytes;
+    s = read_input(j.input, bytes);
+    if (!s.ok()) return finish(s);
+    bytes_in = bytes.size();
+    read_ms = sw.ms();
+    phase.set("decoding");
+    sw.reset();
+    s = decode(bytes, mesh, d);
+    if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
+    decode_ms = sw.ms();
+  }
 
   phase.set("writing");
   sw.reset();

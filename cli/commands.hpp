@@ -21,6 +21,7 @@ struct EncodeArgs : BatchArgs {
   std::string input_format;         // "", ply, obj, stl, off
   int qbits = kDefaultQuantizationBits;
   int level = kDefaultLevel;
+  uint32_t segment_faces = 0;       // 0 = the library's default
   bool force = false, allow_nonfinite = false;
 };
 

@@ -25,7 +25,8 @@ const CLI::Validator kFileOrStdin(
 
 // The options every file command shares.
 void add_batch_options(CLI::App* cmd, BatchArgs& b, bool quiet) {
-  cmd->add_option("-j,--jobs", b.jobs, "Files processed at once (worker threads); 0 = number of cores")
+  cmd->add_option("-j,--jobs", b.jobs,
+                  "Worker threads: files processed at once, or for one file its segments; 0 = number of cores")
       ->check(CLI::Range(0, 1024))->default_str("cores");
   cmd->add_flag("--json", b.json, "One JSON object per input file on stdout (JSON lines), success or failure");
   if (quiet) cmd->add_flag("--quiet", b.quiet, "Print nothing on success: no report, progress bar or summary");
@@ -59,6 +60,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 30))->capture_default_str();
   enc->add_option("-l,--level", ea.level, "Level 0 (fastest decode) .. 9 (smallest)")
       ->check(CLI::Range(0, 9))->capture_default_str();
+  enc->add_option("--segment-faces", ea.segment_faces,
+                  "Code meshes with more faces as segments of at most this many (streaming, parallel decoding); "
+                  "0 = default (262144)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off"}, CLI::ignore_case));

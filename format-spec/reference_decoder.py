@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format version 1), written from
+"""An independent decoder for .tsm files (format version 2), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder never writes them).
@@ -109,7 +109,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version != 1:
+    if version != 2:
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -147,6 +147,7 @@ def read_container(data):
     if not 1 <= h['bits'] <= 30:
         reject('quantization bits')                                 # step 12
     sections = {}
+    segments = []
     order = []
     pos = hend + 4
     while True:
@@ -178,8 +179,13 @@ def read_container(data):
         pos += stored
         if xxh32(body) != cks:
             reject('section checksum')                              # step 19
-        if sid in sections:
-            reject('duplicate section id')                          # step 20
+        if sid == 7:                                                # step 20, §4.3
+            if h['segment_count'] == 1 or len(segments) >= h['segment_count']:
+                reject('segment section')
+        elif sid in sections:
+            reject('duplicate section id')
+        elif 3 <= sid <= 6 and h['segment_count'] > 1:
+            reject('whole-mesh section in a segmented file')
         if codec == 1:                                              # step 21
             try:
                 import zstandard
@@ -191,12 +197,16 @@ def read_container(data):
                 reject('zstd')
             if len(body) != raw:
                 reject('zstd length')
+        if sid == 7:
+            segments.append(bytes(body))
+            continue
         sections[sid] = bytes(body)
         order.append(sid)
         if len(order) > 4096:
             reject('too many sections')                             # step 22
     if pos != n:
         reject('bytes after the end marker')                        # step 23
+    sections[7] = segments
     return h, sections
 
 
@@ -1164,19 +1174,126 @@ def f32(x):
     return struct.unpack('<f', struct.pack('<f', x))[0]
 
 
+def decode_part(streams, counts, bits, earlier, trace):
+    """Steps 26-30 for the whole mesh or one segment (§4.5, §8.11). Returns
+    faces (part-local ids), q (per own vertex), glob (per part vertex: the
+    output id of a reference, NONE for an own vertex), info."""
+    vc, fc, cc, rc = counts
+    s3, s4, s5, sr, s6 = streams
+    if not (vc < 0x3FFFFFFF and cc < 0x3FFFFFFF and fc <= cc):
+        reject('counts')                                             # step 26
+    if rc > vc:
+        reject('references')
+    D = lambda b: 730 * (len(b) + 8)
+    if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + D(s5) // 6:
+        reject('stream budget')
+    if sr is not None and vc > D(sr):
+        reject('references budget')
+    faces, layout, info = decode_connectivity(s3, s4, s5, vc, fc, cc)   # step 29
+    glob = [NONE] * vc
+    if sr is not None:                                               # §8.11
+        ids, tri = layout['id'], layout['tri']
+        ctx = [0] * vc
+        for t in range(0, len(tri), 3):
+            c = [ids[tri[t]], ids[tri[t + 1]], ids[tri[t + 2]]]
+            hole = NONE in c
+            for v in c:
+                if v != NONE:
+                    ctx[v] = max(ctx[v], 2 if hole else 1)
+        d = RangeDecoder(sr)
+        flag = [probs(2) for _ in range(3)]
+        delta = SIntModel(2)
+        prev_flag, prev, found = 0, 0, 0
+        for v in range(vc):
+            prev_flag = d.bit(flag[ctx[v]], prev_flag)
+            if prev_flag:
+                found += 1
+                if found > rc:
+                    reject('references: too many')
+                g = prev + delta.decode(d)
+                if not 0 <= g < earlier:
+                    reject('references: not an earlier vertex')
+                glob[v] = g
+                prev = g
+        if d.truncated():
+            reject('references truncated')
+        if found != rc:
+            reject('references: count')
+        rank = [NONE] * vc
+        n = 0
+        for v in range(vc):
+            if glob[v] == NONE:
+                rank[v] = n
+                n += 1
+        own = dict(layout)
+        own['vertex_count'] = n
+        own['id'] = [NONE if x == NONE else rank[x] for x in ids]
+        vparent = [NONE] * n
+        for v in range(vc):
+            if rank[v] != NONE and layout['vparent'][v] != NONE:
+                vparent[rank[v]] = rank[layout['vparent'][v]]
+        own['vparent'] = vparent
+        layout = own
+    q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 30
+    info.update(ginfo)
+    return faces, q, glob, info
+
+
 def decode(data, trace=None):
     h, sections = read_container(data)
     vc, fc, cc = h['vertex_count'], h['face_count'], h['corner_count']
-    if not (vc < 0x3FFFFFFF and cc < 0x3FFFFFFF and fc <= cc):
-        reject('counts')                                             # step 26
-    for sid in (3, 4, 5):
-        if sid not in sections:
-            reject('connectivity section missing')                   # step 27
-    if 6 not in sections:
-        reject('geometry section missing')                           # step 28
-    faces, layout, info = decode_connectivity(sections[3], sections[4], sections[5], vc, fc, cc)   # step 29
-    q, ginfo = decode_geometry(sections[6], layout, h['bits'], trace)                                # step 30
-    info.update(ginfo)
+    if h['segment_count'] == 1:
+        for sid in (3, 4, 5):
+            if sid not in sections:
+                reject('connectivity section missing')               # step 27
+        if 6 not in sections:
+            reject('geometry section missing')                       # step 28
+        parts = [((sections[3], sections[4], sections[5], None, sections[6]), (vc, fc, cc, 0))]
+    else:                                                            # §4.5
+        parts = []
+        for body in sections[7]:
+            p = 0
+            fields = []
+            for _ in range(8):
+                x, p = read_varint(body, p, len(body))
+                fields.append(x)
+            counts = tuple(fields[:4])
+            streams = []
+            for n in fields[4:]:
+                if n > len(body) - p:
+                    reject('segment stream length')
+                streams.append(body[p:p + n])
+                p += n
+            streams.append(body[p:])
+            if counts[3] > counts[0]:
+                reject('segment references')
+            parts.append((tuple(streams), counts))
+        if len(parts) != h['segment_count']:
+            reject('segment count')
+        if (sum(c[0] - c[3] for _, c in parts), sum(c[1] for _, c in parts),
+                sum(c[2] for _, c in parts)) != (vc, fc, cc):
+            reject('segment sums')
+    faces, q = [], []
+    info = None
+    for streams, counts in parts:
+        pf, pq, glob, pinfo = decode_part(streams, counts, h['bits'], len(q), trace)
+        base = len(q)
+        out_id = []
+        own = 0
+        for g in glob:
+            if g == NONE:
+                out_id.append(base + own)
+                own += 1
+            else:
+                out_id.append(g)
+        faces.extend([[out_id[x] for x in f] for f in pf])
+        q.extend(pq)
+        if info is None:
+            info = pinfo
+        else:
+            for k in ('components', 'jump_edges', 'virtual', 'stitches', 'side_faces', 'polygons'):
+                info[k] += pinfo[k]
+    info['segments'] = len(parts)
     step = h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
     positions = []
     for v in range(vc):
@@ -1275,13 +1392,13 @@ def main(argv):
         return 2
     print('%s: %d vertices, %d faces, q=%d; predictor %s%s, lattice planes %s (%d coordinates on planes), '
           '%d vertices on no triangle (%d anchored), geometry overrun %d; '
-          'components %d, jump edges %d, virtual %d, stitches %d, side faces %d, polygons %d' % (
+          'components %d, jump edges %d, virtual %d, stitches %d, side faces %d, polygons %d, segments %d' % (
               path, len(q), len(faces), h['bits'], info['predictor'],
               (' K=%d lambda=%s' % (info['K'], info['lambda'])) if info['predictor'] == 'ancestors'
               else ' alpha=%s' % info['alpha'],
               info['lattice_planes'], info['on_plane'], info['no_triangle'], info['anchored'], info['overrun'],
               info['components'], info['jump_edges'], info['virtual'],
-              info['stitches'], info['side_faces'], info['polygons']))
+              info['stitches'], info['side_faces'], info['polygons'], info['segments']))
     if trace is not None:
         for line in trace:
             print('  ' + line)

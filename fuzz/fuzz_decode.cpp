@@ -14,6 +14,8 @@
 //   * decode() and inspect() must agree: inspect() fails only if decode()
 //     fails, and a decoded mesh has the counts inspect() reports;
 //   * a decoded mesh must be valid with finite positions;
+//   * the stream decoder, fed the bytes in chunks, accepts exactly what
+//     decode() accepts and gives the same mesh;
 //   * a decoded mesh must itself round-trip: encode() accepts it, decode()
 //     gives it back, and the oracle tsm::compare_meshes says equal on its
 //     grid (the codec's promise holds for every mesh, including one a
@@ -45,6 +47,18 @@ void check(std::string_view bytes) {
   const tsm::Status s = tsm::decode(bytes, mesh, options);
   if (s.code() == tsm::ErrorCode::internal) fail("decode reported an internal error", s);
   if (!s.ok() && s.message().empty()) fail("decode failed without a message", s);
+  {
+    tsm::StreamDecoder sd(options);
+    const size_t chunk = 1 + bytes.size() % 97;
+    tsm::Status ss;
+    for (size_t at = 0; ss.ok() && at < bytes.size(); at += chunk) ss = sd.feed(bytes.substr(at, chunk));
+    if (ss.ok()) ss = sd.finish();
+    if (ss.code() == tsm::ErrorCode::internal) fail("the stream decoder reported an internal error", ss);
+    if (ss.ok() != s.ok()) fail(s.ok() ? "the stream decoder refuses what decode() accepts" : "the stream decoder accepts what decode() refuses", s.ok() ? ss : s);
+    if (s.ok() && (sd.mesh().positions != mesh.positions || sd.mesh().indices != mesh.indices ||
+                   sd.mesh().face_offsets != mesh.face_offsets))
+      fail("streamed and whole decoding differ", s);
+  }
   tsm::FileInfo info;
   const tsm::Status si = tsm::inspect(bytes, info);
   if (si.code() == tsm::ErrorCode::internal) fail("inspect reported an internal error", si);

@@ -5,7 +5,9 @@
 // Input layout (make_seeds.cpp writes seeds in it):
 //   byte 0   quantization bits, 1 + b % 30
 //   byte 1   level b % 10 (low nibble), position mode (b >> 4) % 4, bit 6:
-//            also check that a second encode gives the same bytes
+//            also check that a second encode gives the same bytes, bit 7:
+//            segments of at most 1 + byte 2 % 16 faces, also decoded
+//            streaming in chunks of 1 + byte 3 % 64 bytes
 //   byte 2   vertex count, 1 + b
 //   byte 3   scale exponent, b % 164 - 40 (positions are scaled by 2^e)
 //   then faces: a corner count 1 + b % 6, then that many vertex bytes (b % n).
@@ -53,6 +55,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   tsm::EncodeOptions options;
   options.quantization_bits = 1 + data[0] % 30;
   options.level = (data[1] & 15) % 10;
+  if (data[1] & 0x80) options.segment_faces = 1 + data[2] % 16;
   const int mode = (data[1] >> 4) % 4;
   const uint32_t nv = 1u + data[2];
   const float scale = std::ldexp(1.0f, data[3] % 164 - 40);
@@ -89,5 +92,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fail("inspect's counts differ from the mesh");
   tsm::CompareResult cr = tsm::compare_meshes(m, back, options.quantization_bits);
   if (!cr.equal) fail("oracle: the decoded mesh differs: " + cr.difference);
+  if (options.segment_faces) {
+    tsm::StreamDecoder sd;
+    const size_t chunk = 1 + data[3] % 64;
+    for (size_t at = 0; at < bytes.size(); at += chunk) {
+      s = sd.feed(std::string_view(bytes).substr(at, chunk));
+      if (!s.ok()) fail("the stream decoder refused the encoder's output: " + s.to_string());
+    }
+    s = sd.finish();
+    if (!s.ok()) fail("the stream decoder refused the encoder's output: " + s.to_string());
+    const tsm::Mesh& sm = sd.mesh();
+    if (sm.positions != back.positions || sm.indices != back.indices || sm.face_offsets != back.face_offsets)
+      fail("streamed and whole decoding differ");
+  }
   return 0;
 }

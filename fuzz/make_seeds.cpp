@@ -263,14 +263,22 @@ void roundtrip_seed(const fs::path& dir, const Named& n) {
   }
 }
 
-void encode_seed(const fs::path& dir, const std::string& name, const tsm::Mesh& m, int q, int level) {
+void encode_seed(const fs::path& dir, const std::string& name, const tsm::Mesh& m, int q, int level,
+                 uint32_t segment_faces = 0) {
   std::string bytes;
-  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{q, level}, bytes);
+  tsm::EncodeOptions eo;
+  eo.quantization_bits = q;
+  eo.level = level;
+  eo.segment_faces = segment_faces;
+  tsm::Status s = tsm::encode(m, eo, bytes);
   if (!s.ok()) {
     std::fprintf(stderr, "fuzz_seeds: %s: %s\n", name.c_str(), s.to_string().c_str());
     std::exit(1);
   }
-  put(dir, name + "_q" + std::to_string(q) + "_l" + std::to_string(level) + ".tsm", bytes);
+  put(dir,
+      name + "_q" + std::to_string(q) + "_l" + std::to_string(level) +
+          (segment_faces ? "_s" + std::to_string(segment_faces) : std::string()) + ".tsm",
+      bytes);
 }
 
 void corpus_seeds(const fs::path& corpus, const fs::path& decode_dir, const fs::path& read_dir) {
@@ -328,6 +336,10 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 9);
   encode_seed(decode_dir, "grid_holes", tsm_test::grid_with_holes(10, 2), 30, 9);
   encode_seed(decode_dir, "quads", quad_grid(6), 1, 6);
+  // Files of several segments (FORMAT.md §4.5).
+  encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 12, 6, 40);
+  encode_seed(decode_dir, "grid_holes", tsm_test::grid_with_holes(10, 2), 10, 0, 25);
+  encode_seed(decode_dir, "spheres", tsm_test::copies(tsm_test::icosphere(1), 3), 8, 6, 30);
   handwritten(read_dir);
   corpus_seeds(TSM_CORPUS_DIR, decode_dir, read_dir);
   std::printf("fuzz_seeds: %d seed files in %s\n", written, out.string().c_str());

@@ -65,7 +65,7 @@ TEST(CApi, CreateEncodeDecodeRoundTrip) {
   EXPECT_EQ(copy.indices, src.indices);
 
   Buffer buf;
-  tsm_encode_options eo{12, 5};
+  tsm_encode_options eo{12, 5, 0, 0};
   ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
   ASSERT_NE(buf.p, nullptr);
   ASSERT_GT(buf.n, 0u);
@@ -101,7 +101,7 @@ TEST(CApi, DefaultOptions) {
   std::string cpp;
   ASSERT_TRUE(tsm::encode(src, tsm::EncodeOptions{}, cpp).ok());
   // quantization_bits = 0 and level = -1 mean the defaults; so does NULL.
-  tsm_encode_options defaults{0, -1};
+  tsm_encode_options defaults{0, -1, 0, 0};
   Buffer a, b;
   ASSERT_EQ(tsm_encode(m.p, &defaults, &a.p, &a.n, nullptr, 0), TSM_OK);
   ASSERT_EQ(tsm_encode(m.p, nullptr, &b.p, &b.n, nullptr, 0), TSM_OK);
@@ -202,7 +202,7 @@ TEST(CApi, InvalidMeshesRefused) {
   // Bad options.
   MeshPtr good;
   ASSERT_EQ(tsm_mesh_create(pos, 3, nullptr, 1, idx, 3, &good.p, err, sizeof err), TSM_OK);
-  tsm_encode_options bad_q{31, -1}, bad_level{14, 10};
+  tsm_encode_options bad_q{31, -1, 0, 0}, bad_level{14, 10, 0, 0};
   EXPECT_EQ(tsm_encode(good.p, &bad_q, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err).find("quantization"), std::string::npos) << err;
   EXPECT_EQ(tsm_encode(good.p, &bad_level, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
@@ -252,17 +252,17 @@ TEST(CApi, DecodeLimits) {
   const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
   char err[256];
   tsm_mesh* m = nullptr;
-  tsm_decode_options o{src.vertex_count() - 1, 0, 0};
+  tsm_decode_options o{src.vertex_count() - 1, 0, 0, 0};
   EXPECT_EQ(tsm_decode(data, bytes.size(), &o, &m, err, sizeof err), TSM_LIMIT_EXCEEDED);
   EXPECT_EQ(m, nullptr);
   EXPECT_NE(std::string(err).find("limit"), std::string::npos) << err;
-  o = {0, src.face_count() - 1, 0};
+  o = {0, src.face_count() - 1, 0, 0};
   EXPECT_EQ(tsm_decode(data, bytes.size(), &o, &m, err, sizeof err), TSM_LIMIT_EXCEEDED);
   EXPECT_EQ(m, nullptr);
-  o = {0, 0, src.corner_count() - 1};
+  o = {0, 0, src.corner_count() - 1, 0};
   EXPECT_EQ(tsm_decode(data, bytes.size(), &o, &m, err, sizeof err), TSM_LIMIT_EXCEEDED);
   EXPECT_EQ(m, nullptr);
-  o = {src.vertex_count(), src.face_count(), 0};
+  o = {src.vertex_count(), src.face_count(), 0, 0};
   MeshPtr ok;
   EXPECT_EQ(tsm_decode(data, bytes.size(), &o, &ok.p, err, sizeof err), TSM_OK) << err;
   EXPECT_EQ(tsm_mesh_vertex_count(ok.p), src.vertex_count());

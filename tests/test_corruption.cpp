@@ -198,9 +198,13 @@ std::string describe(const Guarded& g) {
   return s + ", peak " + std::to_string(g.peak) + " bytes, " + std::to_string(g.ms) + " ms";
 }
 
-std::string encode_ok(const Mesh& m, int q = 12, int level = tsm::kDefaultLevel) {
+std::string encode_ok(const Mesh& m, int q = 12, int level = tsm::kDefaultLevel, uint32_t segment_faces = 0) {
   std::string bytes;
-  tsm::Status s = tsm::encode(m, tsm::EncodeOptions{q, level}, bytes);
+  tsm::EncodeOptions eo;
+  eo.quantization_bits = q;
+  eo.level = level;
+  eo.segment_faces = segment_faces;
+  tsm::Status s = tsm::encode(m, eo, bytes);
   EXPECT_TRUE(s.ok()) << s.to_string();
   return bytes;
 }
@@ -227,6 +231,7 @@ std::vector<std::string> small_files() {
   out.push_back(encode_ok(tsm_test::ngon(9), 20));
   out.push_back(encode_ok(point_set(12), 14));
   out.push_back(encode_ok(Mesh(), 14));
+  out.push_back(encode_ok(tsm_test::icosphere(1), 12, tsm::kDefaultLevel, 20));  // 4 segments
   return out;
 }
 
@@ -238,6 +243,8 @@ std::vector<std::string> damage_files() {
   out.push_back(encode_ok(tsm_test::random_soup(60, 90, 5), 10));
   out.push_back(encode_ok(tsm_test::copies(tsm_test::cube_quads(), 3), 9));
   out.push_back(encode_ok(tsm_test::flipped_face_sphere(1), 16));
+  out.push_back(encode_ok(tsm_test::icosphere(2), 12, tsm::kDefaultLevel, 40));  // 8 segments
+  out.push_back(encode_ok(tsm_test::copies(tsm_test::cube_quads(), 4), 9, tsm::kDefaultLevel, 5));
   return out;
 }
 

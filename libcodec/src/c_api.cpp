@@ -7,8 +7,17 @@
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
 
+// A mesh the caller owns, or a view of the stream decoder's growing mesh.
 struct tsm_mesh {
   tsm::Mesh mesh;
+  const tsm::Mesh* view = nullptr;
+  const tsm::Mesh& get() const { return view ? *view : mesh; }
+};
+
+struct tsm_stream {
+  explicit tsm_stream(const tsm::DecodeOptions& o) : decoder(o) { mesh.view = &decoder.mesh(); }
+  tsm::StreamDecoder decoder;
+  tsm_mesh mesh;
 };
 
 namespace {
@@ -48,6 +57,7 @@ int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* optio
       o.max_vertices = options->max_vertices;
       o.max_faces = options->max_faces;
       o.max_corners = options->max_corners;
+      o.threads = options->threads;
     }
     auto* m = new tsm_mesh;
     tsm::Status s = tsm::decode(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, o);
@@ -98,9 +108,11 @@ int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t*
     if (options) {
       if (options->quantization_bits) o.quantization_bits = options->quantization_bits;
       if (options->level >= 0) o.level = options->level;
+      o.segment_faces = options->segment_faces;
+      o.threads = options->threads;
     }
     std::string bytes;
-    tsm::Status s = tsm::encode(mesh->mesh, o, bytes);
+    tsm::Status s = tsm::encode(mesh->get(), o, bytes);
     if (!s.ok()) return s;
     auto* buf = static_cast<uint8_t*>(std::malloc(bytes.size() ? bytes.size() : 1));
     if (!buf) return tsm::Status(tsm::ErrorCode::limit_exceeded, "out of memory");
@@ -111,12 +123,45 @@ int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t*
   });
 }
 
-size_t tsm_mesh_vertex_count(const tsm_mesh* m) { return m ? m->mesh.vertex_count() : 0; }
-size_t tsm_mesh_face_count(const tsm_mesh* m) { return m ? m->mesh.face_count() : 0; }
-size_t tsm_mesh_index_count(const tsm_mesh* m) { return m ? m->mesh.corner_count() : 0; }
-const float* tsm_mesh_positions(const tsm_mesh* m) { return m ? m->mesh.positions.data() : nullptr; }
-const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* m) { return m ? m->mesh.face_offsets.data() : nullptr; }
-const uint32_t* tsm_mesh_indices(const tsm_mesh* m) { return m ? m->mesh.indices.data() : nullptr; }
+tsm_stream* tsm_stream_new(const tsm_decode_options* options) {
+  try {
+    tsm::DecodeOptions o;
+    if (options) {
+      o.max_vertices = options->max_vertices;
+      o.max_faces = options->max_faces;
+      o.max_corners = options->max_corners;
+    }
+    return new tsm_stream(o);
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+int tsm_stream_feed(tsm_stream* s, const uint8_t* data, size_t size, char* err, size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!s || (!data && size)) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
+    return s->decoder.feed(std::string_view(reinterpret_cast<const char*>(data), size));
+  });
+}
+
+int tsm_stream_finish(tsm_stream* s, char* err, size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!s) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
+    return s->decoder.finish();
+  });
+}
+
+size_t tsm_stream_segment_count(const tsm_stream* s) { return s ? s->decoder.segment_count() : 0; }
+size_t tsm_stream_segments_done(const tsm_stream* s) { return s ? s->decoder.segments_done() : 0; }
+const tsm_mesh* tsm_stream_mesh(const tsm_stream* s) { return s ? &s->mesh : nullptr; }
+void tsm_stream_free(tsm_stream* s) { delete s; }
+
+size_t tsm_mesh_vertex_count(const tsm_mesh* m) { return m ? m->get().vertex_count() : 0; }
+size_t tsm_mesh_face_count(const tsm_mesh* m) { return m ? m->get().face_count() : 0; }
+size_t tsm_mesh_index_count(const tsm_mesh* m) { return m ? m->get().corner_count() : 0; }
+const float* tsm_mesh_positions(const tsm_mesh* m) { return m ? m->get().positions.data() : nullptr; }
+const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* m) { return m ? m->get().face_offsets.data() : nullptr; }
+const uint32_t* tsm_mesh_indices(const tsm_mesh* m) { return m ? m->get().indices.data() : nullptr; }
 void tsm_mesh_free(tsm_mesh* m) { delete m; }
 void tsm_free(void* buffer) { std::free(buffer); }
 const char* tsm_version(void) { return tsm::version_string(); }

@@ -3,12 +3,18 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+#ifndef TSM_NO_THREADS
+#include <thread>
+#endif
 
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
+#include "segments.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm {
@@ -29,33 +35,42 @@ const Section* find_section(const std::vector<Section>& sections, uint16_t id) {
   return nullptr;
 }
 
-Status read_streams(std::vector<Section>& sections, ConnectivityStreams& cs) {
-  Section* parts[3] = {nullptr, nullptr, nullptr};
-  for (Section& s : sections) {
-    if (s.id == kSectionVertexTree) parts[0] = &s;
-    if (s.id == kSectionTriangleTree) parts[1] = &s;
-    if (s.id == kSectionTopology) parts[2] = &s;
-  }
-  if (!parts[0] || !parts[1] || !parts[2]) return corrupt("a connectivity section is missing");
-  cs.vertex_tree = std::move(parts[0]->data);
-  cs.triangle_tree = std::move(parts[1]->data);
-  cs.topology = std::move(parts[2]->data);
-  return Status::Ok();
-}
+// One part of a file: the whole mesh (sections 3-6) or one segment (§4.5).
+struct PartCounts {
+  uint64_t vertex_count = 0, face_count = 0, corner_count = 0, reference_count = 0;
+};
+struct PartStreams {
+  std::string_view vertex_tree, triangle_tree, topology, references, geometry;
+  bool segmented = false;  // has a references stream
+};
 
 // A modelled binary decision costs at least -log2(4065/4096) = 0.011 bits
 // (12-bit probabilities adapted by 1/32), so a stream of n bytes (plus the 8
 // zero bytes a decoder may read past its end) holds at most 730 (n + 8)
-// decisions. Every vertex costs at least 3 in the geometry stream, every
-// triangle of the cut surface at least 1 in the triangle-tree stream (a
-// marching bit or a run's end), every side-face corner at least 6 in the
-// topology stream: counts beyond that are forged, refused before allocating.
-uint64_t decisions(const std::vector<Section>& sections, uint16_t id) {
-  const Section* s = find_section(sections, id);
-  return s ? 730 * (static_cast<uint64_t>(s->data.size()) + 8) : 0;
+// decisions. Every own vertex costs at least 3 in the geometry stream, every
+// vertex of a segment 1 in its references stream, every triangle of the cut
+// surface at least 1 in the triangle-tree stream (a marching bit or a run's
+// end), every side-face corner at least 6 in the topology stream: counts
+// beyond that are forged, refused before allocating.
+uint64_t decisions(std::string_view stream) { return 730 * (static_cast<uint64_t>(stream.size()) + 8); }
+
+Status check_budget(const PartCounts& c, const PartStreams& s) {
+  if (c.vertex_count >= 0x3FFFFFFFu || c.corner_count >= 0x3FFFFFFFu || c.face_count > c.corner_count)
+    return corrupt("vertex, face or corner count out of range");
+  if (c.reference_count > c.vertex_count) return corrupt("more references than vertices");
+  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3)
+    return corrupt("the header's " + std::to_string(c.vertex_count - c.reference_count) +
+                   " vertices cannot be coded in a geometry section of this size");
+  if (s.segmented && c.vertex_count > decisions(s.references))
+    return corrupt("the segment's " + std::to_string(c.vertex_count) +
+                   " vertices cannot be flagged in a references stream of this size");
+  if (c.corner_count > 3 * decisions(s.triangle_tree) + decisions(s.topology) / 6)
+    return corrupt("the header's " + std::to_string(c.corner_count) +
+                   " corners cannot be coded in connectivity sections of this size");
+  return Status::Ok();
 }
 
-Status check_limits(const Header& h, const std::vector<Section>& sections, const DecodeOptions& options) {
+Status check_user_limits(const Header& h, const DecodeOptions& options) {
   if (options.max_vertices && h.vertex_count > options.max_vertices)
     return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.vertex_count) +
                                                  " vertices, above the caller's limit of " +
@@ -71,27 +86,310 @@ Status check_limits(const Header& h, const std::vector<Section>& sections, const
                                                  std::to_string(max_corners));
   if (h.vertex_count >= 0x3FFFFFFFu || h.corner_count >= 0x3FFFFFFFu || h.face_count > h.corner_count)
     return corrupt("vertex, face or corner count out of range");
-  if (h.vertex_count > decisions(sections, kSectionGeometry) / 3)
-    return corrupt("the header's " + std::to_string(h.vertex_count) +
-                   " vertices cannot be coded in a geometry section of this size");
-  if (h.corner_count > 3 * decisions(sections, kSectionTriangleTree) + decisions(sections, kSectionTopology) / 6)
-    return corrupt("the header's " + std::to_string(h.corner_count) +
-                   " corners cannot be coded in connectivity sections of this size");
   return Status::Ok();
 }
 
-// The payload of a parsed container (shared by decode and inspect): faces
-// into `out`, grid indices (3 per output vertex) into `q`.
-Status decode_payload(const Header& h, std::vector<Section>& sections, const DecodeOptions& options, Mesh& out,
-                      std::vector<uint32_t>& q, ConnectivityStats* cstats, GeometryStats* gstats) {
-  TSM_RETURN_IF_ERROR(check_limits(h, sections, options));
+// What a decoded part holds before it joins the mesh.
+struct DecodedPart {
+  PartCounts counts;
+  Mesh faces;                    // corners are the part's output vertex ids
+  std::vector<uint32_t> q;       // grid indices, 3 per own vertex
+  std::vector<uint32_t> global;  // per part vertex: the earlier segment's vertex it is, kNone if own
+  ConnectivityStats cstats;
+  GeometryStats gstats;
+  Status status;
+};
+
+Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, DecodedPart& out) {
+  TSM_RETURN_IF_ERROR(check_budget(out.counts, s));
   ConnectivityStreams cs;
-  TSM_RETURN_IF_ERROR(read_streams(sections, cs));
-  const Section* geo = find_section(sections, kSectionGeometry);
-  if (!geo) return corrupt("the geometry section is missing");
+  cs.vertex_tree.assign(s.vertex_tree);
+  cs.triangle_tree.assign(s.triangle_tree);
+  cs.topology.assign(s.topology);
   GeometryLayout layout;
-  TSM_RETURN_IF_ERROR(decode_connectivity(cs, h.vertex_count, h.face_count, h.corner_count, out, layout, cstats));
-  return decode_geometry(geo->data, layout, h.quantization_bits, q, gstats);
+  const PartCounts& c = out.counts;
+  TSM_RETURN_IF_ERROR(
+      decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
+  if (!s.segmented) {
+    out.global.assign(c.vertex_count, kNone);
+    return decode_geometry(s.geometry, layout, bits, out.q, &out.gstats);
+  }
+  TSM_RETURN_IF_ERROR(
+      decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
+  return decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats);
+}
+
+// Runs f(0..n-1) on up to `threads` threads (0 = one per core); each index
+// once. Serial where threads are not available.
+template <class F>
+void parallel_for(size_t n, int threads, F&& f) {
+#ifndef TSM_NO_THREADS
+  size_t t = threads > 0 ? static_cast<size_t>(threads) : std::max(1u, std::thread::hardware_concurrency());
+  t = std::min(t, n);
+  if (t > 1) {
+    std::atomic<size_t> next{0};
+    auto work = [&] {
+      for (size_t i; (i = next.fetch_add(1)) < n;) f(i);
+    };
+    std::vector<std::thread> pool;
+    for (size_t k = 1; k < t; ++k) pool.emplace_back(work);
+    work();
+    for (std::thread& th : pool) th.join();
+    return;
+  }
+#else
+  (void)threads;
+#endif
+  for (size_t i = 0; i < n; ++i) f(i);
+}
+
+// The file's parts, from its parsed sections.
+Status collect_parts(const Header& h, const std::vector<Section>& sections, std::vector<PartStreams>& streams,
+                     std::vector<DecodedPart>& parts) {
+  if (h.segment_count == 1) {
+    PartStreams s;
+    std::string_view* slot[4] = {&s.vertex_tree, &s.triangle_tree, &s.topology, &s.geometry};
+    const uint16_t ids[4] = {kSectionVertexTree, kSectionTriangleTree, kSectionTopology, kSectionGeometry};
+    for (int k = 0; k < 4; ++k) {
+      const Section* sec = find_section(sections, ids[k]);
+      if (!sec) return corrupt(k < 3 ? "a connectivity section is missing" : "the geometry section is missing");
+      *slot[k] = sec->data;
+    }
+    streams.assign(1, s);
+    parts.resize(1);
+    parts[0].counts = PartCounts{h.vertex_count, h.face_count, h.corner_count, 0};
+    return Status::Ok();
+  }
+  PartCounts sum;
+  for (const Section& sec : sections) {
+    if (sec.id != kSectionSegment) continue;
+    SegmentPayload p;
+    TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
+    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true};
+    streams.push_back(s);
+    parts.emplace_back();
+    parts.back().counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
+    sum.vertex_count += p.vertex_count - p.reference_count;
+    sum.face_count += p.face_count;
+    sum.corner_count += p.corner_count;
+  }
+  if (parts.size() != h.segment_count)
+    return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
+                   std::to_string(parts.size()));
+  if (sum.vertex_count != h.vertex_count || sum.face_count != h.face_count || sum.corner_count != h.corner_count)
+    return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
+  return Status::Ok();
+}
+
+double grid_value(const Header& h, double step, int axis, uint32_t q) {
+  constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
+  double x = static_cast<double>(h.origin[axis]) + static_cast<double>(q) * step;
+  // A grid point may lie up to half a step past the largest input
+  // coordinate; near the float limit, clamp (the input was within range).
+  return x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
+}
+
+// Appends a decoded part to the mesh: its own vertices get the next ids,
+// its faces follow the faces so far. Frees the part's buffers.
+void append_part(const Header& h, DecodedPart& part, Mesh& out) {
+  const double step = grid_step(h);
+  const uint32_t base = static_cast<uint32_t>(out.vertex_count());
+  if (out.face_count() == 0 && base == 0 && part.counts.reference_count == 0) {  // the first part: no copy
+    out.face_offsets = std::move(part.faces.face_offsets);
+    out.indices = std::move(part.faces.indices);
+    out.positions.resize(part.q.size());
+    for (size_t i = 0; i < part.q.size(); ++i)
+      out.positions[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
+    part.faces.clear();
+    part.q = std::vector<uint32_t>();
+    part.global = std::vector<uint32_t>();
+    return;
+  }
+  std::vector<uint32_t> id(part.global.size());
+  uint32_t own = 0;
+  for (size_t v = 0; v < id.size(); ++v) id[v] = part.global[v] != kNone ? part.global[v] : base + own++;
+  out.positions.resize(out.positions.size() + part.q.size());
+  float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
+  for (size_t i = 0; i < part.q.size(); ++i) pos[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
+  const uint32_t corner_base = static_cast<uint32_t>(out.indices.size());
+  out.indices.reserve(out.indices.size() + part.faces.indices.size());
+  for (uint32_t x : part.faces.indices) out.indices.push_back(id[x]);
+  out.face_offsets.reserve(out.face_offsets.size() + part.faces.face_count());
+  for (size_t f = 1; f < part.faces.face_offsets.size(); ++f)
+    out.face_offsets.push_back(corner_base + part.faces.face_offsets[f]);
+  part.faces.clear();
+  part.q = std::vector<uint32_t>();
+  part.global = std::vector<uint32_t>();
+}
+
+Status decode_parts(const Header& h, std::vector<Section>& sections, int threads, std::vector<DecodedPart>& parts,
+                    std::vector<PartStreams>& streams) {
+  TSM_RETURN_IF_ERROR(collect_parts(h, sections, streams, parts));
+  std::vector<uint64_t> earlier(parts.size(), 0);
+  for (size_t k = 1; k < parts.size(); ++k)
+    earlier[k] = earlier[k - 1] + parts[k - 1].counts.vertex_count - parts[k - 1].counts.reference_count;
+  parallel_for(parts.size(), threads, [&](size_t k) {
+    parts[k].status = decode_part(streams[k], earlier[k], h.quantization_bits, parts[k]);
+  });
+  for (size_t k = 0; k < parts.size(); ++k)
+    if (!parts[k].status.ok())
+      return parts.size() == 1 ? parts[k].status
+                               : Status(parts[k].status.code(),
+                                        "segment " + std::to_string(k) + ": " + parts[k].status.message());
+  return Status::Ok();
+}
+
+// Encoder: one part (the whole mesh or a segment) coded.
+struct EncodedPart {
+  ConnectivityStreams streams;
+  std::string geometry;
+  std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
+  std::vector<uint8_t> contexts;   // per output vertex, for the references stream
+  Status status;
+};
+
+// qin: grid indices per part input vertex; is_ref: per part input vertex,
+// 1 when an earlier segment holds it (empty: none).
+Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                   const EncodeOptions& options, EncodedPart& out) {
+  const int bits = options.quantization_bits;
+  ConnectivityEncoding ce;
+  CutHints hints;
+  hints.qpos = &qin;
+  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+  if (options.level >= 9) {
+    // The midpoint-distance Kruskal tree instead of the layered spiral, kept
+    // if its connectivity is smaller (on the corpus it never is).
+    ConnectivityEncoding alt;
+    hints.midpoint_tree = true;
+    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, alt, hints));
+    if (alt.stats.bytes < ce.stats.bytes)
+      ce = std::move(alt);
+    else
+      hints.midpoint_tree = false;
+  }
+  // The geometry coder's view: own vertices only, grid indices in output order.
+  std::vector<uint32_t> mark;  // per output vertex: kNone own, 0 reference
+  std::vector<uint32_t> q;
+  GeometryLayout layout;
+  auto prepare = [&] {
+    const size_t n = ce.vertex_order.size();
+    mark.assign(n, kNone);
+    if (!is_ref.empty())
+      for (size_t v = 0; v < n; ++v)
+        if (is_ref[ce.vertex_order[v]]) mark[v] = 0;
+    q.clear();
+    for (size_t v = 0; v < n; ++v)
+      if (mark[v] == kNone)
+        for (int a = 0; a < 3; ++a) q.push_back(qin[3 * static_cast<size_t>(ce.vertex_order[v]) + a]);
+    layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, mark);
+  };
+  prepare();
+  // Vertices on no triangle go last, ordered by a nearby surface vertex
+  // that predicts them: a second pass with those anchors.
+  std::vector<uint32_t> anchor = find_anchors(layout, q, bits);
+  if (std::any_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) {
+    std::vector<uint32_t> own_to_output;
+    for (uint32_t v = 0; v < mark.size(); ++v)
+      if (mark[v] == kNone) own_to_output.push_back(v);
+    std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
+    for (size_t r = 0; r < anchor.size(); ++r)
+      if (anchor[r] != kNone) by_input[ce.vertex_order[own_to_output[r]]] = own_to_output[anchor[r]];
+    ce = ConnectivityEncoding();
+    hints.anchor = &by_input;
+    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+    prepare();
+  }
+  const Lattice lattice = find_lattice(q, layout.vertex_count);
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice);
+  if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
+  out.order = std::move(ce.vertex_order);
+  out.streams = std::move(ce.streams);
+  return Status::Ok();
+}
+
+// The segmented file's parts: each segment's mesh with its own vertex ids
+// (the vertices its faces use, ascending; the last one also takes the
+// vertices on no face), coded in parallel; then the references, which need
+// the final ids of the segments before.
+Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
+                       const std::vector<std::vector<uint32_t>>& segments, const EncodeOptions& options,
+                       ContainerWriter& cw) {
+  const size_t S = segments.size();
+  const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
+  std::vector<uint32_t> owner(V, kNone);
+  for (size_t k = 0; k < S; ++k)
+    for (uint32_t f : segments[k])
+      for (uint32_t i = 0; i < mesh.face_size(f); ++i) {
+        uint32_t& o = owner[mesh.face(f)[i]];
+        if (o == kNone) o = static_cast<uint32_t>(k);
+      }
+  std::vector<std::vector<uint32_t>> inputs(S);  // per segment: its vertices (input ids)
+  std::vector<EncodedPart> parts(S);
+  parallel_for(S, options.threads, [&](size_t k) {
+    std::vector<uint32_t>& in = inputs[k];
+    for (uint32_t f : segments[k])
+      for (uint32_t i = 0; i < mesh.face_size(f); ++i) in.push_back(mesh.face(f)[i]);
+    if (k + 1 == S)
+      for (uint32_t v = 0; v < V; ++v)
+        if (owner[v] == kNone) in.push_back(v);
+    std::sort(in.begin(), in.end());
+    in.erase(std::unique(in.begin(), in.end()), in.end());
+    std::unordered_map<uint32_t, uint32_t> local;
+    local.reserve(in.size());
+    Mesh part;
+    std::vector<uint32_t> q(3 * in.size());
+    std::vector<uint8_t> is_ref(in.size());
+    part.positions.resize(3 * in.size());
+    for (uint32_t i = 0; i < in.size(); ++i) {
+      local.emplace(in[i], i);
+      for (int a = 0; a < 3; ++a) {
+        part.positions[3 * i + a] = mesh.positions[3 * static_cast<size_t>(in[i]) + a];
+        q[3 * i + a] = qin[3 * static_cast<size_t>(in[i]) + a];
+      }
+      is_ref[i] = owner[in[i]] != kNone && owner[in[i]] < k;
+    }
+    std::vector<uint32_t> corners;
+    for (uint32_t f : segments[k]) {
+      corners.clear();
+      for (uint32_t i = 0; i < mesh.face_size(f); ++i) corners.push_back(local[mesh.face(f)[i]]);
+      part.add_face(corners.data(), corners.size());
+    }
+    parts[k].status = encode_part(part, q, is_ref, options, parts[k]);
+  });
+  std::vector<uint32_t> final_id(V, kNone);
+  uint32_t next = 0;
+  for (size_t k = 0; k < S; ++k) {
+    EncodedPart& p = parts[k];
+    TSM_RETURN_IF_ERROR(p.status);
+    std::vector<uint32_t> global(p.order.size(), kNone);
+    uint64_t refs = 0;
+    for (size_t v = 0; v < p.order.size(); ++v) {
+      const uint32_t x = inputs[k][p.order[v]];
+      if (owner[x] == k || owner[x] == kNone) {
+        final_id[x] = next++;
+      } else {
+        global[v] = final_id[x];
+        ++refs;
+      }
+    }
+    const std::string references = encode_references(p.contexts, global);
+    SegmentPayload sp;
+    sp.vertex_count = p.order.size();
+    sp.face_count = segments[k].size();
+    uint64_t corners = 0;
+    for (uint32_t f : segments[k]) corners += mesh.face_size(f);
+    sp.corner_count = corners;
+    sp.reference_count = refs;
+    sp.vertex_tree = p.streams.vertex_tree;
+    sp.triangle_tree = p.streams.triangle_tree;
+    sp.topology = p.streams.topology;
+    sp.references = references;
+    sp.geometry = p.geometry;
+    cw.add_section(kSectionSegment, write_segment(sp), 0);
+    p = EncodedPart();
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -131,48 +429,20 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     int64_t x = grid.quantize(mesh.positions[i], static_cast<int>(i % 3));
     qin[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
   }
-  auto reorder = [&](const ConnectivityEncoding& c) {  // by output id
-    std::vector<uint32_t> q(qin.size());
-    for (size_t v = 0; v < c.vertex_order.size(); ++v)
-      for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(c.vertex_order[v]) + a];
-    return q;
-  };
-
-  ConnectivityEncoding ce;
-  CutHints hints;
-  hints.qpos = &qin;
-  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
-  if (options.level >= 9) {
-    // The midpoint-distance Kruskal tree instead of the layered spiral, kept
-    // if its connectivity is smaller (on the corpus it never is).
-    ConnectivityEncoding alt;
-    hints.midpoint_tree = true;
-    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, alt, hints));
-    if (alt.stats.bytes < ce.stats.bytes)
-      ce = std::move(alt);
-    else
-      hints.midpoint_tree = false;
-  }
-  std::vector<uint32_t> q = reorder(ce);
-  // Vertices on no triangle go last, ordered by a nearby surface vertex
-  // that predicts them: a second pass with those anchors.
-  std::vector<uint32_t> anchor = find_anchors(ce.layout, q, options.quantization_bits);
-  if (std::any_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) {
-    std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
-    for (size_t v = 0; v < anchor.size(); ++v) by_input[ce.vertex_order[v]] = anchor[v];
-    ce = ConnectivityEncoding();
-    hints.anchor = &by_input;
-    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
-    q = reorder(ce);
-  }
-  const Lattice lattice = find_lattice(q, static_cast<uint32_t>(mesh.vertex_count()));
-  std::string geometry = encode_geometry(ce.layout, q, options.quantization_bits, options.level, &lattice);
-
+  const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
+  const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
+  h.segment_count = static_cast<uint32_t>(segments.size());
   ContainerWriter cw(h);
-  cw.add_section(kSectionVertexTree, ce.streams.vertex_tree, 0);
-  cw.add_section(kSectionTriangleTree, ce.streams.triangle_tree, 0);
-  cw.add_section(kSectionTopology, ce.streams.topology, 0);
-  cw.add_section(kSectionGeometry, geometry, 0);
+  if (segments.size() == 1) {
+    EncodedPart p;
+    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, options, p));
+    cw.add_section(kSectionVertexTree, p.streams.vertex_tree, 0);
+    cw.add_section(kSectionTriangleTree, p.streams.triangle_tree, 0);
+    cw.add_section(kSectionTopology, p.streams.topology, 0);
+    cw.add_section(kSectionGeometry, p.geometry, 0);
+  } else {
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, options, cw));
+  }
   out = cw.finish();
   return Status::Ok();
 }
@@ -182,18 +452,12 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   Header h;
   std::vector<Section> sections;
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  std::vector<uint32_t> q;
-  TSM_RETURN_IF_ERROR(decode_payload(h, sections, options, out, q, nullptr, nullptr));
-  const double step = grid_step(h);
-  out.positions.resize(q.size());
-  constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
-  for (size_t i = 0; i < q.size(); ++i) {
-    double x = static_cast<double>(h.origin[i % 3]) + static_cast<double>(q[i]) * step;
-    // A grid point may lie up to half a step past the largest input
-    // coordinate; near the float limit, clamp (the input was within range).
-    x = x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
-    out.positions[i] = static_cast<float>(x);
-  }
+  TSM_RETURN_IF_ERROR(check_user_limits(h, options));
+  std::vector<DecodedPart> parts;
+  std::vector<PartStreams> streams;
+  TSM_RETURN_IF_ERROR(decode_parts(h, sections, options.threads, parts, streams));
+  if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
+  for (DecodedPart& p : parts) append_part(h, p, out);
   return Status::Ok();
 }
 
@@ -220,26 +484,34 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     si.stored_bytes = s.stored_bytes;
     si.raw_bytes = s.raw_bytes;
     info.sections.push_back(si);
-    if (s.id == kSectionVertexTree || s.id == kSectionTriangleTree || s.id == kSectionTopology)
-      info.connectivity_bytes += s.stored_bytes;
-    else if (s.id == kSectionGeometry)
-      info.geometry_bytes += s.stored_bytes;
-    else
-      info.other_bytes += s.stored_bytes;
   }
-  Mesh faces;
-  std::vector<uint32_t> q;
-  ConnectivityStats st;
-  GeometryStats gs;
-  TSM_RETURN_IF_ERROR(decode_payload(h, sections, DecodeOptions(), faces, q, &st, &gs));
-  info.components = st.components;
-  info.vertex_runs = st.vertex_runs;
-  info.triangle_runs = st.triangle_runs;
-  info.jump_edges = st.jump_edges;
-  info.stitches = st.stitches;
-  info.virtual_vertices = st.virtual_vertices;
-  info.side_faces = st.side_faces;
-  info.marching_bits = st.marching_bits;
+  std::vector<DecodedPart> parts;
+  std::vector<PartStreams> streams;
+  TSM_RETURN_IF_ERROR(decode_parts(h, sections, 1, parts, streams));
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const PartStreams& s = streams[k];
+    info.connectivity_bytes += s.vertex_tree.size() + s.triangle_tree.size() + s.topology.size();
+    info.geometry_bytes += s.geometry.size();
+    info.reference_bytes += s.references.size();
+    const ConnectivityStats& st = parts[k].cstats;
+    info.components += st.components;
+    info.vertex_runs += st.vertex_runs;
+    info.triangle_runs += st.triangle_runs;
+    info.jump_edges += st.jump_edges;
+    info.stitches += st.stitches;
+    info.virtual_vertices += st.virtual_vertices;
+    info.side_faces += st.side_faces;
+    info.marching_bits += st.marching_bits;
+    info.references += parts[k].counts.reference_count;
+    SegmentSummary sum;
+    sum.vertices = parts[k].counts.vertex_count;
+    sum.references = parts[k].counts.reference_count;
+    sum.faces = parts[k].counts.face_count;
+    info.segments.push_back(sum);
+  }
+  info.other_bytes = bytes.size() - info.connectivity_bytes - info.geometry_bytes;
+  // The first segment's predictor stands for the file (each segment chooses its own).
+  const GeometryStats& gs = parts[0].gstats;
   info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
                             : gs.predictor == Predictor::gate    ? "gate"
                                                                  : "parallelograms";
@@ -247,5 +519,134 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();
 }
+
+// Streaming: sections are read as their bytes arrive; a segment is decoded
+// as soon as its section is complete (a file of one segment at its end).
+struct StreamDecoder::Impl {
+  DecodeOptions options;
+  std::string buf;      // bytes received and not yet consumed
+  size_t base = 0;      // file offset of buf[0]
+  bool have_header = false, ended = false;
+  Header h;
+  SectionRules rules;
+  std::vector<Section> whole;  // a one-segment file's sections, until the end marker
+  Mesh mesh;
+  uint32_t done = 0;
+  uint64_t faces = 0, corners = 0;
+  Status failed;
+
+  Status part_done(DecodedPart& part, const PartStreams& s) {
+    TSM_RETURN_IF_ERROR(decode_part(s, mesh.vertex_count(), h.quantization_bits, part));
+    append_part(h, part, mesh);
+    ++done;
+    return Status::Ok();
+  }
+
+  Status segment(const Section& sec) {
+    SegmentPayload p;
+    TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
+    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true};
+    DecodedPart part;
+    part.counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
+    // Against the header before anything is allocated: the header's counts
+    // passed the caller's limits.
+    const uint64_t own = p.vertex_count - std::min(p.reference_count, p.vertex_count);
+    if (mesh.vertex_count() + own > h.vertex_count || faces + p.face_count > h.face_count ||
+        corners + p.corner_count > h.corner_count)
+      return corrupt("segment " + std::to_string(done) + " holds more vertices, faces or corners than the header");
+    faces += p.face_count;
+    corners += p.corner_count;
+    Status st = part_done(part, s);
+    if (!st.ok()) return Status(st.code(), "segment " + std::to_string(done) + ": " + st.message());
+    return Status::Ok();
+  }
+
+  Status end() {
+    ended = true;
+    if (h.segment_count == 1) {
+      std::vector<DecodedPart> parts;
+      std::vector<PartStreams> streams;
+      TSM_RETURN_IF_ERROR(collect_parts(h, whole, streams, parts));
+      TSM_RETURN_IF_ERROR(part_done(parts[0], streams[0]));
+      whole.clear();
+      return Status::Ok();
+    }
+    if (done != h.segment_count)
+      return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
+                     std::to_string(done));
+    if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
+      return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
+    return Status::Ok();
+  }
+
+  Status feed(std::string_view bytes) {
+    if (ended && !bytes.empty())
+      return corrupt(std::to_string(bytes.size()) + " unexpected bytes after the end marker");
+    buf.append(bytes.data(), bytes.size());
+    size_t pos = 0;
+    std::string missing;
+    if (!have_header) {
+      TSM_RETURN_IF_ERROR(read_header(buf, pos, h, missing));
+      if (!missing.empty()) return Status::Ok();
+      TSM_RETURN_IF_ERROR(check_user_limits(h, options));
+      have_header = true;
+    }
+    while (!ended) {
+      Section s;
+      TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base));
+      if (!missing.empty()) break;
+      if (s.id == kSectionEnd) {
+        if (pos != buf.size())
+          return corrupt(std::to_string(buf.size() - pos) + " unexpected bytes after the end marker");
+        TSM_RETURN_IF_ERROR(end());
+        break;
+      }
+      TSM_RETURN_IF_ERROR(rules.admit(s, h.segment_count));
+      if (s.id == kSectionSegment)
+        TSM_RETURN_IF_ERROR(segment(s));
+      else if (h.segment_count == 1)
+        whole.push_back(std::move(s));
+    }
+    buf.erase(0, pos);
+    base += pos;
+    return Status::Ok();
+  }
+};
+
+StreamDecoder::StreamDecoder(const DecodeOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+}
+StreamDecoder::~StreamDecoder() = default;
+
+Status StreamDecoder::feed(std::string_view bytes) {
+  if (!impl_->failed.ok()) return impl_->failed;
+  Status s = impl_->feed(bytes);
+  if (!s.ok()) impl_->failed = s;
+  return s;
+}
+
+Status StreamDecoder::finish() {
+  if (!impl_->failed.ok()) return impl_->failed;
+  if (impl_->ended) return Status::Ok();
+  std::string missing;
+  if (!impl_->have_header) {
+    size_t pos = 0;
+    Header h;
+    Status s = read_header(impl_->buf, pos, h, missing);
+    impl_->failed = s.ok() ? corrupt(missing.empty() ? "file ends inside the header" : missing) : s;
+  } else {
+    size_t pos = 0;
+    Section s;
+    Status st = read_section(impl_->buf, pos, s, false, missing, impl_->base);
+    impl_->failed = st.ok() ? corrupt(missing.empty() ? "file ends before the end marker" : missing) : st;
+  }
+  return impl_->failed;
+}
+
+uint32_t StreamDecoder::segment_count() const { return impl_->have_header ? impl_->h.segment_count : 0; }
+uint32_t StreamDecoder::segments_done() const { return impl_->done; }
+bool StreamDecoder::done() const { return impl_->ended && impl_->failed.ok(); }
+const Mesh& StreamDecoder::mesh() const { return impl_->mesh; }
+Mesh StreamDecoder::take_mesh() { return std::move(impl_->mesh); }
 
 }  // namespace tsm

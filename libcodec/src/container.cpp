@@ -10,7 +10,9 @@
 #include "container.hpp"
 
 #include <xxhash.h>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <zstd.h>
 
@@ -25,6 +27,7 @@ const char* section_name(uint16_t id) {
     case kSectionTriangleTree: return "triangle-tree";
     case kSectionTopology: return "topology";
     case kSectionGeometry: return "geometry";
+    case kSectionSegment: return "segment";
   }
   return "unknown";
 }
@@ -45,6 +48,10 @@ void write_header_fields(ByteWriter& w, const Header& h) {
 }
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
+
+Status corrupt_at(size_t at, uint16_t id, const std::string& what) {
+  return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) + ": " + what);
+}
 
 }  // namespace
 
@@ -88,27 +95,46 @@ std::string ContainerWriter::finish() {
   return std::move(out_);
 }
 
-Status read_container(std::string_view bytes, Header& header, std::vector<Section>& sections,
-                      bool decode_payloads) {
-  sections.clear();
+Status read_header(std::string_view bytes, size_t& offset, Header& header, std::string& missing) {
+  missing.clear();
   ByteReader r(bytes);
   std::string_view magic;
-  if (!r.bytes(4, magic) || magic != std::string_view(kMagic, 4))
+  // Refuse a wrong signature from the first bytes that show it.
+  const size_t have = std::min<size_t>(bytes.size(), 4);
+  if (bytes.substr(0, have) != std::string_view(kMagic, have))
     return corrupt("not a .tsm file (bad magic; expected the bytes 'TSM' 0x1A)");
   uint16_t version = 0, flags = 0;
-  if (!r.u16(version) || !r.u16(flags)) return corrupt("file ends inside the header");
+  if (!r.bytes(4, magic) || !r.u16(version)) {
+    missing = "file ends inside the header";
+    return Status::Ok();
+  }
   if (version != kFormatVersion)
     return Status(ErrorCode::unsupported, "format version " + std::to_string(version) +
                                               " is not supported by this decoder (it reads version " +
                                               std::to_string(kFormatVersion) + ")");
+  if (!r.u16(flags)) {
+    missing = "file ends inside the header";
+    return Status::Ok();
+  }
   if (flags != 0) return corrupt("unknown header flags " + std::to_string(flags));
   uint64_t header_len = 0;
   std::string_view fields;
-  if (!r.varint(header_len) || header_len > r.remaining() || !r.bytes(static_cast<size_t>(header_len), fields))
-    return corrupt("header length runs past the end of the file");
+  if (!r.varint(header_len)) {
+    if (r.remaining() >= 10) return corrupt("header length is not a valid varint");
+    missing = "file ends inside the header";
+    return Status::Ok();
+  }
+  if (header_len > (uint64_t{1} << 20)) return corrupt("header length " + std::to_string(header_len) + " is implausible");
+  if (!r.bytes(static_cast<size_t>(header_len), fields)) {
+    missing = "header length runs past the end of the file";
+    return Status::Ok();
+  }
   size_t header_end = r.offset();
   uint32_t sum = 0;
-  if (!r.u32(sum)) return corrupt("file ends before the header checksum");
+  if (!r.u32(sum)) {
+    missing = "file ends before the header checksum";
+    return Status::Ok();
+  }
   if (sum != checksum32(bytes.substr(0, header_end))) return corrupt("header checksum mismatch");
   ByteReader h(fields);
   uint64_t segments = 0;
@@ -125,57 +151,104 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
     return corrupt("header extent is not a finite, non-negative number");
   if (header.quantization_bits < 1 || header.quantization_bits > 30)
     return corrupt("quantization bits " + std::to_string(header.quantization_bits) + " outside 1..30");
+  offset = r.offset();
+  return Status::Ok();
+}
 
-  for (;;) {
-    size_t at = r.offset();
-    uint16_t id = 0;
-    if (!r.u16(id)) return corrupt("file ends before the end marker (truncated at byte " + std::to_string(at) + ")");
-    if (id == kSectionEnd) break;
-    uint8_t codec = 0;
-    uint64_t stored_len = 0, raw_len = 0;
-    uint32_t csum = 0;
-    if (!r.u8(codec) || !r.varint(stored_len) || !r.varint(raw_len) || !r.u32(csum))
-      return corrupt("section at byte " + std::to_string(at) + ": truncated section header");
-    if (codec > 1) return corrupt("section at byte " + std::to_string(at) + ": unknown codec " + std::to_string(codec));
-    if (stored_len > r.remaining())
-      return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) + ": length " +
-                     std::to_string(stored_len) + " runs past the end of the file (" + std::to_string(r.remaining()) +
-                     " bytes left)");
-    if (codec == 0 ? raw_len != stored_len : raw_len > stored_len * kMaxExpansion)
-      return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) +
-                     ": implausible raw length " + std::to_string(raw_len));
-    std::string_view stored;
-    r.bytes(static_cast<size_t>(stored_len), stored);
-    if (checksum32(stored) != csum)
-      return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) +
-                     ": checksum mismatch (the file is damaged)");
-    for (const Section& prev : sections)
-      if (prev.id == id)
-        return corrupt("section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) +
-                       " appears twice");
-    Section s;
-    s.id = id;
-    s.codec = static_cast<SectionCodec>(codec);
-    s.stored_bytes = stored_len;
-    s.raw_bytes = raw_len;
-    if (decode_payloads) {
-      if (s.codec == SectionCodec::raw) {
-        s.data.assign(stored.data(), stored.size());
-      } else {
-        s.data.resize(static_cast<size_t>(raw_len));
-        size_t n = ZSTD_decompress(s.data.data(), s.data.size(), stored.data(), stored.size());
-        if (ZSTD_isError(n) || n != raw_len)
-          return corrupt("section '" + std::string(section_name(id)) + "': zstd payload does not decode to " +
-                         std::to_string(raw_len) + " bytes");
-      }
-    } else {
-      s.data.clear();
-    }
-    sections.push_back(std::move(s));
-    if (sections.size() > 4096) return corrupt("too many sections");
+Status read_section(std::string_view bytes, size_t& offset, Section& s, bool decode_payload, std::string& missing,
+                    size_t base) {
+  missing.clear();
+  const size_t at = base + offset;
+  ByteReader r(bytes.substr(offset));
+  uint16_t id = 0;
+  if (!r.u16(id)) {
+    missing = "file ends before the end marker (truncated at byte " + std::to_string(at) + ")";
+    return Status::Ok();
   }
-  if (r.remaining() != 0)
-    return corrupt(std::to_string(r.remaining()) + " unexpected bytes after the end marker");
+  s = Section();
+  s.id = id;
+  if (id == kSectionEnd) {
+    offset += r.offset();
+    return Status::Ok();
+  }
+  uint8_t codec = 0;
+  uint64_t stored_len = 0, raw_len = 0;
+  uint32_t csum = 0;
+  if (!r.u8(codec)) {
+    missing = "section at byte " + std::to_string(at) + ": truncated section header";
+    return Status::Ok();
+  }
+  if (codec > 1) return corrupt("section at byte " + std::to_string(at) + ": unknown codec " + std::to_string(codec));
+  // The fields below are at most 10 + 10 + 4 bytes: a reader that has that
+  // many and still fails has a bad varint.
+  if (!r.varint(stored_len) || !r.varint(raw_len) || !r.u32(csum)) {
+    if (r.remaining() >= 24) return corrupt("section at byte " + std::to_string(at) + ": bad length field");
+    missing = "section at byte " + std::to_string(at) + ": truncated section header";
+    return Status::Ok();
+  }
+  if (codec == 0 ? raw_len != stored_len : raw_len > stored_len * kMaxExpansion)
+    return corrupt_at(at, id, "implausible raw length " + std::to_string(raw_len));
+  std::string_view stored;
+  if (!r.bytes(static_cast<size_t>(std::min<uint64_t>(stored_len, SIZE_MAX)), stored)) {
+    missing = "section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) + ": length " +
+              std::to_string(stored_len) + " runs past the end of the file (" + std::to_string(r.remaining()) +
+              " bytes left)";
+    return Status::Ok();
+  }
+  if (checksum32(stored) != csum) return corrupt_at(at, id, "checksum mismatch (the file is damaged)");
+  s.codec = static_cast<SectionCodec>(codec);
+  s.stored_bytes = stored_len;
+  s.raw_bytes = raw_len;
+  s.offset = at;
+  if (decode_payload) {
+    if (s.codec == SectionCodec::raw) {
+      s.data.assign(stored.data(), stored.size());
+    } else {
+      s.data.resize(static_cast<size_t>(raw_len));
+      size_t n = ZSTD_decompress(s.data.data(), s.data.size(), stored.data(), stored.size());
+      if (ZSTD_isError(n) || n != raw_len)
+        return corrupt_at(at, id, "zstd payload does not decode to " + std::to_string(raw_len) + " bytes");
+    }
+  }
+  offset += r.offset();
+  return Status::Ok();
+}
+
+Status SectionRules::admit(const Section& s, uint32_t segment_count) {
+  const size_t at = s.offset;
+  if (s.id == kSectionSegment) {
+    if (segment_count == 1) return corrupt_at(at, s.id, "a segment section in a file of one segment");
+    if (++segments > segment_count)
+      return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
+    return Status::Ok();
+  }
+  if (segment_count > 1 && s.id >= kSectionVertexTree && s.id <= kSectionGeometry)
+    return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
+  for (uint16_t prev : seen)
+    if (prev == s.id) return corrupt_at(at, s.id, "appears twice");
+  seen.push_back(s.id);
+  if (seen.size() > 4096) return corrupt("too many sections");
+  return Status::Ok();
+}
+
+Status read_container(std::string_view bytes, Header& header, std::vector<Section>& sections,
+                      bool decode_payloads) {
+  sections.clear();
+  size_t offset = 0;
+  std::string missing;
+  TSM_RETURN_IF_ERROR(read_header(bytes, offset, header, missing));
+  if (!missing.empty()) return corrupt(missing);
+  SectionRules rules;
+  for (;;) {
+    Section s;
+    TSM_RETURN_IF_ERROR(read_section(bytes, offset, s, decode_payloads, missing));
+    if (!missing.empty()) return corrupt(missing);
+    if (s.id == kSectionEnd) break;
+    TSM_RETURN_IF_ERROR(rules.admit(s, header.segment_count));
+    sections.push_back(std::move(s));
+  }
+  if (offset != bytes.size())
+    return corrupt(std::to_string(bytes.size() - offset) + " unexpected bytes after the end marker");
   return Status::Ok();
 }
 

@@ -10,7 +10,7 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 1;
+constexpr uint16_t kFormatVersion = 2;
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder
@@ -25,6 +25,7 @@ enum SectionId : uint16_t {
   kSectionTriangleTree = 4,   // triangle tree runs, marching pattern, polygon flags (range coded)
   kSectionTopology = 5,       // components, jumps, virtual vertices, stitches, side faces (range coded)
   kSectionGeometry = 6,       // predicted quantized positions (range coded)
+  kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
 };
 const char* section_name(uint16_t id);
 
@@ -44,6 +45,7 @@ struct Section {
   SectionCodec codec = SectionCodec::raw;
   uint64_t stored_bytes = 0;
   uint64_t raw_bytes = 0;
+  uint64_t offset = 0;  // file offset of the section's id
   std::string data;  // raw (decoded) payload
 };
 
@@ -57,6 +59,26 @@ class ContainerWriter {
 
  private:
   std::string out_;
+};
+
+// Incremental reading, for bytes that may still be arriving: each reads one
+// piece starting at `offset` of the bytes received so far and advances
+// `offset` past it. When the bytes end inside the piece, `missing` says what
+// is cut off and nothing is consumed (Ok is returned); damage that the bytes
+// at hand already show is an error at once.
+Status read_header(std::string_view bytes, size_t& offset, Header& header, std::string& missing);
+// A section, or the end marker (s.id == kSectionEnd). `base` is the file
+// offset of bytes[0] (for messages and Section::offset).
+Status read_section(std::string_view bytes, size_t& offset, Section& s, bool decode_payload, std::string& missing,
+                    size_t base = 0);
+
+// Which ids may follow which (FORMAT.md §4.3): segment sections only in a
+// file of several segments, at most segment_count of them; the whole-mesh
+// sections only in a file of one; any other id at most once.
+struct SectionRules {
+  std::vector<uint16_t> seen;
+  uint32_t segments = 0;
+  Status admit(const Section& s, uint32_t segment_count);
 };
 
 // Parses the whole container: header, then every section with checksum and

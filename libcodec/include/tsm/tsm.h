@@ -35,11 +35,14 @@ typedef struct tsm_decode_options {
   uint64_t max_vertices; /* 0 = no limit besides the format's own */
   uint64_t max_faces;
   uint64_t max_corners; /* 0 = 16 x max_faces when that is set */
+  int threads;          /* segments decoded in parallel; 0 = one per core */
 } tsm_decode_options;
 
 typedef struct tsm_encode_options {
   int quantization_bits; /* 1..30, 0 = default (14) */
   int level;             /* 0..9, -1 = default */
+  uint32_t segment_faces; /* faces per segment at most; 0 = default (2^18) */
+  int threads;            /* segments coded in parallel; 0 = one per core */
 } tsm_encode_options;
 
 /* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
@@ -55,6 +58,31 @@ int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t*
 /* Encodes a mesh. On success *out is a malloc'ed buffer the caller frees with tsm_free. */
 int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
                size_t err_size);
+
+/* Streaming decode: feed bytes as they arrive; each segment is decoded as
+ * soon as its bytes are all in.
+ *
+ *   tsm_stream* s = tsm_stream_new(NULL);
+ *   while (read a chunk) if (tsm_stream_feed(s, chunk, n, err, sizeof err)) break;
+ *   ... after each feed, tsm_stream_mesh(s) holds the finished segments ...
+ *   tsm_stream_finish(s, err, sizeof err);  tsm_stream_free(s);
+ */
+typedef struct tsm_stream tsm_stream;
+/* options may be NULL (options->threads is not used). Returns NULL only when out of memory. */
+tsm_stream* tsm_stream_new(const tsm_decode_options* options);
+/* Feeds size bytes (any chunking); decodes every segment whose bytes are all in.
+ * Returns TSM_OK or an error code (the stream is then failed and stays failed). */
+int tsm_stream_feed(tsm_stream* s, const uint8_t* data, size_t size, char* err, size_t err_size);
+/* Declares the end of the input: TSM_OK when the whole file was decoded, else an error (truncated file). */
+int tsm_stream_finish(tsm_stream* s, char* err, size_t err_size);
+/* Segments in the file (0 until the header is in) and segments decoded so far. */
+size_t tsm_stream_segment_count(const tsm_stream* s);
+size_t tsm_stream_segments_done(const tsm_stream* s);
+/* The mesh decoded so far (vertices and faces of the finished segments; it only grows: the
+ * vertices and faces of segment k come after those of segments < k, and faces of segment k only
+ * reference vertices of segments <= k). Valid until the next feed/finish/free; read it with tsm_mesh_*. */
+const tsm_mesh* tsm_stream_mesh(const tsm_stream* s);
+void tsm_stream_free(tsm_stream* s);
 
 size_t tsm_mesh_vertex_count(const tsm_mesh* mesh);
 size_t tsm_mesh_face_count(const tsm_mesh* mesh);

@@ -8,6 +8,7 @@
 // Everything returns a tsm::Status; nothing throws across this API.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,13 @@ constexpr int kDefaultLevel = 6;
 struct EncodeOptions {
   int quantization_bits = kDefaultQuantizationBits;  // 1..30
   int level = kDefaultLevel;                         // 0 (fast decode) .. 9 (small)
+  // Meshes with more faces are coded as several segments of at most this
+  // many faces, each decodable on its own as soon as its bytes are in
+  // (streaming, parallel decoding). 0 = the default, 2^18.
+  uint32_t segment_faces = 0;
+  // Threads coding segments in parallel; 0 = one per core. The bytes do not
+  // depend on it.
+  int threads = 0;
 };
 
 struct DecodeOptions {
@@ -34,10 +42,38 @@ struct DecodeOptions {
   uint64_t max_faces = 0;
   // Face corners; when 0 and max_faces is set, 16 x max_faces.
   uint64_t max_corners = 0;
+  // Threads decoding segments in parallel; 0 = one per core.
+  int threads = 0;
 };
 
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out);
 Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options = {});
+
+// Decoding while the bytes arrive: feed() them in chunks of any size; each
+// segment is decoded as soon as its bytes are all in, and mesh() grows: the
+// vertices and faces of segment k come after those of the segments before
+// it, and its faces only use vertices of segments 0..k. A file of one
+// segment appears whole when its last bytes are in. After an error every
+// call returns it again.
+class StreamDecoder {
+ public:
+  explicit StreamDecoder(const DecodeOptions& options = {});
+  ~StreamDecoder();
+  StreamDecoder(const StreamDecoder&) = delete;
+  StreamDecoder& operator=(const StreamDecoder&) = delete;
+  Status feed(std::string_view bytes);
+  // The input is over: Ok when the whole file was decoded, else why not.
+  Status finish();
+  uint32_t segment_count() const;  // 0 until the header is in
+  uint32_t segments_done() const;
+  bool done() const;               // the end marker was read, no error
+  const Mesh& mesh() const;
+  Mesh take_mesh();                // moves the mesh out (call when done)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // What `tsm info` shows: header fields and the sections with their sizes.
 struct SectionInfo {
@@ -46,6 +82,11 @@ struct SectionInfo {
   std::string codec;
   uint64_t stored_bytes = 0;   // as stored (after zstd where used)
   uint64_t raw_bytes = 0;      // before the section codec
+};
+struct SegmentSummary {
+  uint64_t vertices = 0;    // the segment's vertices, references included
+  uint64_t references = 0;  // vertices of earlier segments it uses
+  uint64_t faces = 0;
 };
 struct FileInfo {
   uint32_t format_version = 0;
@@ -62,7 +103,11 @@ struct FileInfo {
   // Topology figures (from decoding the connectivity streams).
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, marching_bits = 0;
-  uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;  // stored bytes by kind
+  // Stored bytes by kind; other = header, framing, references, side data.
+  uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;
+  uint64_t reference_bytes = 0;  // part of other: the segments' references streams
+  uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
+  std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "gate"
   // or "ancestors" (with K), and the lattice planes per axis (0 = unused).
   std::string geometry_predictor;

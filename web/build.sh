@@ -1,0 +1,154 @@
+#!/usr/bin/env bash
+# Builds the tsm decoder for the browser: build/web/tsm_decoder.{js,wasm}
+# (emscripten glue + WebAssembly), from the same libcodec sources as the
+# native library, with emcc directly (no CMake).
+#
+#   web/build.sh            # needs emcc (Debian: apt-get install emscripten node-acorn)
+#   TSM_WEB_DEBUG=1 web/build.sh   # -O1 -g, assertions on
+#
+# zstd: the container allows zstd-coded sections, so the decompressor is
+# compiled from Debian's zstd source package (apt-get source libzstd, fetched
+# into build/web/ with a private deb-src list; the system's apt configuration
+# is not touched). When that cannot be had, web/zstd_stub.c stands in and a
+# zstd section is refused with an error.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="${TSM_WEB_OUT:-$ROOT/build/web}"
+# TSM_WEB_LIBCODEC: another libcodec/ (a snapshot, say) to build from instead of this tree's
+LIBCODEC="${TSM_WEB_LIBCODEC:-$ROOT/libcodec}"
+OBJ="$OUT/obj"
+mkdir -p "$OUT" "$OBJ"
+JOBS="${TSM_WEB_JOBS:-2}"
+
+# emscripten 3.1.6 (Debian) runs acorn from Node and finds it through NODE_PATH.
+if [ -d /usr/share/nodejs/acorn ]; then
+  export NODE_PATH="/usr/share/nodejs${NODE_PATH:+:$NODE_PATH}"
+fi
+command -v emcc >/dev/null || { echo "web/build.sh: emcc not found (apt-get install emscripten node-acorn)" >&2; exit 1; }
+
+VERSION="$(sed -n 's/^project(tsm VERSION \([0-9.]*\).*/\1/p' "$ROOT/CMakeLists.txt")"
+OPT=(-O3 -DNDEBUG)
+LOPT=(-O3)
+if [ "${TSM_WEB_DEBUG:-0}" = 1 ]; then OPT=(-O1 -g); LOPT=(-O1 -g -sASSERTIONS=1); fi
+# TSM_WEB_FLAGS: extra compile and link flags, for trying variants (e.g. "-flto", "-msimd128")
+read -r -a EXTRA <<<"${TSM_WEB_FLAGS:-}"
+OPT+=("${EXTRA[@]}")
+LOPT+=("${EXTRA[@]}")
+
+# ---- zstd decompressor (Debian source package) --------------------------------
+ZSTD_SRC=""
+zstd_from_debian() {
+  local dir="$OUT/zstd"
+  if [ -f "$dir/.ok" ]; then ZSTD_SRC="$(cat "$dir/.ok")"; return 0; fi
+  command -v apt-get >/dev/null || return 1
+  rm -rf "$dir" && mkdir -p "$dir/apt/lists/partial" "$dir/src"
+  # A private source list and state dir: asks Debian's archive for the source
+  # package only, without adding deb-src to the system's configuration.
+  local suite
+  suite="$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-bookworm}")"
+  echo "deb-src http://deb.debian.org/debian ${suite:-bookworm} main" > "$dir/apt/sources.list"
+  local aptopts=(-o "Dir::Etc::SourceList=$dir/apt/sources.list" -o "Dir::Etc::SourceParts=$dir/apt/none"
+                 -o "Dir::State::Lists=$dir/apt/lists" -o "Dir::Cache=$dir/apt/cache" -qq)
+  mkdir -p "$dir/apt/cache/archives/partial"
+  apt-get "${aptopts[@]}" update >"$dir/apt.log" 2>&1 || return 1
+  (cd "$dir/src" && apt-get "${aptopts[@]}" source --download-only libzstd >>"$dir/apt.log" 2>&1) || return 1
+  local tarball
+  tarball="$(ls "$dir"/src/libzstd_*.orig.tar.* 2>/dev/null | head -1)"
+  [ -n "$tarball" ] || return 1
+  tar -xf "$tarball" -C "$dir/src" || return 1
+  local lib
+  lib="$(ls -d "$dir"/src/zstd-*/lib 2>/dev/null | head -1)"
+  [ -f "$lib/decompress/zstd_decompress.c" ] || return 1
+  echo "$lib" > "$dir/.ok"
+  ZSTD_SRC="$lib"
+}
+
+ZSTD_CFLAGS=()
+ZSTD_FILES=()
+ZSTD_H=""
+if [ "${TSM_WEB_ZSTD:-debian}" = debian ] && zstd_from_debian; then
+  echo "web/build.sh: zstd decompressor from Debian's source package ($ZSTD_SRC)"
+  ZSTD_CFLAGS=(-I"$ZSTD_SRC" -DZSTD_DISABLE_ASM -DZSTD_NO_TRACE -DXXH_NAMESPACE=ZSTD_ -DZSTD_LEGACY_SUPPORT=0
+               -DZSTD_STRIP_ERROR_STRINGS -DHUF_FORCE_DECOMPRESS_X1 -DZSTD_FORCE_DECOMPRESS_SEQUENCES_SHORT)
+  ZSTD_FILES=("$ZSTD_SRC"/common/{entropy_common,error_private,fse_decompress,xxhash,zstd_common}.c
+              "$ZSTD_SRC"/decompress/{huf_decompress,zstd_ddict,zstd_decompress,zstd_decompress_block}.c)
+  ZSTD_INC=(-I"$ZSTD_SRC")
+else
+  echo "web/build.sh: zstd source not available; zstd-coded sections will be refused (web/zstd_stub.c)"
+  ZSTD_FILES=("$ROOT/web/zstd_stub.c")
+  ZSTD_INC=()
+  # zstd.h for container.cpp: Debian's libzstd-dev header, through the one-header dir below
+  ZSTD_H=/usr/include/zstd.h
+fi
+# The encoder path of container.cpp names ZSTD_compress; the decoder never
+# reaches it, and this keeps the link whole without the compressor.
+ZSTD_FILES+=("$ROOT/web/zstd_compress_stub.c")
+
+# ---- library sources: libcodec/src minus file I/O and mesh comparison --------
+LIB_FILES=()
+for f in "$LIBCODEC"/src/*.cpp; do
+  case "$(basename "$f")" in io_*.cpp|compare.cpp) continue ;; esac
+  LIB_FILES+=("$f")
+done
+
+CXXFLAGS=("${OPT[@]}" -std=c++17 -DTSM_VERSION="\"$VERSION\"" -DTSM_NO_THREADS -DXXH_INLINE_ALL
+          -DEIGEN_DONT_PARALLELIZE -DEIGEN_MPL2_ONLY
+          -I"$LIBCODEC/include" -I"$LIBCODEC/src" -isystem /usr/include/eigen3
+          -isystem "$OUT/sysinc" "${ZSTD_INC[@]}")
+# xxhash.h (header-only with XXH_INLINE_ALL) from Debian's libxxhash-dev,
+# reached through a one-header include dir so nothing else of /usr/include leaks in.
+mkdir -p "$OUT/sysinc"
+XXH=/usr/include/xxhash.h
+[ -f "$XXH" ] || { echo "web/build.sh: $XXH not found (apt-get install libxxhash-dev)" >&2; exit 1; }
+ln -sf "$XXH" "$OUT/sysinc/xxhash.h"
+rm -f "$OUT/sysinc/zstd.h" "$OUT/sysinc/zstd_errors.h"
+if [ -n "$ZSTD_H" ]; then
+  [ -f "$ZSTD_H" ] || { echo "web/build.sh: $ZSTD_H not found (apt-get install libzstd-dev)" >&2; exit 1; }
+  ln -sf "$ZSTD_H" "$OUT/sysinc/zstd.h"
+fi
+
+compile() {  # src obj flags...
+  local src="$1" obj="$2"; shift 2
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$OUT/.flags" -nt "$obj" ]; then
+    emcc "$@" -c "$src" -o "$obj"
+  fi
+}
+FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}")"
+if [ ! -f "$OUT/.flags" ] || [ "$(cat "$OUT/.flags")" != "$FLAGSIG" ]; then printf '%s\n' "$FLAGSIG" > "$OUT/.flags"; fi
+# headers: rebuild everything when any library header is newer than the last link
+if [ -f "$OUT/tsm_decoder.wasm" ]; then
+  if [ -n "$(find "$LIBCODEC" -name '*.h*' -newer "$OUT/tsm_decoder.wasm" | head -1)" ]; then rm -f "$OBJ"/*.o; fi
+fi
+
+OBJS=()
+pids=()
+run() { compile "$@" & pids+=($!); if [ "${#pids[@]}" -ge "$JOBS" ]; then wait "${pids[0]}"; pids=("${pids[@]:1}"); fi; }
+for f in "${LIB_FILES[@]}"; do
+  o="$OBJ/lib_$(basename "${f%.cpp}").o"; OBJS+=("$o"); run "$f" "$o" "${CXXFLAGS[@]}"
+done
+for f in "${ZSTD_FILES[@]}"; do
+  o="$OBJ/z_$(basename "${f%.c}").o"; OBJS+=("$o"); run "$f" "$o" "${OPT[@]}" "${ZSTD_CFLAGS[@]}" "${ZSTD_INC[@]}"
+done
+for p in "${pids[@]}"; do wait "$p"; done
+
+# ---- link ----------------------------------------------------------------------
+EXPORTS="_malloc,_free,_tsm_decode,_tsm_mesh_vertex_count,_tsm_mesh_face_count,_tsm_mesh_index_count"
+EXPORTS+=",_tsm_mesh_positions,_tsm_mesh_face_offsets,_tsm_mesh_indices,_tsm_mesh_free,_tsm_version"
+if grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h"; then
+  EXPORTS+=",_tsm_stream_new,_tsm_stream_feed,_tsm_stream_finish,_tsm_stream_segment_count"
+  EXPORTS+=",_tsm_stream_segments_done,_tsm_stream_mesh,_tsm_stream_free"
+  echo "web/build.sh: streaming C API found, exported"
+else
+  echo "web/build.sh: no streaming C API in tsm.h yet; whole-file decode only"
+fi
+emcc "${LOPT[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
+  -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTsmModule \
+  -sENVIRONMENT=web,worker -sFILESYSTEM=0 \
+  -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB -sINITIAL_MEMORY=16MB \
+  -sEXPORTED_FUNCTIONS="$EXPORTS" -sEXPORTED_RUNTIME_METHODS=[] \
+  -sINCOMING_MODULE_JS_API=[wasmBinary,locateFile,instantiateWasm,print,printErr,onAbort] \
+  -sTEXTDECODER=2 -sDYNAMIC_EXECUTION=0
+echo "web/build.sh: built $OUT/tsm_decoder.js + tsm_decoder.wasm ($(stat -c %s "$OUT/tsm_decoder.wasm") bytes wasm, $(stat -c %s "$OUT/tsm_decoder.js") bytes js)"
+# The JS API beside the glue: build/web/ is the folder a site serves.
+cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$OUT/"

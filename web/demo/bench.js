@@ -1,0 +1,136 @@
+// Decode-time bench: tsm (this build) beside Draco's WASM decoder (draco3d),
+// same page, same bytes-in-memory conditions; then streaming: time to the
+// first and the last segment of a throttled download. window.benchResult
+// holds everything for web/test/bench.mjs.
+import { loadTsm } from '/dist/tsm.js';
+
+const params = new URLSearchParams(location.search);
+const REPS = Number(params.get('reps') || 15);
+const THROTTLE = Number(params.get('throttle') || 2000000);
+const only = params.get('meshes') ? params.get('meshes').split(',') : null;
+const out = document.getElementById('out');
+const log = (s) => { document.getElementById('log').textContent += '\n' + s; };
+const result = (window.benchResult = { state: 'running', reps: REPS, throttle: THROTTLE, rows: [], streaming: [] });
+
+const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
+const fetchBytes = async (url) => new Uint8Array(await (await fetch(url)).arrayBuffer());
+
+function loadScript(src) {
+  return new Promise((resolve, reject) => {
+    const s = document.createElement('script');
+    s.src = src; s.onload = resolve; s.onerror = () => reject(new Error('cannot load ' + src));
+    document.head.appendChild(s);
+  });
+}
+
+async function loadDraco() {
+  await loadScript('/draco/draco_decoder_nodejs.js');
+  const wasmBinary = await (await fetch('/draco/draco_decoder.wasm')).arrayBuffer();
+  return await new Promise((resolve) => { window.DracoDecoderModule({ wasmBinary }).then((m) => resolve(m)); });
+}
+
+// As three.js's DRACOLoader: decode, then positions and indices out through
+// the heap with one copy each.
+function dracoDecode(draco, bytes) {
+  const decoder = new draco.Decoder();
+  const mesh = new draco.Mesh();
+  try {
+    const status = decoder.DecodeArrayToMesh(bytes, bytes.byteLength, mesh);
+    if (!status.ok() || mesh.ptr === 0) throw new Error('draco: ' + status.error_msg());
+    const faces = mesh.num_faces(), points = mesh.num_points();
+    const nIdx = faces * 3;
+    let ptr = draco._malloc(nIdx * 4);
+    decoder.GetTrianglesUInt32Array(mesh, nIdx * 4, ptr);
+    const indices = new Uint32Array(draco.HEAPU32.buffer, ptr, nIdx).slice();
+    draco._free(ptr);
+    const attr = decoder.GetAttribute(mesh, decoder.GetAttributeId(mesh, draco.POSITION));
+    const n = points * 3;
+    ptr = draco._malloc(n * 4);
+    decoder.GetAttributeDataArrayForAllPoints(mesh, attr, draco.DT_FLOAT32, n * 4, ptr);
+    const positions = new Float32Array(draco.HEAPF32.buffer, ptr, n).slice();
+    draco._free(ptr);
+    return { positions, indices, vertexCount: points, faceCount: faces };
+  } finally {
+    draco.destroy(mesh);
+    draco.destroy(decoder);
+  }
+}
+
+function table(title, head, rows) {
+  const h = document.createElement('h2');
+  h.textContent = title;
+  const t = document.createElement('table');
+  t.innerHTML = '<tr>' + head.map((x) => `<th>${x}</th>`).join('') + '</tr>' +
+    rows.map((r) => '<tr>' + r.map((x) => `<td>${x}</td>`).join('') + '</tr>').join('');
+  out.append(h, t);
+}
+
+async function main() {
+  const index = await (await fetch('/data/index.json')).json();
+  let t = performance.now();
+  const tsm = await loadTsm();
+  result.tsmLoadMs = performance.now() - t;
+  t = performance.now();
+  const draco = await loadDraco();
+  result.dracoLoadMs = performance.now() - t;
+  log(`modules ready: tsm ${result.tsmLoadMs.toFixed(1)} ms, draco ${result.dracoLoadMs.toFixed(1)} ms (fetch + compile)`);
+
+  const rowsHtml = [];
+  for (const m of index) {
+    if (!m.drcBytes || m.ref.faceCount < 1000 || (only && !only.includes(m.name))) continue;
+    const tb = await fetchBytes(`/data/${m.name}.tsm`);
+    const db = await fetchBytes(`/data/${m.name}.drc`);
+    const a = tsm.decode(tb), b = dracoDecode(draco, db);
+    for (let i = 0; i < 2; ++i) { tsm.decode(tb); dracoDecode(draco, db); }
+    const ts = [], ds = [];
+    for (let i = 0; i < REPS; ++i) {
+      let t0 = performance.now(); tsm.decode(tb); ts.push(performance.now() - t0);
+      t0 = performance.now(); dracoDecode(draco, db); ds.push(performance.now() - t0);
+    }
+    const row = { name: m.name, segments: m.segments, tsmBytes: tb.length, drcBytes: db.length,
+      tsmVertices: a.vertexCount, tsmFaces: a.faceCount, dracoVertices: b.vertexCount, dracoFaces: b.faceCount,
+      tsmMs: median(ts), tsmMinMs: Math.min(...ts), dracoMs: median(ds), dracoMinMs: Math.min(...ds) };
+    result.rows.push(row);
+    log(`${m.name}: tsm ${row.tsmMs.toFixed(2)} ms, draco ${row.dracoMs.toFixed(2)} ms`);
+    rowsHtml.push([m.name, `${row.tsmVertices.toLocaleString()} / ${row.tsmFaces.toLocaleString()}`,
+      row.tsmBytes.toLocaleString(), row.drcBytes.toLocaleString(), row.tsmMs.toFixed(2), row.dracoMs.toFixed(2),
+      (row.dracoMs / row.tsmMs).toFixed(2), `${row.dracoVertices.toLocaleString()} / ${row.dracoFaces.toLocaleString()}`]);
+    await new Promise((r) => setTimeout(r, 0));
+  }
+  table(`Decode time, ms (median of ${REPS})`, ['mesh', 'tsm V / F', 'tsm bytes', 'Draco bytes', 'tsm ms', 'Draco ms',
+    'Draco / tsm', 'Draco V / F'], rowsHtml);
+
+  // Streaming: a throttled download, decoded as it arrives, on this thread.
+  const sHtml = [];
+  for (const m of index) {
+    if (only && !only.includes(m.name)) continue;
+    if (m.segments < 2 && m.name !== 'dragon_res2') continue;
+    const t0 = performance.now();
+    let first = null, pieces = 0, faces = 0, dec = 0;
+    const resp = await fetch(`/data/${m.name}.tsm?throttle=${THROTTLE}`);
+    for await (const seg of tsm.decodeStream(resp.body)) {
+      if (first == null && seg.faceCount) first = performance.now() - t0;
+      pieces++; faces += seg.faceCount; dec = seg.decodeMs;
+    }
+    const last = performance.now() - t0;
+    // The same download taken whole, then decoded (no streaming).
+    const w0 = performance.now();
+    const whole = await fetchBytes(`/data/${m.name}.tsm?throttle=${THROTTLE}`);
+    const wDownload = performance.now() - w0;
+    tsm.decode(whole);
+    const wholeMs = performance.now() - w0;
+    const row = { name: m.name, segments: m.segments, bytes: m.tsmBytes, firstMs: first, lastMs: last, pieces, faces,
+      decodeMs: dec, downloadMs: wDownload, wholeMs };
+    result.streaming.push(row);
+    log(`${m.name} streamed: first triangles ${first.toFixed(1)} ms, last ${last.toFixed(1)} ms; whole file then decode ${wholeMs.toFixed(1)} ms`);
+    sHtml.push([m.name, m.segments, m.tsmBytes.toLocaleString(), first.toFixed(1), last.toFixed(1), pieces, dec.toFixed(1),
+      wDownload.toFixed(1), wholeMs.toFixed(1)]);
+  }
+  table(`Streaming at ${THROTTLE / 1e6} MB/s (decoded on the page's thread as the bytes arrive)`,
+    ['file', 'segments', 'bytes', 'first triangles ms', 'last triangles ms', 'pieces', 'decode ms',
+      'whole file: download ms', 'whole file: download + decode ms'], sHtml);
+  result.state = 'done';
+  log('done');
+}
+
+main().catch((e) => { result.state = 'error'; result.error = String(e && e.stack || e); log('error: ' + (e.stack || e)); });

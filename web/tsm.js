@@ -1,0 +1,371 @@
+// tsm in the browser: a small API over the C API (libcodec/include/tsm/tsm.h)
+// compiled to WebAssembly by web/build.sh.
+//
+//   import { loadTsm } from './tsm.js';
+//   const tsm = await loadTsm();
+//   const mesh = tsm.decode(new Uint8Array(await (await fetch('bunny.tsm')).arrayBuffer()));
+//   mesh.positions  // Float32Array, 3 per vertex
+//   mesh.indices    // Uint32Array, the corners of every face
+//   mesh.faceOffsets // Uint32Array (faceCount + 1), only when some face is not a triangle
+//
+//   // streaming: each segment as soon as its bytes are in
+//   for await (const seg of tsm.decodeStream((await fetch('dragon.tsm')).body)) draw(seg);
+//
+//   // the same in a Web Worker (the page's thread stays free)
+//   for await (const seg of decodeStreamInWorker((await fetch('dragon.tsm')).body)) draw(seg);
+//
+// Results are plain typed arrays that own their memory: each is one bulk
+// copy (TypedArray.prototype.slice) of a view on the WebAssembly heap, made
+// once per decode or per segment; nothing is copied element by element.
+//
+// A segment is { index, vertexStart, vertexCount, faceStart, faceCount,
+// cornerStart, positions, indices, faceOffsets?, segmentCount, segmentsDone,
+// bytesIn, decodeMs }: positions are the segment's new vertices (3 floats each, global
+// numbers vertexStart..), indices are global vertex numbers (they may refer to
+// vertices of earlier segments), faceOffsets (only when the segment has a
+// face that is not a triangle) are faceCount + 1 offsets into the whole
+// mesh's corner array: subtract cornerStart to index this segment's indices.
+// bytesIn is the input fed so far, decodeMs the time spent in the decoder so
+// far (feed and finish calls, copies out included).
+import createTsmModule from './tsm_decoder.js';
+
+const ERR_SIZE = 512;
+const OPTIONS_SIZE = 64; // room for tsm_decode_options (three uint64 and an int: 32 bytes today)
+
+export const ErrorCode = Object.freeze({
+  OK: 0, INVALID_ARGUMENT: 1, IO_ERROR: 2, PARSE_ERROR: 3, CORRUPT_DATA: 4,
+  UNSUPPORTED: 5, LIMIT_EXCEEDED: 6, INTERNAL: 7,
+});
+const CODE_NAMES = Object.fromEntries(Object.entries(ErrorCode).map(([k, v]) => [v, k.toLowerCase()]));
+
+export class TsmError extends Error {
+  constructor(code, message) {
+    super(message || CODE_NAMES[code] || `error ${code}`);
+    this.name = 'TsmError';
+    this.code = code;
+    this.codeName = CODE_NAMES[code] || 'unknown';
+  }
+}
+
+const DEFAULT_WASM = new URL('./tsm_decoder.wasm', import.meta.url).href;
+
+/** Loads the WebAssembly decoder. options: { wasmUrl, wasmBinary } (wasmBinary, an
+ *  ArrayBuffer or Uint8Array, skips the fetch: needed under Node). */
+export async function loadTsm(options = {}) {
+  const moduleArgs = {};
+  if (options.wasmBinary) {
+    moduleArgs.wasmBinary = options.wasmBinary;
+  } else {
+    const url = options.wasmUrl || DEFAULT_WASM;
+    moduleArgs.locateFile = (name) => (name.endsWith('.wasm') ? url : name);
+  }
+  const mod = await createTsmModule(moduleArgs);
+  return new TsmDecoder(mod);
+}
+
+export class TsmDecoder {
+  constructor(mod) {
+    this.mod = mod;
+    this.errPtr = mod._malloc(ERR_SIZE);
+    this.optPtr = mod._malloc(OPTIONS_SIZE);
+    this.outPtr = mod._malloc(4); // tsm_mesh* out-parameter
+    this.inPtr = 0;
+    this.inCap = 0;
+    this.hasStreaming = typeof mod._tsm_stream_new === 'function';
+  }
+
+  /** The library's version string. */
+  get version() { return this.cstring(this.mod._tsm_version()); }
+
+  /** Decodes a whole .tsm file (Uint8Array or ArrayBuffer). options: { maxVertices,
+   *  maxFaces, maxCorners } refuse larger files before anything is allocated.
+   *  Returns { positions, indices, faceOffsets?, vertexCount, faceCount }. */
+  decode(bytes, options) {
+    return this.guard(() => this.decodeNow(bytes, options));
+  }
+
+  decodeNow(bytes, options) {
+    const m = this.mod;
+    const data = toBytes(bytes);
+    const inPtr = this.input(data);
+    const opt = this.options(options);
+    const rc = m._tsm_decode(inPtr, data.length, opt, this.outPtr, this.errPtr, ERR_SIZE);
+    if (rc !== 0) throw new TsmError(rc, this.cstring(this.errPtr));
+    const mesh = m.HEAPU32[this.outPtr >> 2];
+    try {
+      return this.extract(mesh, 0, 0, m._tsm_mesh_vertex_count(mesh), m._tsm_mesh_face_count(mesh), true);
+    } finally {
+      m._tsm_mesh_free(mesh);
+    }
+  }
+
+  /** A streaming decoder: feed(chunk) and finish() return the segments that chunk
+   *  completed (often none, sometimes several). */
+  createStream(options) { return new TsmStream(this, options); }
+
+  /** Decodes a ReadableStream (a fetch body) or any (async) iterable of byte
+   *  chunks, yielding each segment as soon as it is decoded. Leaving the loop
+   *  early (or an error) cancels a ReadableStream source. */
+  async *decodeStream(source, options) {
+    const stream = this.createStream(options);
+    try {
+      for await (const chunk of chunks(source)) {
+        for (const seg of stream.feed(chunk)) yield seg;
+      }
+      for (const seg of stream.finish()) yield seg;
+    } finally {
+      stream.free();
+    }
+  }
+
+  // ---- internals ----------------------------------------------------------
+
+  // Runs f; an abort inside the WebAssembly module (out of memory: the build
+  // has C++ exception catching off, so std::bad_alloc aborts) leaves the
+  // module unusable: every later call fails at once with this error.
+  guard(f) {
+    if (this.dead) throw this.dead;
+    try {
+      return f();
+    } catch (e) {
+      if (e instanceof TsmError) throw e;
+      this.dead = new TsmError(ErrorCode.INTERNAL, `the decoder aborted (${e && e.message || e}); load a new one`);
+      throw this.dead;
+    }
+  }
+
+  input(data) { // copies the input into the heap (one set), reusing one buffer
+    const m = this.mod;
+    if (data.length > this.inCap) {
+      if (this.inPtr) m._free(this.inPtr);
+      this.inCap = Math.max(data.length, this.inCap * 2, 1 << 16);
+      this.inPtr = m._malloc(this.inCap);
+      if (!this.inPtr) { this.inCap = 0; throw new TsmError(ErrorCode.LIMIT_EXCEEDED, 'out of memory'); }
+    }
+    m.HEAPU8.set(data, this.inPtr);
+    return this.inPtr;
+  }
+
+  options(o) {
+    if (!o) return 0;
+    const m = this.mod;
+    m.HEAPU8.fill(0, this.optPtr, this.optPtr + OPTIONS_SIZE);
+    const put = (i, v) => {
+      const n = Number(v || 0);
+      m.HEAPU32[(this.optPtr >> 2) + 2 * i] = n % 4294967296;
+      m.HEAPU32[(this.optPtr >> 2) + 2 * i + 1] = Math.floor(n / 4294967296);
+    };
+    put(0, o.maxVertices); put(1, o.maxFaces); put(2, o.maxCorners);
+    m.HEAP32[(this.optPtr >> 2) + 6] = 1; // threads: the WebAssembly build decodes on one
+    return this.optPtr;
+  }
+
+  cstring(ptr) {
+    const h = this.mod.HEAPU8;
+    let end = ptr;
+    while (h[end]) ++end;
+    return new TextDecoder().decode(h.subarray(ptr, end));
+  }
+
+  // Copies vertices [v0, v1) and faces [f0, f1) of a tsm_mesh out of the heap:
+  // one slice per array. The heap views are read after the decode, since a
+  // grown memory replaces them.
+  extract(mesh, v0, f0, v1, f1, whole) {
+    const m = this.mod;
+    const pos = m._tsm_mesh_positions(mesh) >> 2;
+    const idx = m._tsm_mesh_indices(mesh) >> 2;
+    const cornerCount = m._tsm_mesh_index_count(mesh);
+    let c0, c1, faceOffsets;
+    const allTriangles = cornerCount === 3 * m._tsm_mesh_face_count(mesh);
+    if (allTriangles) {
+      c0 = 3 * f0; c1 = 3 * f1;
+    } else {
+      const off = m._tsm_mesh_face_offsets(mesh) >> 2;
+      const U = m.HEAPU32;
+      c0 = U[off + f0]; c1 = U[off + f1];
+      if (c1 - c0 !== 3 * (f1 - f0) || whole) faceOffsets = U.subarray(off + f0, off + f1 + 1).slice();
+    }
+    const r = {
+      vertexStart: v0, vertexCount: v1 - v0, faceStart: f0, faceCount: f1 - f0, cornerStart: c0,
+      positions: m.HEAPF32.subarray(pos + 3 * v0, pos + 3 * v1).slice(),
+      indices: m.HEAPU32.subarray(idx + c0, idx + c1).slice(),
+    };
+    if (faceOffsets) r.faceOffsets = faceOffsets;
+    return r;
+  }
+}
+
+export class TsmStream {
+  constructor(dec, options) {
+    this.dec = dec;
+    this.m = dec.mod;
+    this.v = 0; this.f = 0; this.segIndex = 0; this.bytesIn = 0;
+    this.decodeMs = 0; // time spent decoding (in feed/finish, copies out included)
+    this.failed = null;
+    if (dec.hasStreaming) {
+      this.s = this.m._tsm_stream_new(dec.options(options));
+      if (!this.s) throw new TsmError(ErrorCode.LIMIT_EXCEEDED, 'out of memory');
+    } else {
+      // The library has no streaming API yet: gather the chunks, decode at finish.
+      this.s = 0; this.parts = []; this.opts = options;
+    }
+  }
+
+  get segmentCount() { return this.s ? this.m._tsm_stream_segment_count(this.s) : (this.done ? 1 : 0); }
+  get segmentsDone() { return this.s ? this.m._tsm_stream_segments_done(this.s) : (this.done ? 1 : 0); }
+
+  feed(chunk) {
+    const data = toBytes(chunk);
+    this.bytesIn += data.length;
+    if (this.failed) throw this.failed;
+    if (!this.s) { this.parts.push(data.slice()); return []; }
+    if (data.length === 0) return [];
+    return this.dec.guard(() => {
+      const t0 = now();
+      const ptr = this.dec.input(data);
+      const rc = this.m._tsm_stream_feed(this.s, ptr, data.length, this.dec.errPtr, ERR_SIZE);
+      return this.collect(rc, t0);
+    });
+  }
+
+  finish() {
+    if (this.failed) throw this.failed;
+    const t0 = now();
+    if (!this.s) {
+      const all = concat(this.parts, this.bytesIn);
+      this.parts = [];
+      const mesh = this.dec.decode(all, this.opts);
+      this.done = true;
+      this.decodeMs += now() - t0;
+      return [{ ...mesh, index: 0, segmentCount: 1, segmentsDone: 1, bytesIn: this.bytesIn, decodeMs: this.decodeMs }];
+    }
+    return this.dec.guard(() => {
+      const rc = this.m._tsm_stream_finish(this.s, this.dec.errPtr, ERR_SIZE);
+      return this.collect(rc, t0);
+    });
+  }
+
+  collect(rc, t0) {
+    try {
+      return this.collectSegments(rc);
+    } finally {
+      this.decodeMs += now() - t0;
+      if (this.last) { this.last.decodeMs = this.decodeMs; this.last = null; }
+    }
+  }
+
+  collectSegments(rc) {
+    const m = this.m;
+    if (rc !== 0) {
+      this.failed = new TsmError(rc, this.dec.cstring(this.dec.errPtr));
+      throw this.failed;
+    }
+    const mesh = m._tsm_stream_mesh(this.s);
+    const v1 = m._tsm_mesh_vertex_count(mesh);
+    const f1 = m._tsm_mesh_face_count(mesh);
+    const done = m._tsm_stream_segments_done(this.s);
+    if (v1 === this.v && f1 === this.f && done === this.segIndex) return [];
+    // Everything finished since the last call comes out as one piece (several
+    // segments finished by one chunk are reported together).
+    const seg = this.dec.extract(mesh, this.v, this.f, v1, f1, false);
+    seg.index = this.segIndex;
+    seg.segmentsDone = done;
+    seg.segmentCount = m._tsm_stream_segment_count(this.s);
+    seg.bytesIn = this.bytesIn;
+    this.v = v1; this.f = f1; this.segIndex = done;
+    this.last = seg; // gets decodeMs: time spent in feed/finish so far, this call included
+    return [seg];
+  }
+
+  free() {
+    if (this.s && !this.dec.dead) this.m._tsm_stream_free(this.s);
+    this.s = 0; this.parts = [];
+    if (!this.failed) this.failed = new TsmError(ErrorCode.INVALID_ARGUMENT, 'stream already freed');
+  }
+}
+
+/** Streams source (fetch body, iterable of chunks) through a decoder in a Web
+ *  Worker (tsm-worker.js beside this file); yields the same segments as
+ *  decodeStream. options: { workerUrl, wasmUrl, decodeOptions }. */
+export async function* decodeStreamInWorker(source, options = {}) {
+  const worker = new Worker(options.workerUrl || new URL('./tsm-worker.js', import.meta.url), { type: 'module' });
+  const queue = [];
+  let wake = null, ended = false, error = null, stopped = false;
+  worker.onmessage = (e) => {
+    const msg = e.data;
+    if (msg.type === 'segment') queue.push(msg.segment);
+    else if (msg.type === 'done') ended = true;
+    else if (msg.type === 'error') { error = new TsmError(msg.code, msg.message); ended = true; }
+    if (wake) { wake(); wake = null; }
+  };
+  worker.onerror = (e) => { error = new Error(e.message || 'worker failed'); ended = true; if (wake) { wake(); wake = null; } };
+  worker.postMessage({ type: 'start', wasmUrl: options.wasmUrl, decodeOptions: options.decodeOptions });
+  // Pump the input into the worker while segments come back.
+  const pump = (async () => {
+    try {
+      for await (const chunk of chunks(source)) {
+        if (stopped) return; // the consumer left: stop reading (the reader is released)
+        const c = toBytes(chunk);
+        const own = c.byteOffset === 0 && c.byteLength === c.buffer.byteLength ? c : c.slice();
+        worker.postMessage({ type: 'chunk', bytes: own }, [own.buffer]);
+      }
+      worker.postMessage({ type: 'end' });
+    } catch (e) {
+      error = e; ended = true;
+      if (wake) { wake(); wake = null; }
+    }
+  })();
+  try {
+    for (;;) {
+      while (queue.length) yield queue.shift();
+      if (error) throw error;
+      if (ended) break;
+      await new Promise((r) => { wake = r; });
+    }
+    await pump;
+  } finally {
+    stopped = true;
+    worker.terminate();
+  }
+}
+
+// ---- helpers ----------------------------------------------------------------
+
+const now = () => (typeof performance !== 'undefined' ? performance.now() : Date.now());
+
+function toBytes(b) {
+  if (b instanceof Uint8Array) return b;
+  if (b instanceof ArrayBuffer) return new Uint8Array(b);
+  if (ArrayBuffer.isView(b)) return new Uint8Array(b.buffer, b.byteOffset, b.byteLength);
+  throw new TypeError('expected a Uint8Array or ArrayBuffer');
+}
+
+async function* chunks(source) {
+  if (source && typeof source.getReader === 'function') { // ReadableStream
+    const reader = source.getReader();
+    let finished = false;
+    try {
+      for (;;) {
+        const { done, value } = await reader.read();
+        if (done) { finished = true; return; }
+        yield value;
+      }
+    } finally {
+      // Left early (the consumer stopped, or decoding failed): cancel the download.
+      if (!finished) reader.cancel().catch(() => {});
+      reader.releaseLock();
+    }
+  } else if (source instanceof Uint8Array || source instanceof ArrayBuffer) {
+    yield source;
+  } else {
+    yield* source;
+  }
+}
+
+function concat(parts, total) {
+  if (parts.length === 1) return parts[0];
+  const out = new Uint8Array(total);
+  let at = 0;
+  for (const p of parts) { out.set(p, at); at += p.length; }
+  return out;
+}
