@@ -95,8 +95,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (options.segment_faces) {
     tsm::StreamDecoder sd;
     const size_t chunk = 1 + data[3] % 64;
-    for (size_t at = 0; at < bytes.size(); at += chunk) {
-      s = sd.feed(std::string_view(bytes).substr(at, chunk));
+    for (size_t pos = 0; pos < bytes.size(); pos += chunk) {
+      s = sd.feed(std::string_view(bytes).substr(pos, chunk));
       if (!s.ok()) fail("the stream decoder refused the encoder's output: " + s.to_string());
     }
     s = sd.finish();

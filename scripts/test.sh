@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite: install, build release and ASan+UBSan, run both, then
 # a short smoke run of every libFuzzer target (fuzz/run.sh; clang + libFuzzer
-# are required: without them this fails, it never skips).
+# are required: without them this fails, it never skips), then the browser
+# test (web/test.sh: emscripten and Chromium from Debian; when they cannot be
+# installed it prints "web test SKIPPED: <reason>" and the suite goes on).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -17,3 +19,5 @@ done
 fuzz_seconds=${TSM_FUZZ_SMOKE_SECONDS:-20}
 echo "== fuzz smoke run (${fuzz_seconds} s per target)"
 FUZZ_JOBS=$jobs bash fuzz/run.sh "$fuzz_seconds"
+echo "== browser test: the WebAssembly decoder in headless Chromium (web/test.sh; it says plainly when it skips)"
+bash web/test.sh

@@ -67,6 +67,7 @@ zstd_from_debian() {
 ZSTD_CFLAGS=()
 ZSTD_FILES=()
 ZSTD_H=""
+ZSTD_MODE=debian
 if [ "${TSM_WEB_ZSTD:-debian}" = debian ] && zstd_from_debian; then
   echo "web/build.sh: zstd decompressor from Debian's source package ($ZSTD_SRC)"
   ZSTD_CFLAGS=(-I"$ZSTD_SRC" -DZSTD_DISABLE_ASM -DZSTD_NO_TRACE -DXXH_NAMESPACE=ZSTD_ -DZSTD_LEGACY_SUPPORT=0
@@ -78,6 +79,7 @@ else
   echo "web/build.sh: zstd source not available; zstd-coded sections will be refused (web/zstd_stub.c)"
   ZSTD_FILES=("$ROOT/web/zstd_stub.c")
   ZSTD_INC=()
+  ZSTD_MODE=stub
   # zstd.h for container.cpp: Debian's libzstd-dev header, through the one-header dir below
   ZSTD_H=/usr/include/zstd.h
 fi
@@ -152,3 +154,6 @@ emcc "${LOPT[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
 echo "web/build.sh: built $OUT/tsm_decoder.js + tsm_decoder.wasm ($(stat -c %s "$OUT/tsm_decoder.wasm") bytes wasm, $(stat -c %s "$OUT/tsm_decoder.js") bytes js)"
 # The JS API beside the glue: build/web/ is the folder a site serves.
 cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$OUT/"
+STREAMING=false
+grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h" && STREAMING=true
+printf '{"version": "%s", "zstd": "%s", "streaming": %s}\n' "$VERSION" "$ZSTD_MODE" "$STREAMING" > "$OUT/build-info.json"

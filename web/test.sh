@@ -54,11 +54,14 @@ fi
 
 # ---- build ------------------------------------------------------------------------
 nice -n 10 bash "$HERE/build.sh" || fail "web/build.sh failed"
+# The native CLI makes the reference figures: it must be of the same sources
+# as the wasm, so it is (re)built when missing or older than libcodec/.
 TSM="$ROOT/build/release/cli/tsm"
-if [ ! -x "$TSM" ]; then
+if [ ! -x "$TSM" ] || [ -n "$(find "$ROOT/libcodec" "$ROOT/cli" -newer "$TSM" -type f 2>/dev/null | head -1)" ]; then
   echo "web/test.sh: building the native tsm CLI (build/release) for the reference data"
-  { (cd "$ROOT" && cmake --preset release >/dev/null) && nice -n 10 cmake --build "$ROOT/build/release" --target tsm_cli -j 2; } ||
-    fail "cannot build the native CLI (cmake --preset release && cmake --build --preset release)"
+  { { [ -f "$ROOT/build/release/CMakeCache.txt" ] || (cd "$ROOT" && cmake --preset release >/dev/null); } &&
+    nice -n 10 cmake --build "$ROOT/build/release" --target tsm_cli -j 2 >"$ROOT/build/web/native-build.log" 2>&1; } ||
+    fail "cannot build the native CLI (build/web/native-build.log)"
 fi
 TSM="$TSM" bash "$HERE/prepare-data.sh" || fail "web/prepare-data.sh failed"
 

@@ -1,24 +1,27 @@
 // A module Web Worker that decodes a .tsm stream off the page's thread
 // (used by decodeStreamInWorker in tsm.js). Messages in: {type:'start',
-// wasmUrl?, decodeOptions?}, {type:'chunk', bytes}, {type:'end'}. Out:
+// wasmUrl?, decodeOptions?}, {type:'chunk', bytes}, {type:'end'},
+// {type:'cancel'}; a new 'start' drops any stream left unfinished. Out:
 // {type:'segment', segment} (its arrays transferred, not copied), {type:'done'},
 // {type:'error', code, message}.
 import { loadTsm } from './tsm.js';
 
 let decoderReady = null;
 let stream = null;
+let runId = 0; // the id of the current 'start', on every message out
 let queue = Promise.resolve();
 
 function send(segments) {
   for (const s of segments) {
     const transfer = [s.positions.buffer, s.indices.buffer];
     if (s.faceOffsets) transfer.push(s.faceOffsets.buffer);
-    self.postMessage({ type: 'segment', segment: s }, transfer);
+    self.postMessage({ type: 'segment', id: runId, segment: s }, transfer);
   }
 }
 
 function fail(e) {
-  self.postMessage({ type: 'error', code: e && e.code !== undefined ? e.code : 7, message: String(e && e.message || e) });
+  self.postMessage({ type: 'error', id: runId, code: e && e.code !== undefined ? e.code : 7,
+    message: String(e && e.message || e) });
   if (stream) { stream.free(); stream = null; }
 }
 
@@ -27,9 +30,12 @@ self.onmessage = (e) => {
   // Messages are handled one after another (the decoder loads asynchronously).
   queue = queue.then(async () => {
     try {
-      if (msg.type === 'start') {
+      if (msg.type === 'start' || msg.type === 'cancel') {
+        if (stream) { stream.free(); stream = null; }
+        if (msg.type === 'cancel') return;
+        runId = msg.id;
         decoderReady = decoderReady || loadTsm(msg.wasmUrl ? { wasmUrl: msg.wasmUrl } : {});
-        const dec = await decoderReady;
+        const dec = await decoderReady.catch((err) => { decoderReady = null; throw err; });
         stream = dec.createStream(msg.decodeOptions);
       } else if (msg.type === 'chunk') {
         if (stream) send(stream.feed(msg.bytes));
@@ -38,7 +44,7 @@ self.onmessage = (e) => {
           send(stream.finish());
           stream.free();
           stream = null;
-          self.postMessage({ type: 'done' });
+          self.postMessage({ type: 'done', id: runId });
         }
       }
     } catch (err) {

@@ -11,7 +11,8 @@
 //   // streaming: each segment as soon as its bytes are in
 //   for await (const seg of tsm.decodeStream((await fetch('dragon.tsm')).body)) draw(seg);
 //
-//   // the same in a Web Worker (the page's thread stays free)
+//   // the same in a Web Worker (the page's thread stays free); a worker made
+//   // with createTsmWorker() can be passed as { worker } and reused
 //   for await (const seg of decodeStreamInWorker((await fetch('dragon.tsm')).body)) draw(seg);
 //
 // Results are plain typed arrays that own their memory: each is one bulk
@@ -284,30 +285,46 @@ export class TsmStream {
   }
 }
 
+let runCounter = 0;
+
+/** A Web Worker running tsm-worker.js (beside this file), to pass as
+ *  options.worker to decodeStreamInWorker and reuse for several files: the
+ *  module is then loaded and compiled once. */
+export function createTsmWorker(workerUrl) {
+  return new Worker(workerUrl || new URL('./tsm-worker.js', import.meta.url), { type: 'module' });
+}
+
 /** Streams source (fetch body, iterable of chunks) through a decoder in a Web
- *  Worker (tsm-worker.js beside this file); yields the same segments as
- *  decodeStream. options: { workerUrl, wasmUrl, decodeOptions }. */
+ *  Worker; yields the same segments as decodeStream, their arrays transferred
+ *  from the worker. options: { worker (from createTsmWorker, kept; else a
+ *  worker is made for this call and ended after it), workerUrl, wasmUrl,
+ *  decodeOptions }. One stream at a time per worker. */
 export async function* decodeStreamInWorker(source, options = {}) {
-  const worker = new Worker(options.workerUrl || new URL('./tsm-worker.js', import.meta.url), { type: 'module' });
+  const own = !options.worker;
+  const worker = options.worker || createTsmWorker(options.workerUrl);
   const queue = [];
   let wake = null, ended = false, error = null, stopped = false;
+  const id = ++runCounter; // messages of an earlier, abandoned run on a reused worker are ignored
   worker.onmessage = (e) => {
     const msg = e.data;
+    if (msg.id !== id) return;
     if (msg.type === 'segment') queue.push(msg.segment);
     else if (msg.type === 'done') ended = true;
     else if (msg.type === 'error') { error = new TsmError(msg.code, msg.message); ended = true; }
     if (wake) { wake(); wake = null; }
   };
   worker.onerror = (e) => { error = new Error(e.message || 'worker failed'); ended = true; if (wake) { wake(); wake = null; } };
-  worker.postMessage({ type: 'start', wasmUrl: options.wasmUrl, decodeOptions: options.decodeOptions });
+  worker.postMessage({ type: 'start', id, wasmUrl: options.wasmUrl, decodeOptions: options.decodeOptions });
+  // Chunks of a ReadableStream are ours to hand over (transferred); others are copied first.
+  const transferable = !!(source && typeof source.getReader === 'function');
   // Pump the input into the worker while segments come back.
   const pump = (async () => {
     try {
       for await (const chunk of chunks(source)) {
         if (stopped) return; // the consumer left: stop reading (the reader is released)
         const c = toBytes(chunk);
-        const own = c.byteOffset === 0 && c.byteLength === c.buffer.byteLength ? c : c.slice();
-        worker.postMessage({ type: 'chunk', bytes: own }, [own.buffer]);
+        const mine = transferable && c.byteOffset === 0 && c.byteLength === c.buffer.byteLength ? c : c.slice();
+        worker.postMessage({ type: 'chunk', bytes: mine }, [mine.buffer]);
       }
       worker.postMessage({ type: 'end' });
     } catch (e) {
@@ -325,7 +342,10 @@ export async function* decodeStreamInWorker(source, options = {}) {
     await pump;
   } finally {
     stopped = true;
-    worker.terminate();
+    worker.onmessage = null;
+    worker.onerror = null;
+    if (own) worker.terminate();
+    else if (!ended) worker.postMessage({ type: 'cancel' });
   }
 }
 

@@ -3,7 +3,7 @@
 // Query: ?mesh=NAME&worker=1&throttle=BYTES_PER_SECOND&chunk=BYTES (mesh= loads at once).
 // window.tsmDemo holds the state and, when done, the counts and checksums
 // the browser test compares with the native decoder's.
-import { loadTsm, decodeStreamInWorker } from '/dist/tsm.js';
+import { loadTsm, decodeStreamInWorker, createTsmWorker } from '/dist/tsm.js';
 import { MeshView } from './render.js';
 import { fnv1a, hex } from './hash.js';
 
@@ -40,10 +40,11 @@ async function main() {
   stats.textContent = `decoder ${tsm.version} ready${tsm.hasStreaming ? '' : ' (no streaming C API in this build: whole-file decode at the end)'}`;
 
   let running = null;
+  let worker = null; // made on the first load in a worker, then reused
   async function load() {
     if (running) return;
-    const name = $('mesh').value, worker = $('worker').checked, throttle = Number($('throttle').value);
-    const s = { name, worker, bytes: 0, total: 0, triangles: 0, vertices: 0, faces: 0, corners: 0, segmentsDone: 0,
+    const name = $('mesh').value, inWorker = $('worker').checked, throttle = Number($('throttle').value);
+    const s = { name, worker: inWorker, bytes: 0, total: 0, triangles: 0, vertices: 0, faces: 0, corners: 0, segmentsDone: 0,
       segmentCount: 0, decodeMs: 0, firstMs: null, totalMs: null, pieces: 0, finished: false };
     Object.assign(state, { state: 'loading', stats: s, result: null, error: null });
     view.clear();
@@ -65,7 +66,8 @@ async function main() {
           yield value;
         }
       })();
-      const segments = worker ? decodeStreamInWorker(counted) : tsm.decodeStream(counted);
+      if (inWorker && !worker) worker = createTsmWorker();
+      const segments = inWorker ? decodeStreamInWorker(counted, { worker }) : tsm.decodeStream(counted);
       for await (const seg of segments) {
         const tris = seg.faceOffsets ? seg.indices.length - 2 * seg.faceCount : seg.faceCount;
         if (s.firstMs == null && seg.faceCount) s.firstMs = performance.now() - t0;
@@ -83,7 +85,7 @@ async function main() {
       s.totalMs = performance.now() - t0;
       s.finished = true;
       show(s);
-      const result = { name, worker, vertexCount: s.vertices, faceCount: s.faces, cornerCount: s.corners,
+      const result = { name, worker: inWorker, vertexCount: s.vertices, faceCount: s.faces, cornerCount: s.corners,
         triangles: !polygons, indexHash: hex(hIdx), positionHash: hex(hPos), bytes: s.bytes,
         pieces: s.pieces, segmentCount: s.segmentCount, decodeMs: s.decodeMs, firstMs: s.firstMs, totalMs: s.totalMs };
       if (polygons) result.faceOffsetHash = hex(hOff);
