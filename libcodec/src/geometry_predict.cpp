@@ -54,6 +54,7 @@ int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
 }
 
 struct ResidualModels {
+  ResidualModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
   ResidualModel m[3][kClasses][kActivity];
   // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
   // then the lattice index offset from the plane nearest the prediction.

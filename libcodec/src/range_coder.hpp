@@ -21,9 +21,17 @@ struct Prob {
   uint16_t p = kProbOne / 2;  // probability of a 0 bit, in 1/4096
 };
 
+// A probability its model initializes on first use (the mantissa rows of
+// UIntModelT): a model set of many contexts then costs nothing to create,
+// so a small mesh or segment does not pay for the contexts it never uses.
+struct LazyProb {
+  uint16_t p;
+};
+
 class RangeEncoder {
  public:
-  void bit(Prob& prob, int b) {
+  template <class P>
+  void bit(P& prob, int b) {
     uint32_t bound = (range_ >> kProbBits) * prob.p;
     if (!b) {
       range_ = bound;
@@ -66,7 +74,8 @@ class RangeDecoder {
   RangeDecoder() = default;
   explicit RangeDecoder(std::string_view data) { init(data); }
   void init(std::string_view data);
-  int bit(Prob& prob) {
+  template <class P>
+  int bit(P& prob) {
     uint32_t bound = (range_ >> kProbBits) * prob.p;
     int b;
     if (code_ < bound) {
@@ -146,17 +155,30 @@ inline int bit_length(uint64_t x) { return x ? 64 - __builtin_clzll(x) : 0; }
 template <int M>
 struct UIntModelT {
   static constexpr int kModelled = M;
+  // User-provided, so that value-initialization (make_unique<T>()) of a set
+  // of models does not zero the mantissa rows either: they are set up on
+  // first use (`ready`).
+  UIntModelT() {}
   BitTreeModel<6> length;
-  Prob mantissa[33][1 << M];
+  uint64_t ready = 0;  // bit n: mantissa row n is initialized
+  LazyProb mantissa[33][1 << M];
+  LazyProb* row(int n) {
+    if (!((ready >> n) & 1)) {
+      for (LazyProb& q : mantissa[n]) q.p = kProbOne / 2;
+      ready |= uint64_t{1} << n;
+    }
+    return mantissa[n];
+  }
   void encode(RangeEncoder& e, uint32_t v) {
     uint64_t x = static_cast<uint64_t>(v) + 1;
     int n = bit_length(x) - 1;  // 0..32
     length.encode(e, static_cast<uint32_t>(n));
     int top = n < M ? n : M;
     uint32_t ctx = 1;
+    LazyProb* mrow = top ? row(n) : nullptr;
     for (int i = 0; i < top; ++i) {
       int b = static_cast<int>((x >> (n - 1 - i)) & 1);
-      e.bit(mantissa[n][ctx], b);
+      e.bit(mrow[ctx], b);
       ctx = (ctx << 1) | static_cast<uint32_t>(b);
     }
     int rest = n - top;
@@ -169,8 +191,9 @@ struct UIntModelT {
     uint64_t x = 1;
     int top = n < M ? n : M;
     uint32_t ctx = 1;
+    LazyProb* mrow = top ? row(n) : nullptr;
     for (int i = 0; i < top; ++i) {
-      int b = d.bit(mantissa[n][ctx]);
+      int b = d.bit(mrow[ctx]);
       ctx = (ctx << 1) | static_cast<uint32_t>(b);
       x = (x << 1) | static_cast<uint64_t>(b);
     }
