@@ -184,7 +184,7 @@ def read_container(data):
                 reject('segment section')
         elif sid in sections:
             reject('duplicate section id')
-        elif 3 <= sid <= 6 and h['segment_count'] > 1:
+        elif (3 <= sid <= 6 or sid == 8) and h['segment_count'] > 1:
             reject('whole-mesh section in a segmented file')
         if codec == 1:                                              # step 21
             try:
@@ -1254,7 +1254,7 @@ def decode(data, trace=None):
         for body in sections[7]:
             p = 0
             fields = []
-            for _ in range(8):
+            for _ in range(9):
                 x, p = read_varint(body, p, len(body))
                 fields.append(x)
             counts = tuple(fields[:4])
@@ -1264,7 +1264,7 @@ def decode(data, trace=None):
                     reject('segment stream length')
                 streams.append(body[p:p + n])
                 p += n
-            streams.append(body[p:])
+            # the rest is the segment's attribute stream (§8.12), not decoded here
             if counts[3] > counts[0]:
                 reject('segment references')
             parts.append((tuple(streams), counts))

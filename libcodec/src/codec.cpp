@@ -11,6 +11,7 @@
 #include <thread>
 #endif
 
+#include "attributes.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
@@ -42,6 +43,7 @@ struct PartCounts {
 struct PartStreams {
   std::string_view vertex_tree, triangle_tree, topology, references, geometry;
   bool segmented = false;  // has a references stream
+  std::string_view attributes;  // empty: none
 };
 
 // A modelled binary decision costs at least -log2(4065/4096) = 0.011 bits
@@ -112,11 +114,17 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
   if (!s.segmented) {
     out.global.assign(c.vertex_count, kNone);
-    return decode_geometry(s.geometry, layout, bits, out.q, &out.gstats);
+    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
+  } else {
+    TSM_RETURN_IF_ERROR(
+        decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
+    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats));
   }
-  TSM_RETURN_IF_ERROR(
-      decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
-  return decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats);
+  AttributePart ap;
+  ap.faces = &out.faces;
+  ap.global = &out.global;
+  ap.q = &out.q;
+  return decode_attributes(s.attributes, ap, out.faces.attributes);
 }
 
 // Runs f(0..n-1) on up to `threads` threads (0 = one per core); each index
@@ -155,6 +163,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
       if (!sec) return corrupt(k < 3 ? "a connectivity section is missing" : "the geometry section is missing");
       *slot[k] = sec->data;
     }
+    if (const Section* a = find_section(sections, kSectionAttributes)) s.attributes = a->data;
     streams.assign(1, s);
     parts.resize(1);
     parts[0].counts = PartCounts{h.vertex_count, h.face_count, h.corner_count, 0};
@@ -165,7 +174,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
     if (sec.id != kSectionSegment) continue;
     SegmentPayload p;
     TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true};
+    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
     streams.push_back(s);
     parts.emplace_back();
     parts.back().counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
@@ -191,9 +200,33 @@ double grid_value(const Header& h, double step, int axis, uint32_t q) {
 
 // Appends a decoded part to the mesh: its own vertices get the next ids,
 // its faces follow the faces so far. Frees the part's buffers.
-void append_part(const Header& h, DecodedPart& part, Mesh& out) {
+// The parts of a file carry the same attributes (names, kinds, domains,
+// types, components), each with its own values.
+Status merge_attributes(const Mesh& out, bool first, const std::vector<Attribute>& part) {
+  if (first) return Status::Ok();
+  bool same = part.size() == out.attributes.size();
+  for (size_t i = 0; same && i < part.size(); ++i) {
+    const Attribute &a = part[i], &b = out.attributes[i];
+    same = a.name == b.name && a.kind == b.kind && a.domain == b.domain && a.type == b.type &&
+           a.components == b.components;
+  }
+  return same ? Status::Ok() : corrupt("the segments disagree on the attributes they carry");
+}
+
+Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
+  TSM_RETURN_IF_ERROR(merge_attributes(out, first, part.faces.attributes));
   const double step = grid_step(h);
   const uint32_t base = static_cast<uint32_t>(out.vertex_count());
+  if (first) {
+    out.attributes = std::move(part.faces.attributes);
+  } else {
+    for (size_t i = 0; i < out.attributes.size(); ++i) {
+      Attribute &o = out.attributes[i], &p = part.faces.attributes[i];
+      const uint32_t value_base = static_cast<uint32_t>(o.value_count());
+      o.values.insert(o.values.end(), p.values.begin(), p.values.end());
+      for (uint32_t x : p.indices) o.indices.push_back(value_base + x);
+    }
+  }
   if (out.face_count() == 0 && base == 0 && part.counts.reference_count == 0) {  // the first part: no copy
     out.face_offsets = std::move(part.faces.face_offsets);
     out.indices = std::move(part.faces.indices);
@@ -203,7 +236,7 @@ void append_part(const Header& h, DecodedPart& part, Mesh& out) {
     part.faces.clear();
     part.q = std::vector<uint32_t>();
     part.global = std::vector<uint32_t>();
-    return;
+    return Status::Ok();
   }
   std::vector<uint32_t> id(part.global.size());
   uint32_t own = 0;
@@ -220,6 +253,7 @@ void append_part(const Header& h, DecodedPart& part, Mesh& out) {
   part.faces.clear();
   part.q = std::vector<uint32_t>();
   part.global = std::vector<uint32_t>();
+  return Status::Ok();
 }
 
 Status decode_parts(const Header& h, std::vector<Section>& sections, int threads, std::vector<DecodedPart>& parts,
@@ -243,6 +277,7 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
 struct EncodedPart {
   ConnectivityStreams streams;
   std::string geometry;
+  std::string attributes;
   std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
   std::vector<uint8_t> contexts;   // per output vertex, for the references stream
   Status status;
@@ -251,7 +286,7 @@ struct EncodedPart {
 // qin: grid indices per part input vertex; is_ref: per part input vertex,
 // 1 when an earlier segment holds it (empty: none).
 Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                   const EncodeOptions& options, EncodedPart& out) {
+                   const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
   const int bits = options.quantization_bits;
   ConnectivityEncoding ce;
   CutHints hints;
@@ -302,10 +337,70 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
   }
   const Lattice lattice = find_lattice(q, layout.vertex_count);
   out.geometry = encode_geometry(layout, q, bits, options.level, &lattice);
+  if (!headers.empty()) {
+    // The faces as the decoder will give them, to code face and corner
+    // values in its order.
+    Mesh faces;
+    GeometryLayout scratch;
+    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(),
+                                            faces, scratch));
+    std::vector<uint8_t> ref_out(mark.size());
+    for (size_t v = 0; v < mark.size(); ++v) ref_out[v] = mark[v] != kNone;
+    AttributeInput ai;
+    ai.part = &mesh;
+    ai.order = &ce.vertex_order;
+    ai.is_ref = &ref_out;
+    ai.faces = &faces;
+    ai.q = &q;
+    TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, out.attributes));
+  }
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
   return Status::Ok();
+}
+
+// A segment's attributes: the values of its vertices (`in`, ascending input
+// ids) and faces; a corner attribute keeps the values its corners use (in
+// input order), and the last segment also those no corner uses. A value
+// used on both sides of a border is stored in each segment that uses it.
+std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<uint32_t>& in,
+                                          const std::vector<uint32_t>& faces, bool last) {
+  std::vector<Attribute> out;
+  for (const Attribute& a : mesh.attributes) {
+    Attribute b;
+    b.name = a.name;
+    b.kind = a.kind;
+    b.domain = a.domain;
+    b.type = a.type;
+    b.components = a.components;
+    const size_t c = a.components;
+    auto take = [&](size_t j) { b.values.insert(b.values.end(), a.values.begin() + c * j, a.values.begin() + c * (j + 1)); };
+    if (a.domain == AttributeDomain::vertex) {
+      for (uint32_t v : in) take(v);
+    } else if (a.domain == AttributeDomain::face) {
+      for (uint32_t f : faces) take(f);
+    } else {
+      std::vector<uint32_t> local(a.value_count(), kNone);
+      std::vector<uint8_t> used_anywhere;
+      if (last) {
+        used_anywhere.assign(a.value_count(), 0);
+        for (uint32_t x : a.indices) used_anywhere[x] = 1;
+      }
+      std::vector<uint8_t> mine(a.value_count(), 0);
+      for (uint32_t f : faces)
+        for (uint32_t i = mesh.face_offsets[f]; i < mesh.face_offsets[f + 1]; ++i) mine[a.indices[i]] = 1;
+      for (size_t j = 0; j < a.value_count(); ++j)
+        if (mine[j] || (last && !used_anywhere[j])) {
+          local[j] = static_cast<uint32_t>(b.value_count());
+          take(j);
+        }
+      for (uint32_t f : faces)
+        for (uint32_t i = mesh.face_offsets[f]; i < mesh.face_offsets[f + 1]; ++i) b.indices.push_back(local[a.indices[i]]);
+    }
+    out.push_back(std::move(b));
+  }
+  return out;
 }
 
 // The segmented file's parts: each segment's mesh with its own vertex ids
@@ -313,8 +408,8 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
 // vertices on no face), coded in parallel; then the references, which need
 // the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
-                       const std::vector<std::vector<uint32_t>>& segments, const EncodeOptions& options,
-                       ContainerWriter& cw) {
+                       const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
+                       const EncodeOptions& options, ContainerWriter& cw) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -355,7 +450,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       for (uint32_t i = 0; i < mesh.face_size(f); ++i) corners.push_back(local[mesh.face(f)[i]]);
       part.add_face(corners.data(), corners.size());
     }
-    parts[k].status = encode_part(part, q, is_ref, options, parts[k]);
+    part.attributes = segment_attributes(mesh, in, segments[k], k + 1 == S);
+    parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
   });
   std::vector<uint32_t> final_id(V, kNone);
   uint32_t next = 0;
@@ -386,6 +482,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     sp.topology = p.streams.topology;
     sp.references = references;
     sp.geometry = p.geometry;
+    sp.attributes = p.attributes;
     cw.add_section(kSectionSegment, write_segment(sp), 0);
     p = EncodedPart();
   }
@@ -429,19 +526,29 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     int64_t x = grid.quantize(mesh.positions[i], static_cast<int>(i % 3));
     qin[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
   }
+  for (const Attribute& a : mesh.attributes)
+    if (a.type != AttributeType::f32)
+      for (float x : a.values)
+        if (x != std::floor(x) || std::fabs(x) > static_cast<float>(1 << 30))
+          return Status(ErrorCode::invalid_argument, "attribute '" + a.name + "' is of an integer type but holds " +
+                                                         std::to_string(x) + " (integers up to 2^30 only)");
+  if (mesh.attributes.size() > 64)
+    return Status(ErrorCode::invalid_argument, "more than 64 attributes");
+  const std::vector<AttributeHeader> headers = attribute_headers(mesh, AttributeBits{});
   const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());
   ContainerWriter cw(h);
   if (segments.size() == 1) {
     EncodedPart p;
-    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, options, p));
+    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     cw.add_section(kSectionVertexTree, p.streams.vertex_tree, 0);
     cw.add_section(kSectionTriangleTree, p.streams.triangle_tree, 0);
     cw.add_section(kSectionTopology, p.streams.topology, 0);
     cw.add_section(kSectionGeometry, p.geometry, 0);
+    if (!p.attributes.empty()) cw.add_section(kSectionAttributes, p.attributes, 0);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, options, cw));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
   }
   out = cw.finish();
   return Status::Ok();
@@ -457,7 +564,7 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   std::vector<PartStreams> streams;
   TSM_RETURN_IF_ERROR(decode_parts(h, sections, options.threads, parts, streams));
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
-  for (DecodedPart& p : parts) append_part(h, p, out);
+  for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
   return Status::Ok();
 }
 
@@ -537,7 +644,7 @@ struct StreamDecoder::Impl {
 
   Status part_done(DecodedPart& part, const PartStreams& s) {
     TSM_RETURN_IF_ERROR(decode_part(s, mesh.vertex_count(), h.quantization_bits, part));
-    append_part(h, part, mesh);
+    TSM_RETURN_IF_ERROR(append_part(h, part, mesh, done == 0));
     ++done;
     return Status::Ok();
   }
@@ -545,7 +652,7 @@ struct StreamDecoder::Impl {
   Status segment(const Section& sec) {
     SegmentPayload p;
     TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true};
+    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
     DecodedPart part;
     part.counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
     // Against the header before anything is allocated: the header's counts

@@ -17,6 +17,8 @@
 
 #include "tsm/compare.hpp"
 
+#include "attributes.hpp"
+
 namespace tsm {
 
 Grid Grid::for_mesh(const Mesh& mesh, int bits) {
@@ -135,20 +137,64 @@ size_t distinct(std::vector<uint64_t> v) {
   return static_cast<size_t>(std::unique(v.begin(), v.end()) - v.begin());
 }
 
-// Faces as label sequences rotated to their lexicographically smallest
-// rotation (orientation kept), sorted.
-std::vector<std::vector<uint64_t>> canonical_faces(const Mesh& m, const std::vector<uint64_t>& label) {
+// Attribute keys (the integers the codec codes a value as, on the original
+// mesh's quantization): per vertex, per face and per corner, hashed. A
+// corner's key also holds how many corners share its value (so merged or
+// split seams show), and `unused` lists the values no corner uses.
+struct AttributeKeys {
+  std::vector<uint64_t> vertex, face, corner, unused;
+};
+
+AttributeKeys attribute_keys(const Mesh& m, const std::vector<AttributeHeader>& headers) {
+  AttributeKeys k;
+  k.vertex.assign(m.vertex_count(), 0);
+  k.face.assign(m.face_count(), 0);
+  k.corner.assign(m.corner_count(), 0);
+  int32_t key[4];
+  for (size_t i = 0; i < headers.size() && i < m.attributes.size(); ++i) {
+    const AttributeHeader& h = headers[i];
+    const Attribute& a = m.attributes[i];
+    const uint32_t n = attribute_key_size(h);
+    auto value_hash = [&](size_t j) {
+      attribute_key(h, &a.values[a.components * j], key);
+      uint64_t x = 0x51ed27 + i;
+      for (uint32_t c = 0; c < n; ++c) x = combine(x, static_cast<uint64_t>(static_cast<int64_t>(key[c])));
+      return x;
+    };
+    if (a.domain == AttributeDomain::vertex) {
+      for (size_t v = 0; v < m.vertex_count(); ++v) k.vertex[v] = combine(k.vertex[v], value_hash(v));
+    } else if (a.domain == AttributeDomain::face) {
+      for (size_t f = 0; f < m.face_count(); ++f) k.face[f] = combine(k.face[f], value_hash(f));
+    } else {
+      std::vector<uint32_t> uses(a.value_count(), 0);
+      for (uint32_t x : a.indices) uses[x]++;
+      for (size_t c = 0; c < m.corner_count(); ++c)
+        k.corner[c] = combine(k.corner[c], combine(value_hash(a.indices[c]), uses[a.indices[c]]));
+      for (size_t j = 0; j < a.value_count(); ++j)
+        if (!uses[j]) k.unused.push_back(value_hash(j));
+    }
+  }
+  std::sort(k.unused.begin(), k.unused.end());
+  return k;
+}
+
+// Faces as label sequences (each corner's vertex label with its corner
+// attribute key, then the face's attribute key) rotated to their
+// lexicographically smallest rotation (orientation kept), sorted.
+std::vector<std::vector<uint64_t>> canonical_faces(const Mesh& m, const std::vector<uint64_t>& label,
+                                                   const AttributeKeys& keys) {
   std::vector<std::vector<uint64_t>> faces(m.face_count());
   std::vector<uint64_t> seq, best;
   for (size_t f = 0; f < m.face_count(); ++f) {
     const uint32_t* c = m.face(f);
-    uint32_t n = m.face_size(f);
+    const uint32_t n = m.face_size(f), at = m.face_offsets[f];
     best.clear();
     for (uint32_t r = 0; r < n; ++r) {
       seq.clear();
-      for (uint32_t i = 0; i < n; ++i) seq.push_back(label[c[(r + i) % n]]);
+      for (uint32_t i = 0; i < n; ++i) seq.push_back(combine(label[c[(r + i) % n]], keys.corner[at + (r + i) % n]));
       if (best.empty() || seq < best) best = seq;
     }
+    best.push_back(keys.face[f]);
     faces[f] = best;
   }
   std::sort(faces.begin(), faces.end());
@@ -184,8 +230,39 @@ CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits
                    std::to_string(original.corner_count());
     return r;
   }
+  if (original.attributes.size() != decoded.attributes.size()) {
+    r.difference = std::to_string(decoded.attributes.size()) + " attributes, expected " +
+                   std::to_string(original.attributes.size());
+    return r;
+  }
+  for (size_t i = 0; i < original.attributes.size(); ++i) {
+    const Attribute &x = original.attributes[i], &y = decoded.attributes[i];
+    if (x.name != y.name || x.kind != y.kind || x.domain != y.domain || x.type != y.type ||
+        x.components != y.components) {
+      r.difference = "attribute " + std::to_string(i) + " ('" + x.name + "') is described differently in the decoded mesh";
+      return r;
+    }
+  }
+  const std::vector<AttributeHeader> headers = attribute_headers(original, AttributeBits{});
+  const AttributeKeys ka = attribute_keys(original, headers), kb = attribute_keys(decoded, headers);
+  if (ka.unused != kb.unused) {
+    r.difference = "the values no corner uses differ (" + std::to_string(kb.unused.size()) + ", expected " +
+                   std::to_string(ka.unused.size()) + ")";
+    return r;
+  }
   const Grid grid = Grid::for_mesh(original, bits);
   Labelled a = initial_labels(original, grid), b = initial_labels(decoded, grid);
+  if (!original.attributes.empty()) {
+    std::vector<uint64_t> xa = ka.vertex, xb = kb.vertex;
+    for (size_t v = 0; v < a.label.size(); ++v) a.label[v] = combine(a.label[v], ka.vertex[v]);
+    for (size_t v = 0; v < b.label.size(); ++v) b.label[v] = combine(b.label[v], kb.vertex[v]);
+    std::sort(xa.begin(), xa.end());
+    std::sort(xb.begin(), xb.end());
+    if (xa != xb) {
+      r.difference = "vertex attribute values differ";
+      return r;
+    }
+  }
 
   // Positions, and the largest error (matched by sorted grid position).
   {
@@ -221,7 +298,7 @@ CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits
   size_t classes = distinct(la);
   bool stable = false;
   for (int round = 0; round < 8; ++round) {
-    if (canonical_faces(original, la) != canonical_faces(decoded, lb)) {
+    if (canonical_faces(original, la, ka) != canonical_faces(decoded, lb, kb)) {
       r.difference = round == 0 ? "faces differ (some oriented face of the original, by corner positions, is not in "
                                   "the decoded mesh, or is there a different number of times)"
                                 : "faces differ around coincident vertices (refinement round " +

@@ -28,6 +28,7 @@ const char* section_name(uint16_t id) {
     case kSectionTopology: return "topology";
     case kSectionGeometry: return "geometry";
     case kSectionSegment: return "segment";
+    case kSectionAttributes: return "attributes";
   }
   return "unknown";
 }
@@ -222,7 +223,7 @@ Status SectionRules::admit(const Section& s, uint32_t segment_count) {
       return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
     return Status::Ok();
   }
-  if (segment_count > 1 && s.id >= kSectionVertexTree && s.id <= kSectionGeometry)
+  if (segment_count > 1 && ((s.id >= kSectionVertexTree && s.id <= kSectionGeometry) || s.id == kSectionAttributes))
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
   for (uint16_t prev : seen)
     if (prev == s.id) return corrupt_at(at, s.id, "appears twice");

@@ -26,6 +26,7 @@ enum SectionId : uint16_t {
   kSectionTopology = 5,       // components, jumps, virtual vertices, stitches, side faces (range coded)
   kSectionGeometry = 6,       // predicted quantized positions (range coded)
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
+  kSectionAttributes = 8,     // normals, colours, texture coordinates, ... (headers + range coded)
 };
 const char* section_name(uint16_t id);
 

@@ -10,6 +10,7 @@ void Mesh::clear() {
   positions.clear();
   face_offsets.assign(1, 0);
   indices.clear();
+  attributes.clear();
 }
 
 void Mesh::reserve(size_t vertices, size_t faces, size_t corners) {
@@ -65,6 +66,9 @@ size_t Mesh::unreferenced_vertex_count() const {
 bool Mesh::all_finite() const {
   for (float x : positions)
     if (!std::isfinite(x)) return false;
+  for (const Attribute& a : attributes)
+    for (float x : a.values)
+      if (!std::isfinite(x)) return false;
   return true;
 }
 
@@ -83,7 +87,40 @@ bool Mesh::valid(std::string* why) const {
     if (indices[i] >= nv)
       return fail("corner " + std::to_string(i) + " references vertex " + std::to_string(indices[i]) +
                   " of " + std::to_string(nv));
+  for (size_t k = 0; k < attributes.size(); ++k) {
+    const Attribute& a = attributes[k];
+    const std::string what = "attribute " + std::to_string(k) + " ('" + a.name + "')";
+    if (a.components < 1 || a.components > 4) return fail(what + " has " + std::to_string(a.components) + " components (1..4)");
+    if (a.values.size() % a.components != 0) return fail(what + ": values size is not a multiple of its components");
+    if (static_cast<uint8_t>(a.kind) > 3 || static_cast<uint8_t>(a.domain) > 2 || static_cast<uint8_t>(a.type) > 3)
+      return fail(what + ": unknown kind, domain or type");
+    if (a.kind == AttributeKind::normal && a.components != 3) return fail(what + ": a normal has 3 components");
+    if (a.kind == AttributeKind::texcoord && a.components != 2) return fail(what + ": a texture coordinate has 2 components");
+    if (a.kind == AttributeKind::color && a.components < 3) return fail(what + ": a colour has 3 or 4 components");
+    const size_t n = a.value_count();
+    switch (a.domain) {
+      case AttributeDomain::vertex:
+        if (n != nv || !a.indices.empty()) return fail(what + ": a vertex attribute needs one value per vertex");
+        break;
+      case AttributeDomain::face:
+        if (n != face_count() || !a.indices.empty()) return fail(what + ": a face attribute needs one value per face");
+        break;
+      case AttributeDomain::corner:
+        if (a.indices.size() != indices.size()) return fail(what + ": a corner attribute needs one index per corner");
+        for (size_t i = 0; i < a.indices.size(); ++i)
+          if (a.indices[i] >= n)
+            return fail(what + ": corner " + std::to_string(i) + " names value " + std::to_string(a.indices[i]) +
+                        " of " + std::to_string(n));
+        break;
+    }
+  }
   return true;
+}
+
+const Attribute* Mesh::find_attribute(AttributeKind kind) const {
+  for (const Attribute& a : attributes)
+    if (a.kind == kind) return &a;
+  return nullptr;
 }
 
 double BoundingBox::largest_extent() const {

@@ -50,7 +50,7 @@ struct SegmentPayload {
   uint64_t face_count = 0;
   uint64_t corner_count = 0;
   uint64_t reference_count = 0;
-  std::string_view vertex_tree, triangle_tree, topology, references, geometry;
+  std::string_view vertex_tree, triangle_tree, topology, references, geometry, attributes;
 };
 std::string write_segment(const SegmentPayload& p);
 Status read_segment(std::string_view bytes, SegmentPayload& p);

@@ -12,10 +12,46 @@
 
 namespace tsm {
 
+// What an attribute holds (it chooses how the codec quantizes and predicts it).
+enum class AttributeKind : uint8_t {
+  generic = 0,   // any values
+  normal = 1,    // 3 components, unit length (octahedral quantization)
+  color = 2,     // 3 or 4 components (RGB, RGBA)
+  texcoord = 3,  // 2 components (u, v)
+};
+// What one value belongs to.
+enum class AttributeDomain : uint8_t {
+  vertex = 0,  // one value per vertex
+  face = 1,    // one value per face
+  corner = 2,  // per face corner, through `indices` into a value list of its own (seams, creases)
+};
+// How the values were stored in the file they came from; integer types hold
+// integer values (a u8 colour is 0..255), coded exactly.
+enum class AttributeType : uint8_t { f32 = 0, u8 = 1, u16 = 2, i32 = 3 };
+
+// A per-vertex, per-face or per-corner attribute. `values` holds
+// value_count() values of `components` floats each. For the vertex and face
+// domains there is one value per vertex / face, in their order, and
+// `indices` is empty. For the corner domain `indices` has one entry per face
+// corner (in the order of Mesh::indices) naming a value; values may repeat
+// or be used by no corner (OBJ's vt / vn lists, glTF seams): all of it is
+// kept as given.
+struct Attribute {
+  std::string name;  // "normal", "color", "texcoord", or the file's own name
+  AttributeKind kind = AttributeKind::generic;
+  AttributeDomain domain = AttributeDomain::vertex;
+  AttributeType type = AttributeType::f32;
+  uint32_t components = 1;  // 1..4
+  std::vector<float> values;
+  std::vector<uint32_t> indices;  // corner domain only
+  size_t value_count() const { return components ? values.size() / components : 0; }
+};
+
 struct Mesh {
   std::vector<float> positions;            // 3 * vertex_count()
   std::vector<uint32_t> face_offsets{0};   // face_count() + 1, starts with 0
   std::vector<uint32_t> indices;           // corners of all faces
+  std::vector<Attribute> attributes;       // normals, colours, texture coordinates, ...
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t face_count() const { return face_offsets.size() - 1; }
@@ -36,9 +72,11 @@ struct Mesh {
   // Vertices not referenced by any face.
   size_t unreferenced_vertex_count() const;
   // True when every position is finite.
-  bool all_finite() const;
-  // Internal consistency (offsets monotone, indices in range); for asserts
-  // and for checking meshes handed to the encoder by API users.
+  bool all_finite() const;  // positions and attribute values
+  const Attribute* find_attribute(AttributeKind kind) const;
+  // Internal consistency (offsets monotone, indices in range, attribute
+  // sizes matching their domain); for asserts and for checking meshes handed
+  // to the encoder by API users.
   bool valid(std::string* why = nullptr) const;
 };
 

@@ -1,0 +1,74 @@
+// Internal: attributes (normals, colours, texture coordinates, generic
+// values) per vertex, face and corner (see attributes.cpp).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tsm/mesh.hpp"
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+// How an attribute's values become integers (FORMAT.md §8.12).
+enum class AttributeQuant : uint8_t {
+  exact = 0,       // integer types: the values are the integers
+  grid = 1,        // a uniform grid over the attribute's own bounding box (bits per component)
+  octahedral = 2,  // normals: two grid indices on the octahedron (bits each)
+};
+
+// What every part of a file states about an attribute (the same for all).
+struct AttributeHeader {
+  std::string name;
+  AttributeKind kind = AttributeKind::generic;
+  AttributeDomain domain = AttributeDomain::vertex;
+  AttributeType type = AttributeType::f32;
+  uint32_t components = 1;
+  AttributeQuant quant = AttributeQuant::exact;
+  int bits = 0;                  // grid and octahedral
+  float origin[4] = {0, 0, 0, 0};  // grid
+  double extent = 0;             // grid: largest extent of the values
+};
+
+struct AttributeBits {
+  int normal = 10, texcoord = 12, color = 10, generic = 16;
+};
+
+// The headers for a mesh's attributes (grids from all of their values).
+std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const AttributeBits& bits);
+
+// Encoder, one part: `part` is the part's input mesh (its faces and
+// attributes), `order` maps output vertex ids to part input vertex ids, `own`
+// marks output vertices coded in this part (empty: all), `faces` are the
+// part's faces as the decoder will output them (output vertex ids), `q` the
+// quantized positions of the own vertices (3 each, own-rank order) for
+// normal prediction. Vertex attributes cover the own vertices only.
+struct AttributeInput {
+  const Mesh* part = nullptr;
+  const std::vector<uint32_t>* order = nullptr;
+  const std::vector<uint8_t>* is_ref = nullptr;  // per output vertex, 1 = reference (may be empty)
+  const Mesh* faces = nullptr;
+  const std::vector<uint32_t>* q = nullptr;
+};
+Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out);
+
+// Decoder, one part: the attributes of its own vertices (output order), its
+// faces and corners (output order), each corner attribute with the part's own
+// value list.
+struct AttributePart {
+  const Mesh* faces = nullptr;                     // the part's decoded faces (part output ids)
+  const std::vector<uint32_t>* global = nullptr;   // per part vertex: kNone own, else a reference
+  const std::vector<uint32_t>* q = nullptr;        // own vertices' grid indices
+};
+Status decode_attributes(std::string_view bytes, const AttributePart& in, std::vector<Attribute>& out);
+
+// The integers a value is coded as (2 for octahedral, else the components):
+// the oracle compares attributes through them.
+uint32_t attribute_key_size(const AttributeHeader& h);
+void attribute_key(const AttributeHeader& h, const float* value, int32_t* out);
+
+// Float value of grid index x on component c of a grid attribute.
+float attribute_grid_value(const AttributeHeader& h, int c, int64_t x);
+
+}  // namespace tsm

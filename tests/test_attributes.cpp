@@ -1,0 +1,257 @@
+// Attributes (issue: normals, colours, texture coordinates): per vertex, per
+// face and per corner (seams and creases), through encode and decode, exact
+// up to each attribute's quantization; in segments and streamed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/tsm.hpp"
+
+using namespace tsm;
+using namespace tsm_test;
+
+namespace {
+
+Attribute make(const std::string& name, AttributeKind kind, AttributeDomain domain, AttributeType type, uint32_t comps) {
+  Attribute a;
+  a.name = name;
+  a.kind = kind;
+  a.domain = domain;
+  a.type = type;
+  a.components = comps;
+  return a;
+}
+
+// A sphere with unit normals, u8 RGB colours and spherical UVs per vertex.
+Mesh sphere_with_vertex_attributes(int level) {
+  Mesh m = icosphere(level);
+  Attribute n = make("normal", AttributeKind::normal, AttributeDomain::vertex, AttributeType::f32, 3);
+  Attribute c = make("color", AttributeKind::color, AttributeDomain::vertex, AttributeType::u8, 3);
+  Attribute t = make("texcoord", AttributeKind::texcoord, AttributeDomain::vertex, AttributeType::f32, 2);
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    const float* p = &m.positions[3 * v];
+    const float len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int k = 0; k < 3; ++k) n.values.push_back(p[k] / len);
+    for (int k = 0; k < 3; ++k) c.values.push_back(std::floor(127.5f * (p[k] / len + 1.0f)));
+    t.values.push_back(0.5f + std::atan2(p[1], p[0]) / 6.2831853f);
+    t.values.push_back(0.5f + std::asin(std::max(-1.0f, std::min(1.0f, p[2] / len))) / 3.1415927f);
+  }
+  m.attributes = {n, c, t};
+  return m;
+}
+
+// A cube of quads with flat normals per corner (6 values, creases), UVs per
+// corner with seams (a value list with duplicates and two unused entries) and
+// a colour and an integer id per face.
+Mesh cube_with_corner_attributes() {
+  Mesh m = cube_quads();
+  Attribute n = make("normal", AttributeKind::normal, AttributeDomain::corner, AttributeType::f32, 3);
+  Attribute t = make("texcoord", AttributeKind::texcoord, AttributeDomain::corner, AttributeType::f32, 2);
+  Attribute fc = make("color", AttributeKind::color, AttributeDomain::face, AttributeType::f32, 4);
+  Attribute id = make("part_id", AttributeKind::generic, AttributeDomain::face, AttributeType::i32, 1);
+  const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (size_t f = 0; f < m.face_count(); ++f) {
+    // Face normal from the first three corners.
+    const float* a = &m.positions[3 * m.face(f)[0]];
+    const float* b = &m.positions[3 * m.face(f)[1]];
+    const float* c = &m.positions[3 * m.face(f)[2]];
+    const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    for (float& x : nn) n.values.push_back(x / len);
+    for (uint32_t k = 0; k < m.face_size(f); ++k) {
+      n.indices.push_back(static_cast<uint32_t>(f));
+      t.indices.push_back(static_cast<uint32_t>(t.value_count()));
+      t.values.push_back(0.25f * static_cast<float>(f % 4) + 0.2f * uv[k][0]);
+      t.values.push_back(0.5f * static_cast<float>(f / 4) + 0.4f * uv[k][1]);
+    }
+    for (int k = 0; k < 4; ++k) fc.values.push_back(0.1f * static_cast<float>(f + k));
+    id.values.push_back(static_cast<float>(1000 * f) - 2000.0f);
+  }
+  t.values.insert(t.values.end(), {0.9f, 0.9f, 0.0f, 0.0f});  // two values no corner uses
+  m.attributes = {n, t, fc, id};
+  return m;
+}
+
+Mesh round_trip(const Mesh& m, uint32_t segment_faces = 0, int q = 14) {
+  EncodeOptions eo;
+  eo.quantization_bits = q;
+  eo.segment_faces = segment_faces;
+  std::string bytes;
+  Status s = encode(m, eo, bytes);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  Mesh back;
+  s = decode(bytes, back);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return back;
+}
+
+double max_error(const Attribute& a, const Attribute& b) {
+  // Values compared through the corners' or elements' own order is what the
+  // oracle does; here only the ranges: every decoded value near some original.
+  double worst = 0;
+  for (size_t j = 0; j < b.value_count(); ++j) {
+    double best = 1e30;
+    for (size_t i = 0; i < a.value_count(); ++i) {
+      double d = 0;
+      for (uint32_t c = 0; c < a.components; ++c)
+        d = std::max(d, std::fabs(double(a.values[a.components * i + c]) - b.values[b.components * j + c]));
+      best = std::min(best, d);
+    }
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(Attributes, VertexNormalsColoursAndUVsRoundTrip) {
+  const Mesh m = sphere_with_vertex_attributes(3);
+  ASSERT_TRUE(m.valid());
+  const Mesh back = round_trip(m);
+  CompareResult r = compare_meshes(m, back, 14);
+  EXPECT_TRUE(r.equal) << r.difference;
+  ASSERT_EQ(back.attributes.size(), 3u);
+  EXPECT_EQ(back.attributes[1].type, AttributeType::u8);
+  EXPECT_LT(max_error(m.attributes[0], back.attributes[0]), 4e-3);  // 10-bit octahedral normals (~0.2 degrees)
+  EXPECT_EQ(max_error(m.attributes[1], back.attributes[1]), 0.0);   // u8 colours exactly
+  EXPECT_LT(max_error(m.attributes[2], back.attributes[2]), 1.5e-4); // 12-bit UVs on [0, 1]
+}
+
+TEST(Attributes, CornerSeamsCreasesFaceValuesAndUnusedValuesRoundTrip) {
+  const Mesh m = cube_with_corner_attributes();
+  std::string why;
+  ASSERT_TRUE(m.valid(&why)) << why;
+  const Mesh back = round_trip(m);
+  CompareResult r = compare_meshes(m, back, 14);
+  EXPECT_TRUE(r.equal) << r.difference;
+  ASSERT_EQ(back.attributes.size(), 4u);
+  EXPECT_EQ(back.attributes[0].value_count(), 6u);   // one normal per face, shared by its corners
+  EXPECT_EQ(back.attributes[1].value_count(), 26u);  // 24 corner UVs and the 2 unused ones
+  std::vector<float> ids = back.attributes[3].values, expected = m.attributes[3].values;
+  std::sort(ids.begin(), ids.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(ids, expected) << "integer face ids, exactly (faces may come in another order)";
+}
+
+TEST(Attributes, OracleSeesADamagedAttribute) {
+  const Mesh m = cube_with_corner_attributes();
+  Mesh back = round_trip(m);
+  ASSERT_TRUE(compare_meshes(m, back, 14).equal);
+  Mesh merged = back;  // a seam closed: two corners now share one UV value
+  merged.attributes[1].indices[1] = merged.attributes[1].indices[0];
+  EXPECT_FALSE(compare_meshes(m, merged, 14).equal);
+  Mesh moved = back;
+  moved.attributes[0].values[0] = 0.6f;  // one face's normal turned
+  moved.attributes[0].values[1] = 0.8f;
+  moved.attributes[0].values[2] = 0.0f;
+  EXPECT_FALSE(compare_meshes(m, moved, 14).equal);
+  Mesh face = back;
+  face.attributes[3].values[2] += 1;
+  EXPECT_FALSE(compare_meshes(m, face, 14).equal);
+}
+
+TEST(Attributes, GeneratedFamiliesWithAttributes) {
+  std::mt19937 rng(8);
+  for (Mesh m : {genus_surface(2, 2), grid_with_holes(12, 3), random_soup(80, 120, 3), copies(icosphere(1), 4)}) {
+    Attribute c = make("color", AttributeKind::color, AttributeDomain::vertex, AttributeType::u8, 4);
+    Attribute g = make("weight", AttributeKind::generic, AttributeDomain::vertex, AttributeType::f32, 1);
+    Attribute t = make("texcoord", AttributeKind::texcoord, AttributeDomain::corner, AttributeType::f32, 2);
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      for (int k = 0; k < 4; ++k) c.values.push_back(static_cast<float>(rng() % 256));
+      g.values.push_back(static_cast<float>(rng() % 1000) / 7.0f);
+    }
+    for (size_t k = 0; k < m.corner_count(); ++k) {  // per corner, half of them shared with the vertex's value
+      if (rng() % 2) {
+        t.indices.push_back(m.indices[k]);
+      } else {
+        t.indices.push_back(static_cast<uint32_t>(m.vertex_count() + k));
+      }
+    }
+    for (size_t j = 0; j < m.vertex_count() + m.corner_count(); ++j) {
+      t.values.push_back(static_cast<float>(rng() % 4096) / 4095.0f);
+      t.values.push_back(static_cast<float>(rng() % 4096) / 4095.0f);
+    }
+    m.attributes = {c, g, t};
+    std::string why;
+    ASSERT_TRUE(m.valid(&why)) << why;
+    const Mesh back = round_trip(m);
+    CompareResult r = compare_meshes(m, back, 14);
+    EXPECT_TRUE(r.equal) << r.difference;
+  }
+}
+
+TEST(Attributes, VertexAndFaceAttributesInSegmentsAndStreamed) {
+  Mesh m = sphere_with_vertex_attributes(4);
+  Attribute fc = make("material", AttributeKind::generic, AttributeDomain::face, AttributeType::u16, 1);
+  for (size_t f = 0; f < m.face_count(); ++f) fc.values.push_back(static_cast<float>(f % 7));
+  m.attributes.push_back(fc);
+  EncodeOptions eo;
+  eo.segment_faces = 700;
+  std::string bytes;
+  ASSERT_TRUE(encode(m, eo, bytes).ok());
+  Mesh back;
+  ASSERT_TRUE(decode(bytes, back).ok());
+  CompareResult r = compare_meshes(m, back, 14);
+  EXPECT_TRUE(r.equal) << r.difference;
+  StreamDecoder sd;
+  for (size_t at = 0; at < bytes.size(); at += 333) ASSERT_TRUE(sd.feed(std::string_view(bytes).substr(at, 333)).ok());
+  ASSERT_TRUE(sd.finish().ok());
+  const Mesh& streamed = sd.mesh();
+  ASSERT_EQ(streamed.attributes.size(), back.attributes.size());
+  for (size_t i = 0; i < back.attributes.size(); ++i) EXPECT_EQ(streamed.attributes[i].values, back.attributes[i].values);
+}
+
+TEST(Attributes, NormalsPredictedFromTheGeometryAreSmall) {
+  const Mesh plain = icosphere(4);
+  const Mesh with = sphere_with_vertex_attributes(4);
+  Mesh normals_only = plain;
+  normals_only.attributes = {with.attributes[0]};
+  EncodeOptions eo;
+  std::string a, b;
+  ASSERT_TRUE(encode(plain, eo, a).ok());
+  ASSERT_TRUE(encode(normals_only, eo, b).ok());
+  const double bits_per_normal = 8.0 * static_cast<double>(b.size() - a.size()) / static_cast<double>(plain.vertex_count());
+  EXPECT_LT(bits_per_normal, 8.0) << "smooth sphere normals should cost well under 20 bits (10-bit octahedral)";
+  RecordProperty("bits_per_normal", std::to_string(bits_per_normal));
+  std::printf("sphere normals: %.2f bits per normal\n", bits_per_normal);
+}
+
+TEST(Attributes, EncoderRefusesBadAttributes) {
+  Mesh m = icosphere(1);
+  Attribute a = make("id", AttributeKind::generic, AttributeDomain::vertex, AttributeType::u8, 1);
+  a.values.assign(m.vertex_count(), 1.5f);  // not an integer
+  m.attributes = {a};
+  std::string bytes;
+  Status s = encode(m, EncodeOptions{}, bytes);
+  EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
+  EXPECT_NE(s.message().find("id"), std::string::npos) << s.message();
+  m.attributes[0].values.pop_back();  // wrong size
+  EXPECT_EQ(encode(m, EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+}
+
+TEST(Attributes, DamagedAttributeStreamsAreRefused) {
+  const Mesh m = cube_with_corner_attributes();
+  std::string bytes;
+  ASSERT_TRUE(encode(m, EncodeOptions{}, bytes).ok());
+  std::mt19937 rng(2);
+  int refused = 0;
+  for (int i = 0; i < 300; ++i) {
+    std::string bad = bytes;
+    bad[rng() % bad.size()] ^= static_cast<char>(1 << (rng() % 8));
+    Mesh back;
+    Status s = decode(bad, back);
+    if (!s.ok()) ++refused;
+    else EXPECT_TRUE(back.valid());
+  }
+  EXPECT_GT(refused, 280);
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    Mesh back;
+    EXPECT_FALSE(decode(bytes.substr(0, n), back).ok());
+  }
+}
