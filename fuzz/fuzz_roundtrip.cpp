@@ -3,7 +3,9 @@
 // deterministic. Any mismatch aborts.
 //
 // Input layout (make_seeds.cpp writes seeds in it):
-//   byte 0   quantization bits, 1 + b % 30
+//   byte 0   quantization bits, 1 + b % 30; bit 7: with attributes (a u8
+//            colour and a normal per vertex, an i32 per face, and when not in
+//            segments a texture coordinate per corner with seams)
 //   byte 1   level b % 10 (low nibble), position mode (b >> 4) % 4, bit 6:
 //            also check that a second encode gives the same bytes, bit 7:
 //            segments of at most 1 + byte 2 % 16 faces, also decoded
@@ -72,6 +74,42 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (at + n > size) break;
     for (uint32_t i = 0; i < n; ++i) corners[i] = data[at++] % nv;
     m.add_face(corners, n);
+  }
+  if (data[0] & 0x80) {
+    tsm::Attribute c, n, f, t;
+    c.name = "color";
+    c.kind = tsm::AttributeKind::color;
+    c.type = tsm::AttributeType::u8;
+    c.components = 3;
+    n.name = "normal";
+    n.kind = tsm::AttributeKind::normal;
+    n.components = 3;
+    for (uint32_t i = 0; i < nv; ++i) {
+      for (uint32_t k = 0; k < 3; ++k) c.values.push_back(static_cast<float>(mix(i * 7u + k) & 255));
+      for (uint32_t k = 0; k < 3; ++k) n.values.push_back(static_cast<float>(static_cast<int64_t>(mix(i * 5u + k) % 2001) - 1000));
+    }
+    f.name = "part";
+    f.domain = tsm::AttributeDomain::face;
+    f.type = tsm::AttributeType::i32;
+    for (size_t k = 0; k < m.face_count(); ++k) f.values.push_back(static_cast<float>(static_cast<int64_t>(mix(k) % 4001) - 2000));
+    m.attributes = {c, n, f};
+    // Corner values shared across a segment border are stored once per
+    // segment (FORMAT.md §10): the oracle would see the sharing differ.
+    if (!options.segment_faces) {
+      t.name = "texcoord";
+      t.kind = tsm::AttributeKind::texcoord;
+      t.domain = tsm::AttributeDomain::corner;
+      t.components = 2;
+      for (size_t k = 0; k < m.corner_count(); ++k) {
+        const uint64_t r = mix(k + 99);
+        t.indices.push_back(r & 1 ? m.indices[k] : nv + static_cast<uint32_t>(r % 5));
+      }
+      for (uint32_t j = 0; j < nv + 5; ++j) {
+        t.values.push_back(static_cast<float>(mix(j) % 1000) / 999.0f);
+        t.values.push_back(static_cast<float>(mix(j + 1000) % 1000) / 999.0f);
+      }
+      m.attributes.push_back(t);
+    }
   }
   if (!m.all_finite()) return 0;  // the encoder refuses those by design
   std::string bytes;
