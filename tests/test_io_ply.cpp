@@ -401,7 +401,7 @@ TEST(PlyRead, SkippedElementWithListBeforeFaces) {
   b.put(0.f).put(0.f).put(0.f).put(1.f).put(0.f).put(0.f).put(0.f).put(1.f).put(0.5f);
   b.put<uint8_t>(2).put<int32_t>(0).put<int32_t>(1).put<uint8_t>(255);
   b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).put<uint8_t>(7);
-  b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).put<uint8_t>(2).put(0.f).put(1.f);
+  b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).put<uint8_t>(6).put(0.f).put(0.f).put(1.f).put(0.f).put(0.f).put(1.f);
   b.put(0.25);
   Mesh mb;
   ReadInfo binfo;

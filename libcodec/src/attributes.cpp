@@ -50,8 +50,16 @@ void oct_encode(double x, double y, double z, int bits, int32_t out[2]) {
     y = (1 - std::fabs(ox)) * (oy >= 0 ? 1 : -1);
   }
   const double m = std::ldexp(1.0, bits) - 1;
-  out[0] = static_cast<int32_t>(std::floor((x * 0.5 + 0.5) * m + 0.5));
-  out[1] = static_cast<int32_t>(std::floor((y * 0.5 + 0.5) * m + 0.5));
+  int32_t u = static_cast<int32_t>(std::floor((x * 0.5 + 0.5) * m + 0.5));
+  int32_t v = static_cast<int32_t>(std::floor((y * 0.5 + 0.5) * m + 0.5));
+  // The square's border is folded onto itself: (u, 0) and (m - u, 0) are one
+  // direction, so are (0, v) and (0, m - v) (and the corners are (0, 0, -1)).
+  // One representative, so that a decoded normal keys as it was coded.
+  const int32_t top = static_cast<int32_t>(m);
+  if (v == 0 || v == top) u = std::min(u, top - u);
+  if (u == 0 || u == top) v = std::min(v, top - v);
+  out[0] = u;
+  out[1] = v;
 }
 
 void oct_decode(int32_t u, int32_t v, int bits, float out[3]) {

@@ -1,16 +1,37 @@
 // Wavefront OBJ reading and writing (file-format stage, not part of the
-// compression method): turns `v` and `f` records into a Mesh and back.
+// compression method): turns `v`, `vt`, `vn` and `f` records into a Mesh and
+// back.
 //
 // Reader: one pass over the bytes with TextCursor and std::from_chars, no
 // allocation per line. Positions are parsed straight to float (correctly
 // rounded, no double-to-float double rounding). Faces are kept exactly as
 // written: polygons of any size, faces of 1 or 2 corners, repeated corners.
-// Vertices no face references are kept. Texture and normal indices in the
-// `i/t`, `i//n` and `i/t/n` corner forms are checked for syntax and ignored
-// for now; `vt`, `vn`, `vp`, grouping and material records are ignored;
-// `l` and `p` records (lines and points) are skipped and counted; records
-// with unknown keywords are skipped with a note. A backslash at the end of a
-// line joins it with the next (except in comments).
+// Vertices no face references are kept. `vp`, grouping and material records
+// are ignored; `l` and `p` records (lines and points) are skipped and counted;
+// records with unknown keywords are skipped with a note. A backslash at the
+// end of a line joins it with the next (except in comments).
+//
+// Attributes (Mesh::attributes):
+//  - `vt u [v [w]]` and `vn x y z` lists, named by the `i/t`, `i//n` and
+//    `i/t/n` corner forms, become corner-domain attributes 'texcoord' (kind
+//    texcoord, 2 components) and 'normal' (kind normal, 3), type f32, with
+//    the file's value lists kept whole (file order, values no corner uses
+//    included) and one index per corner. When some vt has a w other than 0,
+//    the texture coordinates are kept whole as a generic corner attribute
+//    'texcoord3' of 3 components (u, v, w) instead, and a note says so.
+//  - OBJ lets some corners name a vt (or vn) and others not; Mesh has no
+//    "none" value, so such a list cannot be kept: it is dropped with a note
+//    naming a line of each kind (refusing the file would lose the whole
+//    mesh). vt / vn lists no corner names are dropped with a note.
+//  - `v x y z r g b` (exactly three numbers after x y z, a common extension)
+//    on every `v` line gives a vertex 'color' attribute (kind color, f32, 3
+//    components, the values as written). When only some `v` lines have them
+//    they are dropped with a note; other trailing numbers (w) are ignored.
+//  - vt / vn / colour values must be numbers (a missing u or a short vn is
+//    an error naming the line); NaN and infinity are refused unless
+//    ReadOptions::allow_nonfinite, as for positions. Indices follow the rules
+//    of vertex indices below, checked (at the end, naming the line) only for
+//    the lists that are kept.
 //
 // Index validation: index 0 is refused where it appears. Negative indices are
 // relative to the vertices defined so far (-1 = the last one) and must land on
@@ -22,7 +43,19 @@
 // Writer: `v x y z` with the shortest decimal text that reads back to the
 // same float (std::to_chars), `f` lines with 1-based indices. Reading the
 // result gives bit-identical positions and identical faces. (NaN payloads are
-// the one exception: NaN is written as "nan" or "-nan".)
+// the one exception: NaN is written as "nan" or "-nan".) Attributes: the
+// first texcoord attribute (or a 3-component 'texcoord3') becomes the `vt`
+// list and the first normal attribute the `vn` list, written as `f v/t/n`,
+// `v/t` or `v//n`: a corner-domain attribute with its value list as it is
+// and its indices, a vertex-domain one with one value per vertex (indexed by
+// the vertex), a face-domain one with one value per face. (They read back as
+// corner-domain attributes with the same value at every corner.) The first
+// vertex-domain colour is written as `v x y z r g b`: f32 values as they are,
+// u8 / u16 ones scaled to 0..1 (v / 255, v / 65535; OBJ colours are 0..1),
+// alpha dropped. Whatever OBJ cannot hold (other attributes, alpha) is named
+// in a `# tsm: not written` comment line. A mesh without attributes gives
+// the same bytes as before attributes existed.
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -91,8 +124,34 @@ class ObjReader {
     return p >= end_ || is_line_end(*p) || *p == '#';
   }
 
+  // Which vt (or vn) each corner names, while every corner names one.
+  struct CornerRefs {
+    enum class State { unknown, all, none, mixed };
+    CornerRefs(const char* w, const char* r) : what(w), record(r) {}
+    const char* what;    // "texture", "normal"
+    const char* record;  // "vt", "vn"
+    State state = State::unknown;
+    std::vector<uint32_t> index;  // per corner (state all)
+    size_t line_with = 0, line_without = 0;  // a line of each kind (notes)
+    size_t bad_line = 0;                     // first index that names no value
+    std::string bad;
+    // Faces with a positive index beyond the values seen at that point:
+    // (first corner, corners, line), checked at the end.
+    std::vector<std::array<size_t, 3>> forward;
+  };
+  struct Ref {
+    bool has = false;
+    int64_t raw = 0;
+  };
+
   Status parse_vertex(Mesh& mesh);
   Status parse_face(Mesh& mesh);
+  Status parse_values(const char* record, int min, int max, float* out, int& got);
+  Status parse_texcoord();
+  Status parse_normal();
+  void commit_refs(CornerRefs& r, const std::vector<Ref>& refs, size_t first_corner, size_t count);
+  Status check_refs(const CornerRefs& r, size_t count) const;
+  void finish_attributes(Mesh& mesh, std::vector<std::string>& notes);
   // Parses an optional-sign integer at p; returns the end or nullptr.
   const char* parse_index(const char* p, int64_t& v, bool& overflow) const {
     overflow = false;
@@ -122,7 +181,197 @@ class ObjReader {
   size_t lines_ = 0, points_ = 0;
   std::vector<std::pair<std::string, size_t>> unknown_;  // first few unknown keywords
   size_t unknown_other_ = 0;
+
+  std::vector<float> vt_;  // u, v, w of each vt
+  bool vt_w_ = false;      // some w is not 0
+  std::vector<float> vn_;  // x, y, z of each vn
+  CornerRefs vt_refs_{"texture", "vt"};
+  CornerRefs vn_refs_{"normal", "vn"};
+  std::vector<Ref> face_t_, face_n_;  // reused for every face
+  // Vertex colours: every v line so far has r g b (state all) or none has.
+  CornerRefs::State color_state_ = CornerRefs::State::unknown;
+  size_t color_line_with_ = 0, color_line_without_ = 0;
+  std::vector<float> colors_;
 };
+
+// Numbers after a vt / vn keyword: at least min, at most max (more are ignored).
+Status ObjReader::parse_values(const char* record, int min, int max, float* out, int& got) {
+  static const char* const kNames[2][3] = {{"u", "v", "w"}, {"x", "y", "z"}};
+  const bool tex = record[1] == 't';
+  got = 0;
+  for (int a = 0; a < max; ++a) {
+    skip_blanks_joined();
+    if (at_content_end()) break;
+    const char* s = cur_.position();
+    const size_t line = cur_.line();
+    if (!cur_.parse_float(out[a])) {
+      cur_.set_position(s, line);
+      return cur_.error(std::string("bad number ") + quote(token_at(s)) + " for the " + kNames[tex ? 0 : 1][a] +
+                        " of a '" + record + "' record");
+    }
+    if (!options_.allow_nonfinite && !std::isfinite(out[a]))
+      return cur_.error(std::string("non-finite ") + (tex ? "texture coordinate " : "normal component ") +
+                        quote(std::string_view(s, static_cast<size_t>(cur_.position() - s))) +
+                        " (NaN or infinity); use --allow-nonfinite to accept it");
+    ++got;
+  }
+  if (got < min)
+    return cur_.error(std::string("'") + record + "' record has no " + kNames[tex ? 0 : 1][got] + " value (expected " +
+                      (tex ? "'vt u [v [w]]'" : "'vn x y z'") + ")");
+  return Status::Ok();
+}
+
+Status ObjReader::parse_texcoord() {
+  float uvw[3] = {0, 0, 0};
+  int got;
+  TSM_RETURN_IF_ERROR(parse_values("vt", 1, 3, uvw, got));
+  if (vt_.size() / 3 >= kMaxIndexableVertices) return limit_error("texture coordinates", kMaxIndexableVertices);
+  if (uvw[2] != 0.0f) vt_w_ = true;
+  vt_.insert(vt_.end(), uvw, uvw + 3);
+  skip_record();
+  return Status::Ok();
+}
+
+Status ObjReader::parse_normal() {
+  float xyz[3];
+  int got;
+  TSM_RETURN_IF_ERROR(parse_values("vn", 3, 3, xyz, got));
+  if (vn_.size() / 3 >= kMaxIndexableVertices) return limit_error("normals", kMaxIndexableVertices);
+  vn_.insert(vn_.end(), xyz, xyz + 3);
+  skip_record();
+  return Status::Ok();
+}
+
+// Records the vt (vn) indices of one accepted face of `count` corners.
+void ObjReader::commit_refs(CornerRefs& r, const std::vector<Ref>& refs, size_t first_corner, size_t count) {
+  using State = CornerRefs::State;
+  const size_t line = cur_.line();
+  bool forward = false;
+  for (const Ref& ref : refs) {
+    if (r.state == State::mixed) return;
+    if (!ref.has) {
+      if (r.line_without == 0) r.line_without = line;
+      if (r.state == State::all) {
+        r.state = State::mixed;
+        r.index.clear();
+        r.index.shrink_to_fit();
+        r.forward.clear();
+        return;
+      }
+      r.state = State::none;
+      continue;
+    }
+    if (r.line_with == 0) r.line_with = line;
+    if (r.state == State::none) {
+      r.state = State::mixed;
+      return;
+    }
+    r.state = State::all;
+    // Resolve like a vertex index; problems are reported only if the list is kept.
+    uint32_t index = 0;
+    if (ref.raw == 0) {
+      if (r.bad.empty()) {
+        r.bad_line = line;
+        r.bad = std::string(r.what) + " index 0 in a face (OBJ indices start at 1; negative ones count back from the "
+                                      "last '" + r.record + "')";
+      }
+    } else if (ref.raw < 0) {
+      const uint64_t back = static_cast<uint64_t>(-(ref.raw + 1)) + 1;
+      if (back > count) {
+        if (r.bad.empty()) {
+          r.bad_line = line;
+          r.bad = "relative " + std::string(r.what) + " index " + std::to_string(ref.raw) + " reaches before the first '" +
+                  r.record + "' (" + std::to_string(count) + " defined so far)";
+        }
+      } else {
+        index = static_cast<uint32_t>(count - back);
+      }
+    } else if (static_cast<uint64_t>(ref.raw) > kMaxIndexableVertices) {
+      if (r.bad.empty()) {
+        r.bad_line = line;
+        r.bad = std::string(r.what) + " index " + std::to_string(ref.raw) + " is out of range";
+      }
+    } else {
+      index = static_cast<uint32_t>(ref.raw - 1);
+      if (index >= count) forward = true;
+    }
+    r.index.push_back(index);
+  }
+  if (forward) r.forward.push_back({first_corner, refs.size(), line});
+}
+
+// A list that is kept: every index must name one of its `count` values.
+Status ObjReader::check_refs(const CornerRefs& r, size_t count) const {
+  if (!r.bad.empty())
+    return Status(ErrorCode::parse_error, cur_.name() + ": line " + std::to_string(r.bad_line) + ": " + r.bad);
+  for (const auto& fw : r.forward)
+    for (size_t c = fw[0]; c < fw[0] + fw[1]; ++c)
+      if (r.index[c] >= count)
+        return Status(ErrorCode::parse_error,
+                      cur_.name() + ": line " + std::to_string(fw[2]) + ": " + r.what + " index " +
+                          std::to_string(static_cast<uint64_t>(r.index[c]) + 1) + " is out of range (the file has " +
+                          std::to_string(count) + " '" + r.record + "' records)");
+  return Status::Ok();
+}
+
+void ObjReader::finish_attributes(Mesh& mesh, std::vector<std::string>& notes) {
+  using State = CornerRefs::State;
+  if (color_state_ == State::all && !colors_.empty()) {
+    Attribute a;
+    a.name = "color";
+    a.kind = AttributeKind::color;
+    a.domain = AttributeDomain::vertex;
+    a.components = 3;
+    a.values = std::move(colors_);
+    mesh.attributes.push_back(std::move(a));
+  } else if (color_state_ == State::mixed) {
+    notes.push_back("ignored the vertex colours: line " + std::to_string(color_line_with_) +
+                    " has 'v x y z r g b' but line " + std::to_string(color_line_without_) +
+                    " has no colour (kept only when every vertex has one)");
+  }
+  struct List {
+    CornerRefs* refs;
+    std::vector<float>* values;
+  };
+  for (List l : {List{&vt_refs_, &vt_}, List{&vn_refs_, &vn_}}) {
+    CornerRefs& r = *l.refs;
+    const size_t count = l.values->size() / 3;
+    if (r.state == State::all) {
+      Attribute a;
+      a.domain = AttributeDomain::corner;
+      if (l.refs == &vn_refs_) {
+        a.name = "normal";
+        a.kind = AttributeKind::normal;
+        a.components = 3;
+        a.values = std::move(*l.values);
+      } else if (vt_w_) {
+        a.name = "texcoord3";
+        a.components = 3;
+        a.values = std::move(*l.values);
+        notes.push_back("texture coordinates with a w other than 0: kept as the generic 3-component corner "
+                        "attribute 'texcoord3' (u, v, w)");
+      } else {
+        a.name = "texcoord";
+        a.kind = AttributeKind::texcoord;
+        a.components = 2;
+        a.values.resize(2 * count);
+        for (size_t i = 0; i < count; ++i) {
+          a.values[2 * i] = (*l.values)[3 * i];
+          a.values[2 * i + 1] = (*l.values)[3 * i + 1];
+        }
+      }
+      a.indices = std::move(r.index);
+      mesh.attributes.push_back(std::move(a));
+    } else if (r.state == State::mixed) {
+      notes.push_back(std::string("ignored the ") + r.what + " indices and '" + r.record + "' records: line " +
+                      std::to_string(r.line_with) + " has a face corner with a " + r.what + " index but line " +
+                      std::to_string(r.line_without) + " has one without (kept only when every corner has one)");
+    } else if (count > 0) {
+      notes.push_back("ignored " + std::to_string(count) + " '" + r.record + "' record" + (count == 1 ? "" : "s") +
+                      " (no face corner uses them)");
+    }
+  }
+}
 
 Status ObjReader::parse_vertex(Mesh& mesh) {
   static const char* const kAxis[3] = {"x", "y", "z"};
@@ -145,13 +394,56 @@ Status ObjReader::parse_vertex(Mesh& mesh) {
   const size_t n = mesh.vertex_count();
   if (options_.max_vertices != 0 && n >= options_.max_vertices) return limit_error("vertices", options_.max_vertices);
   if (n >= kMaxIndexableVertices) return limit_error("vertices", kMaxIndexableVertices);
+  // Exactly three more numbers: r g b (a common extension). Anything else
+  // after x y z (a w, text) is ignored as before.
+  using State = CornerRefs::State;
+  float rgb[3] = {0, 0, 0};
+  int extra = 0;
+  bool other = false;
+  const char* first_extra = nullptr;
+  for (;;) {
+    skip_blanks_joined();
+    if (at_content_end()) break;
+    if (!first_extra) first_extra = cur_.position();
+    float x;
+    if (extra == 3 || !cur_.parse_float(x)) {
+      other = true;
+      break;
+    }
+    rgb[extra++] = x;
+  }
+  const bool has_color = extra == 3 && !other;
+  if (has_color) {
+    if (!options_.allow_nonfinite && !(std::isfinite(rgb[0]) && std::isfinite(rgb[1]) && std::isfinite(rgb[2])))
+      return cur_.error("non-finite vertex colour " +
+                        quote(std::string_view(first_extra, static_cast<size_t>(cur_.position() - first_extra))) +
+                        " (NaN or infinity); use --allow-nonfinite to accept it");
+    if (color_line_with_ == 0) color_line_with_ = cur_.line();
+    if (color_state_ == State::none) {
+      color_state_ = State::mixed;
+    } else if (color_state_ != State::mixed) {
+      color_state_ = State::all;
+      colors_.insert(colors_.end(), rgb, rgb + 3);
+    }
+  } else {
+    if (color_line_without_ == 0) color_line_without_ = cur_.line();
+    if (color_state_ == State::all) {
+      color_state_ = State::mixed;
+      colors_.clear();
+      colors_.shrink_to_fit();
+    } else if (color_state_ == State::unknown) {
+      color_state_ = State::none;
+    }
+  }
   mesh.add_vertex(xyz[0], xyz[1], xyz[2]);
-  skip_record();  // w, colours, comments
+  skip_record();  // w, comments
   return Status::Ok();
 }
 
 Status ObjReader::parse_face(Mesh& mesh) {
   corners_.clear();
+  face_t_.clear();
+  face_n_.clear();
   const size_t nv = mesh.vertex_count();
   bool forward = false;
   for (;;) {
@@ -163,21 +455,24 @@ Status ObjReader::parse_face(Mesh& mesh) {
     const char* p = parse_index(s, v, overflow);
     if (!p) return cur_.error("bad vertex index " + quote(token_at(s)) + " in a face");
     if (overflow) return cur_.error("vertex index " + quote(token_at(s)) + " is out of range");
-    // Optional /t, //n or /t/n: integers, checked for syntax only.
+    // Optional /t, //n or /t/n (resolved once the face is accepted).
+    Ref t, nn;
     if (p < end_ && *p == '/') {
       ++p;
       if (p < end_ && *p != '/' && !TextCursor::is_space(*p)) {
-        int64_t t;
-        p = parse_index(p, t, overflow);
+        p = parse_index(p, t.raw, overflow);
         if (!p || overflow) return cur_.error("bad texture index in face corner " + quote(token_at(s)));
+        t.has = true;
       }
       if (p < end_ && *p == '/') {
         ++p;
-        int64_t nn;
-        p = parse_index(p, nn, overflow);
+        p = parse_index(p, nn.raw, overflow);
         if (!p || overflow) return cur_.error("bad normal index in face corner " + quote(token_at(s)));
+        nn.has = true;
       }
     }
+    face_t_.push_back(t);
+    face_n_.push_back(nn);
     if (p < end_ && !TextCursor::is_space(*p))
       return cur_.error("malformed face corner " + quote(token_at(s)) + " (expected i, i/t, i//n or i/t/n)");
     uint32_t index;
@@ -206,6 +501,8 @@ Status ObjReader::parse_face(Mesh& mesh) {
   if (mesh.indices.size() + corners_.size() > std::numeric_limits<uint32_t>::max())
     return limit_error("face corners in all", std::numeric_limits<uint32_t>::max());
   if (forward) forward_faces_.emplace_back(f, cur_.line());
+  commit_refs(vt_refs_, face_t_, mesh.indices.size(), vt_.size() / 3);
+  commit_refs(vn_refs_, face_n_, mesh.indices.size(), vn_.size() / 3);
   mesh.add_face(corners_.data(), corners_.size());
   skip_record();  // a trailing comment, the line end
   return Status::Ok();
@@ -229,7 +526,11 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
       TSM_RETURN_IF_ERROR(parse_vertex(mesh));
     } else if (key == "f") {
       TSM_RETURN_IF_ERROR(parse_face(mesh));
-    } else if (key == "vt" || key == "vn" || key == "vp" || key == "o" || key == "g" || key == "s" ||
+    } else if (key == "vt") {
+      TSM_RETURN_IF_ERROR(parse_texcoord());
+    } else if (key == "vn") {
+      TSM_RETURN_IF_ERROR(parse_normal());
+    } else if (key == "vp" || key == "o" || key == "g" || key == "s" ||
                key == "usemtl" || key == "mtllib" || key == "mg" || key == "usemap" || key == "maplib" ||
                key == "lod" || key == "bevel" || key == "c_interp" || key == "d_interp" ||
                key == "shadow_obj" || key == "trace_obj" || key == "ctech" || key == "stech") {
@@ -270,6 +571,12 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
                           std::to_string(nv) + " vertices)");
   }
 
+  // vt / vn indices of the lists that are kept.
+  if (vt_refs_.state == CornerRefs::State::all) TSM_RETURN_IF_ERROR(check_refs(vt_refs_, vt_.size() / 3));
+  if (vn_refs_.state == CornerRefs::State::all) TSM_RETURN_IF_ERROR(check_refs(vn_refs_, vn_.size() / 3));
+  std::vector<std::string> attribute_notes;
+  finish_attributes(mesh, attribute_notes);
+
   if (info) {
     info->skipped_elements = lines_ + points_;
     std::string notes;
@@ -277,6 +584,7 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
       if (!notes.empty()) notes += "; ";
       notes += s;
     };
+    for (const std::string& n : attribute_notes) add(n);
     if (lines_ + points_ > 0) {
       std::string s = "skipped ";
       if (lines_) s += std::to_string(lines_) + " 'l' records";
@@ -325,13 +633,47 @@ Status write_obj(const Mesh& mesh, std::string& out) {
     if (mesh.face_size(f) == 0)
       return Status(ErrorCode::invalid_argument,
                     "cannot write OBJ: face " + std::to_string(f) + " has no corners (OBJ cannot express it)");
+  // What OBJ can hold: one vt list, one vn list, r g b per vertex.
+  const Attribute* tex = nullptr;
+  const Attribute* nrm = nullptr;
+  const Attribute* col = nullptr;
+  for (const Attribute& a : mesh.attributes)
+    if (!tex && a.kind == AttributeKind::texcoord) tex = &a;
+  for (const Attribute& a : mesh.attributes)
+    if (!tex && a.kind == AttributeKind::generic && a.name == "texcoord3" && a.components == 3) tex = &a;
+  for (const Attribute& a : mesh.attributes) {
+    if (!nrm && a.kind == AttributeKind::normal) nrm = &a;
+    if (!col && a.kind == AttributeKind::color && a.domain == AttributeDomain::vertex) col = &a;
+  }
+  std::string dropped;
+  for (size_t k = 0; k < mesh.attributes.size(); ++k) {
+    const Attribute& a = mesh.attributes[k];
+    if (&a == tex || &a == nrm || (&a == col && a.components == 3)) continue;
+    static const char* const kDomain[3] = {"vertex", "face", "corner"};
+    dropped += dropped.empty() ? "" : ", ";
+    dropped += &a == col ? "the alpha of " : "";
+    dropped += std::string(kDomain[static_cast<size_t>(a.domain) % 3]) + " attribute '" + a.name + "'";
+  }
+
   out.clear();
-  out.reserve(mesh.vertex_count() * 36 + mesh.corner_count() * 8 + mesh.face_count() * 3 + 64);
+  out.reserve(mesh.vertex_count() * (col ? 60 : 36) + mesh.corner_count() * (tex || nrm ? 20 : 8) +
+              mesh.face_count() * 3 + 64);
   out += "# tsm: " + std::to_string(mesh.vertex_count()) + " vertices, " + std::to_string(mesh.face_count()) +
          " faces\n";
-  char buf[128];
+  // Names can hold anything: keep the comment on one line.
+  if (!dropped.empty()) {
+    for (char& c : dropped)
+      if (c == '\n' || c == '\r') c = ' ';
+    out += "# tsm: not written (OBJ cannot hold them): " + dropped + "\n";
+  }
+  char buf[256];
   char* const bend = buf + sizeof buf;
   const float* pos = mesh.positions.data();
+  // OBJ colours are 0..1: integer types are scaled.
+  const float col_scale = !col                               ? 1.0f
+                          : col->type == AttributeType::u8  ? 255.0f
+                          : col->type == AttributeType::u16 ? 65535.0f
+                                                            : 1.0f;
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     char* p = buf;
     *p++ = 'v';
@@ -339,17 +681,58 @@ Status write_obj(const Mesh& mesh, std::string& out) {
       *p++ = ' ';
       p = put_float(p, bend, pos[3 * v + static_cast<size_t>(a)]);
     }
+    if (col) {
+      for (uint32_t a = 0; a < 3; ++a) {
+        *p++ = ' ';
+        const float x = col->values[v * col->components + a];
+        p = put_float(p, bend, col_scale == 1.0f ? x : static_cast<float>(static_cast<double>(x) / col_scale));
+      }
+    }
     *p++ = '\n';
     out.append(buf, static_cast<size_t>(p - buf));
   }
+  auto put_list = [&](const Attribute* a, const char* key) {
+    if (!a) return;
+    const size_t n = a->value_count();
+    for (size_t i = 0; i < n; ++i) {
+      char* p = buf;
+      for (const char* k = key; *k; ++k) *p++ = *k;
+      for (uint32_t c = 0; c < a->components; ++c) {
+        *p++ = ' ';
+        p = put_float(p, bend, a->values[i * a->components + c]);
+      }
+      *p++ = '\n';
+      out.append(buf, static_cast<size_t>(p - buf));
+    }
+  };
+  put_list(tex, "vt");
+  put_list(nrm, "vn");
+  // The value a vt / vn list gives corner c (of face f, vertex v), 1-based.
+  auto ref = [](const Attribute* a, size_t c, size_t f, uint32_t v) -> uint64_t {
+    switch (a->domain) {
+      case AttributeDomain::vertex: return static_cast<uint64_t>(v) + 1;
+      case AttributeDomain::face: return static_cast<uint64_t>(f) + 1;
+      case AttributeDomain::corner: break;
+    }
+    return static_cast<uint64_t>(a->indices[c]) + 1;
+  };
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     const uint32_t* c = mesh.face(f);
     const uint32_t n = mesh.face_size(f);
+    const size_t first = mesh.face_offsets[f];
     out.push_back('f');
     for (uint32_t i = 0; i < n; ++i) {
       char* p = buf;
       *p++ = ' ';
       p = std::to_chars(p, bend, static_cast<uint64_t>(c[i]) + 1).ptr;
+      if (tex || nrm) {
+        *p++ = '/';
+        if (tex) p = std::to_chars(p, bend, ref(tex, first + i, f, c[i])).ptr;
+        if (nrm) {
+          *p++ = '/';
+          p = std::to_chars(p, bend, ref(nrm, first + i, f, c[i])).ptr;
+        }
+      }
       out.append(buf, static_cast<size_t>(p - buf));
     }
     out.push_back('\n');
