@@ -181,6 +181,8 @@ MeshFormat parse_format(const std::string& s) {
   if (s == "obj") return MeshFormat::obj;
   if (s == "stl") return MeshFormat::stl;
   if (s == "off") return MeshFormat::off;
+  if (s == "gltf") return MeshFormat::gltf;
+  if (s == "glb") return MeshFormat::glb;
   return MeshFormat::unknown;
 }
 
@@ -192,8 +194,13 @@ std::string lower(std::string s) {
 
 // A mesh from bytes: the format the user named, else content, else extension.
 Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
-                  const ReadOptions& ro, ReadInfo& info) {
+                  const ReadOptions& read_options, ReadInfo& info) {
   const std::string name = shown_input(input);
+  ReadOptions ro = read_options;  // a .gltf file's buffers may be files beside it
+  if (input != "-" && ro.external_files_dir.empty()) {
+    const std::string dir = fs::path(input).parent_path().string();
+    ro.external_files_dir = dir.empty() ? "." : dir;
+  }
   if (forced == MeshFormat::unknown) {
     if (input == "-" && bytes.empty())
       return Status(ErrorCode::parse_error, name + ": no data (stdin was empty)");
@@ -210,6 +217,8 @@ Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat f
     case MeshFormat::obj: return read_obj(bytes, name, mesh, ro, &info);
     case MeshFormat::stl: return read_stl(bytes, name, mesh, ro, &info);
     case MeshFormat::off: return read_off(bytes, name, mesh, ro, &info);
+    case MeshFormat::gltf:
+    case MeshFormat::glb: return read_gltf(bytes, name, mesh, ro, &info);
     case MeshFormat::unknown: break;
   }
   return Status(ErrorCode::internal, name + ": no reader for the format");
@@ -362,6 +371,8 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   std::string out;
   if (format == MeshFormat::obj) {
     s = write_obj(mesh, out);
+  } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
+    s = write_gltf(mesh, WriteOptions(), out, format == MeshFormat::glb);
   } else {
     WriteOptions wo;
     wo.ascii = a.ascii;
@@ -487,7 +498,10 @@ int cmd_encode(const EncodeArgs& a) {
 int cmd_decode(const DecodeArgs& a) {
   install_signal_guard();
   const MeshFormat wanted = parse_format(lower(a.format));
-  const std::string ext = wanted == MeshFormat::obj ? ".obj" : ".ply";
+  const std::string ext = wanted == MeshFormat::obj    ? ".obj"
+                          : wanted == MeshFormat::gltf ? ".gltf"
+                          : wanted == MeshFormat::glb  ? ".glb"
+                                                       : ".ply";
   std::vector<Job> jobs;
   if (int rc = plan_outputs(a.inputs, a.output, ext, a.force, "a .tsm file", jobs)) return rc;
   // One output format for the run: --format, else the extension of -o FILE, else PLY.
@@ -499,11 +513,12 @@ int cmd_decode(const DecodeArgs& a) {
       if (by_name != MeshFormat::unknown && by_name != wanted)
         return usage_error(j.output + ": the name says " + mesh_format_name(by_name) + " but --format says " +
                            mesh_format_name(wanted) + "; drop one of them");
-    } else if (by_name == MeshFormat::ply || by_name == MeshFormat::obj) {
+    } else if (by_name == MeshFormat::ply || by_name == MeshFormat::obj || by_name == MeshFormat::gltf ||
+               by_name == MeshFormat::glb) {
       format = by_name;  // only a single -o FILE can name another format than .ply
     } else {
       j.refused = Status(ErrorCode::invalid_argument,
-                         j.output + ": output must end in .ply or .obj (or pass --format ply|obj)");
+                         j.output + ": output must end in .ply, .obj, .gltf or .glb (or pass --format ply|obj|gltf|glb)");
     }
   }
   const bool to_stdout = jobs.size() == 1 && jobs[0].output == "-";
@@ -512,6 +527,9 @@ int cmd_decode(const DecodeArgs& a) {
   if (to_stdout && format == MeshFormat::ply && !a.ascii && is_terminal(stdout))
     return usage_error("refusing to write binary PLY to a terminal; redirect stdout (> out.ply), pipe it, or pass "
                        "--ascii or --format obj for text");
+  if (to_stdout && format == MeshFormat::glb && is_terminal(stdout))
+    return usage_error("refusing to write binary GLB to a terminal; redirect stdout (> out.glb), pipe it, or pass "
+                       "--format gltf for text");
   BatchOptions bo;
   bo.jobs = effective_jobs(a.jobs);
   bo.quiet = a.quiet;

@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
-      ->check(CLI::IsMember({"ply", "obj", "stl", "off"}, CLI::ignore_case));
+      ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--allow-nonfinite", ea.allow_nonfinite, "Read NaN/inf coordinates (the encoder still refuses them)");
   add_batch_options(enc, ea, true);
@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
                   "Output: a .ply/.obj file (one input), a folder (DIR/, or several inputs: DIR/NAME.ply), or - for "
                   "stdout (default: beside each input, NAME.ply; stdout for stdin)");
   dec->add_option("--format", da.format, "Output format (default: the extension of -o FILE, else ply)")
-      ->check(CLI::IsMember({"ply", "obj"}, CLI::ignore_case));
+      ->check(CLI::IsMember({"ply", "obj", "gltf", "glb"}, CLI::ignore_case));
   dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
   dec->add_flag("-f,--force", da.force, "Overwrite existing output files (never an input)");
   dec->add_option("--max-vertices", da.max_vertices, "Refuse files with more vertices (memory bound)")

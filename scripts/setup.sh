@@ -9,6 +9,8 @@ PACKAGES=(
   g++ cmake ninja-build pkg-config git ca-certificates
   # core library
   libzstd-dev libeigen3-dev libxxhash-dev
+  # glTF reading and writing (tinygltf's header, compiled in; its JSON library)
+  libtinygltf-dev nlohmann-json3-dev
   # command-line tool
   libcli11-dev
   # tests (and the sanitizer build's runtime comes with gcc)

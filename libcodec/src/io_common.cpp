@@ -47,6 +47,8 @@ const char* mesh_format_name(MeshFormat format) {
     case MeshFormat::obj: return "OBJ";
     case MeshFormat::stl: return "STL";
     case MeshFormat::off: return "OFF";
+    case MeshFormat::gltf: return "glTF";
+    case MeshFormat::glb: return "GLB";
     case MeshFormat::unknown: break;
   }
   return "unknown";
@@ -57,10 +59,21 @@ MeshFormat format_from_extension(std::string_view path) {
   if (ends_with_ci(path, ".obj")) return MeshFormat::obj;
   if (ends_with_ci(path, ".stl")) return MeshFormat::stl;
   if (ends_with_ci(path, ".off")) return MeshFormat::off;
+  if (ends_with_ci(path, ".gltf")) return MeshFormat::gltf;
+  if (ends_with_ci(path, ".glb")) return MeshFormat::glb;
   return MeshFormat::unknown;
 }
 
 MeshFormat sniff_format(std::string_view bytes) {
+  if (bytes.substr(0, 4) == "glTF") return MeshFormat::glb;
+  {
+    // .gltf: a JSON object (after an optional UTF-8 byte order mark and
+    // blanks) with an "asset" member somewhere.
+    size_t k = bytes.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
+    while (k < bytes.size() && (bytes[k] == ' ' || bytes[k] == '\t' || bytes[k] == '\n' || bytes[k] == '\r')) ++k;
+    if (k < bytes.size() && bytes[k] == '{' && bytes.find("\"asset\"", k) != std::string_view::npos)
+      return MeshFormat::gltf;
+  }
   if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" &&
       (bytes[3] == '\n' || bytes[3] == '\r' || bytes[3] == ' ' || bytes[3] == '\t'))
     return MeshFormat::ply;
@@ -186,16 +199,25 @@ Status read_mesh_from_memory(std::string_view bytes, const std::string& name, Me
     case MeshFormat::obj: return read_obj(bytes, name, out, options, info);
     case MeshFormat::stl: return read_stl(bytes, name, out, options, info);
     case MeshFormat::off: return read_off(bytes, name, out, options, info);
+    case MeshFormat::gltf:
+    case MeshFormat::glb: return read_gltf(bytes, name, out, options, info);
     case MeshFormat::unknown: break;
   }
   return Status(ErrorCode::parse_error,
-                name + ": unknown mesh format (expected PLY, OBJ, STL or OFF; the content did not match any and the "
-                       "extension did not say)");
+                name + ": unknown mesh format (expected PLY, OBJ, STL, OFF or glTF; the content did not match any and "
+                       "the extension did not say)");
 }
 
 Status read_mesh(const std::string& path, Mesh& out, const ReadOptions& options, ReadInfo* info) {
   std::string bytes;
   TSM_RETURN_IF_ERROR(read_file(path, bytes));
+  if (options.external_files_dir.empty()) {
+    // A .gltf file's buffers may be files beside it.
+    ReadOptions o = options;
+    const size_t slash = path.find_last_of('/');
+    o.external_files_dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+    return read_mesh_from_memory(bytes, path, out, o, info, format_from_extension(path));
+  }
   return read_mesh_from_memory(bytes, path, out, options, info, format_from_extension(path));
 }
 
@@ -208,9 +230,12 @@ Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions&
     TSM_RETURN_IF_ERROR(write_ply(mesh, options, bytes));
   } else if (format == MeshFormat::obj) {
     TSM_RETURN_IF_ERROR(write_obj(mesh, bytes));
+  } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
+    Status s = write_gltf(mesh, options, bytes, format == MeshFormat::glb);
+    if (!s.ok()) return Status(s.code(), path + ": " + s.message());
   } else {
     return Status(ErrorCode::invalid_argument,
-                  path + ": cannot write this format; use a .ply or .obj file name");
+                  path + ": cannot write this format; use a .ply, .obj, .gltf or .glb file name");
   }
   return write_file_atomic(path, bytes);
 }

@@ -1,4 +1,5 @@
-// tsm: mesh file readers and writers (PLY, OBJ, STL, OFF in; PLY, OBJ out).
+// tsm: mesh file readers and writers (PLY, OBJ, STL, OFF, glTF in; PLY, OBJ,
+// glTF out).
 //
 // Readers report bad input with the file name, the line (text formats) or
 // byte offset (binary formats) and what is wrong. Writers never leave a
@@ -12,13 +13,15 @@
 
 namespace tsm {
 
-enum class MeshFormat { unknown, ply, obj, stl, off };
+// gltf: JSON (.gltf), glb: binary glTF (.glb); one reader takes both.
+enum class MeshFormat { unknown, ply, obj, stl, off, gltf, glb };
 
 const char* mesh_format_name(MeshFormat format);
-// By file extension (case-insensitive): .ply .obj .stl .off.
+// By file extension (case-insensitive): .ply .obj .stl .off .gltf .glb.
 MeshFormat format_from_extension(std::string_view path);
-// By content: "ply\n", "OFF", binary STL size check, "solid", else OBJ-like
-// text. Returns unknown when nothing fits.
+// By content: "glTF" (GLB magic), a JSON object with an "asset" member
+// (.gltf), "ply\n", "OFF", binary STL size check, "solid". Returns unknown
+// when nothing fits (OBJ has no signature).
 MeshFormat sniff_format(std::string_view bytes);
 
 struct ReadOptions {
@@ -31,6 +34,12 @@ struct ReadOptions {
   // what the file size can hold).
   size_t max_vertices = 0;
   size_t max_faces = 0;
+  // glTF: the folder in which a .gltf file's external buffers ("uri":
+  // "mesh.bin", relative names only, regular files only) are looked up.
+  // Empty: external buffers are refused (data-URI and GLB buffers need no
+  // files), so reading from memory never touches the file system unless
+  // asked to. read_mesh sets it to the folder of the file it reads.
+  std::string external_files_dir;
 };
 
 struct ReadInfo {
@@ -57,16 +66,32 @@ Status read_stl(std::string_view bytes, const std::string& name, Mesh& out,
                 const ReadOptions& options, ReadInfo* info);
 Status read_off(std::string_view bytes, const std::string& name, Mesh& out,
                 const ReadOptions& options, ReadInfo* info);
+// glTF 2.0, .gltf or .glb (told apart by content): the triangles of the
+// meshes of the default scene, concatenated, with their vertex attributes
+// (NORMAL -> "normal", TEXCOORD_n -> "texcoord<n>", COLOR_0 -> "color",
+// others under their glTF name); node transforms are not applied; what is
+// not kept (materials, textures, ...) is listed in ReadInfo::notes. See
+// io_gltf.cpp.
+Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out,
+                 const ReadOptions& options, ReadInfo* info);
 
 struct WriteOptions {
   bool ascii = false;  // PLY only: binary little endian by default
 };
 
-// Writes by extension (.ply or .obj), atomically.
+// Writes by extension (.ply, .obj, .gltf or .glb), atomically.
 Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options = {});
 // Serializers (to memory).
 Status write_ply(const Mesh& mesh, const WriteOptions& options, std::string& out);
 Status write_obj(const Mesh& mesh, std::string& out);
+// glTF 2.0: binary (.glb) or JSON with the buffer as a data URI (.gltf). One
+// triangle primitive (a points primitive when there are no faces) with
+// POSITION, NORMAL, TEXCOORD_n, COLOR_n (u8 / u16 colours as normalized
+// unsigned byte / short) and other vertex attributes as "_name". Refuses
+// (ErrorCode::unsupported) faces that are not triangles, face and corner
+// attributes (glTF would need split vertices: write PLY or OBJ) and
+// non-finite positions.
+Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary);
 
 // Whole-file helpers used by readers, writers and the CLI.
 Status read_file(const std::string& path, std::string& out);

@@ -1,0 +1,1421 @@
+// glTF 2.0 reader and writer (file-format stage, not part of the compression
+// method): .gltf (JSON with data-URI or external buffers) and .glb (binary
+// container) to a tsm::Mesh and back, through Debian's tinygltf (JSON and
+// container parsing, JSON writing) with nlohmann-json. Images are never
+// decoded (no stb): tinygltf is built here without image loading, and image
+// bytes are dropped.
+//
+// Reading
+//   - The meshes instanced by the nodes of the default scene (`scene`, else
+//     scene 0; every mesh when the file has no scene), each mesh once however
+//     many nodes use it, in the order the node tree (depth first) meets them.
+//     Node transforms are NOT applied: positions are kept as stored. Several
+//     meshes / primitives are concatenated into one tsm::Mesh (noted).
+//   - Triangles (mode 4) as stored, degenerate ones included; strips (5) and
+//     fans (6) become triangles with the winding the spec gives, dropping the
+//     degenerate triangles strips use for stitching (noted). Points and lines
+//     (modes 0..3): their vertices are kept (as vertices no face uses, like
+//     OBJ's `v` records next to `l` ones), the points and lines are skipped
+//     and counted in ReadInfo::skipped_elements.
+//   - POSITION -> positions; NORMAL -> vertex attribute "normal";
+//     TEXCOORD_n -> "texcoord<n>"; COLOR_0 -> "color", COLOR_n -> "color<n>"
+//     (normalized unsigned byte / short -> type u8 / u16 holding 0..255 /
+//     0..65535, float -> f32); any other attribute (TANGENT, JOINTS_n,
+//     WEIGHTS_n, _CUSTOM) -> a generic vertex attribute under its glTF name
+//     (float -> f32, unsigned byte / short -> u8 / u16 integers, byte / short
+//     -> i32 integers). Normalized or integer normals and texture
+//     coordinates (KHR_mesh_quantization) become floats as the spec decodes
+//     them. Primitives sharing the same vertex accessors share vertices.
+//     When primitives disagree on attributes, missing values are filled
+//     (zeros; colours opaque white) and differing types widened (noted).
+//   - Indices of any unsigned type; none: 0..n-1.
+//   - Everything else (materials, textures, images, samplers, animations,
+//     skins, cameras, morph targets, extensions) is dropped and listed in
+//     ReadInfo::notes.
+//
+// Not read: Draco (KHR_draco_mesh_compression) and meshopt
+// (EXT_meshopt_compression) compressed data, refused with ErrorCode::
+// unsupported when the file requires them (a primitive that only offers
+// Draco beside an uncompressed copy is read from the copy). NaN / infinite
+// float values are refused unless ReadOptions::allow_nonfinite.
+//
+// Robustness: the GLB container is checked here before tinygltf sees it, the
+// JSON nesting depth is bounded (tinygltf walks `extras` recursively), and
+// every accessor (dense and sparse) is checked against its buffer view and
+// buffer before a byte is read: types, strides, offsets, counts, sparse
+// indices, vertex indices. What the primitives produce is bounded by a small
+// multiple of the input's bytes (accessors reused by many primitives cannot
+// blow up memory), and by ReadOptions::max_vertices / max_faces. External
+// buffer files are read only from ReadOptions::external_files_dir (set by
+// read_mesh to the file's folder), only regular files, never otherwise.
+//
+// Writing: one mesh, one primitive, one buffer (GLB: the BIN chunk; .gltf: a
+// base64 data URI). Triangles only: a mesh with other faces is refused
+// (write PLY or OBJ to keep polygons) rather than silently triangulated. A
+// mesh with vertices but no faces is written as a points primitive (which
+// reads back as the same vertices). POSITION with min / max, NORMAL,
+// TEXCOORD_0.. (numbered in order), COLOR_0.. (u8 / u16 colours as
+// normalized unsigned byte / short, padded to 4-byte elements), other
+// vertex attributes as custom `_name` semantics (names that are glTF
+// semantics already, or start with '_', are kept; f32 and i32 as float, u8 /
+// u16 as unsigned byte / short, normalized for WEIGHTS_n only). The empty
+// mesh is written as a file without scene or mesh (glTF has no empty
+// primitive). Indices are uint16 when every vertex index fits (< 65535),
+// else uint32. Face and corner attributes cannot be expressed without
+// splitting vertices, which tsm does not do silently: they are refused (PLY
+// or OBJ keep them), as are non-finite positions (POSITION min / max must be
+// numbers).
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#define TINYGLTF_NO_FS  // file access only through the callbacks below
+#include <fstream>      // tinygltf 2.7's file writers need it even without its file system
+#include <tiny_gltf.h>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <new>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <vector>
+
+#include "tsm/io.hpp"
+
+#ifndef TSM_VERSION
+#define TSM_VERSION "unknown"
+#endif
+
+namespace tsm {
+
+namespace {
+
+constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE;
+constexpr int kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;
+constexpr int kUShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+constexpr int kUInt = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+
+constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;
+constexpr uint32_t kChunkBin = 0x004E4942;
+constexpr size_t kMaxJsonDepth = 128;
+constexpr uint64_t kMaxIndex = std::numeric_limits<uint32_t>::max();
+
+size_t component_size(int ct) {
+  switch (ct) {
+    case kByte:
+    case kUByte: return 1;
+    case kShort:
+    case kUShort: return 2;
+    case kUInt:
+    case kFloat: return 4;
+    default: return 0;
+  }
+}
+
+const char* component_name(int ct) {
+  switch (ct) {
+    case kByte: return "byte";
+    case kUByte: return "unsigned byte";
+    case kShort: return "short";
+    case kUShort: return "unsigned short";
+    case TINYGLTF_COMPONENT_TYPE_INT: return "int";
+    case kUInt: return "unsigned int";
+    case kFloat: return "float";
+    case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "double";
+    default: return "unknown";
+  }
+}
+
+// Components of an accessor type; 0 for matrices and unknown types.
+uint32_t type_components(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+  }
+}
+
+const char* type_name(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+    default: return "unknown";
+  }
+}
+
+int type_for_components(uint32_t c) {
+  switch (c) {
+    case 1: return TINYGLTF_TYPE_SCALAR;
+    case 2: return TINYGLTF_TYPE_VEC2;
+    case 3: return TINYGLTF_TYPE_VEC3;
+    default: return TINYGLTF_TYPE_VEC4;
+  }
+}
+
+uint32_t load_u32(const unsigned char* p) {
+  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
+         static_cast<uint32_t>(p[3]) << 24;
+}
+uint16_t load_u16(const unsigned char* p) { return static_cast<uint16_t>(p[0] | p[1] << 8); }
+
+void store_u32(unsigned char* p, uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+void store_u16(unsigned char* p, uint16_t v) {
+  p[0] = static_cast<unsigned char>(v);
+  p[1] = static_cast<unsigned char>(v >> 8);
+}
+void store_f32(unsigned char* p, float f) {
+  uint32_t b;
+  std::memcpy(&b, &f, 4);
+  store_u32(p, b);
+}
+
+// One component as float: floats keep their exact bits; integers are their
+// value, or the spec's normalized decoding.
+float load_value(int ct, bool normalized, const unsigned char* p) {
+  switch (ct) {
+    case kFloat: {
+      uint32_t b = load_u32(p);
+      float f;
+      std::memcpy(&f, &b, 4);
+      return f;
+    }
+    case kByte: {
+      const int v = static_cast<int8_t>(p[0]);
+      return normalized ? static_cast<float>(std::max(v / 127.0, -1.0)) : static_cast<float>(v);
+    }
+    case kUByte: return normalized ? static_cast<float>(p[0] / 255.0) : static_cast<float>(p[0]);
+    case kShort: {
+      const int v = static_cast<int16_t>(load_u16(p));
+      return normalized ? static_cast<float>(std::max(v / 32767.0, -1.0)) : static_cast<float>(v);
+    }
+    case kUShort: {
+      const unsigned v = load_u16(p);
+      return normalized ? static_cast<float>(v / 65535.0) : static_cast<float>(v);
+    }
+    case kUInt: return static_cast<float>(load_u32(p));
+    default: return 0.0f;
+  }
+}
+
+uint32_t load_index(int ct, const unsigned char* p) {
+  switch (ct) {
+    case kUByte: return p[0];
+    case kUShort: return load_u16(p);
+    default: return load_u32(p);
+  }
+}
+
+std::string float_text(float x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(x));
+  return buf;
+}
+
+std::string hex32(uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08X", v);
+  return buf;
+}
+
+// Short, printable form of a name for messages.
+std::string shown_name(std::string_view s) {
+  std::string r = "'";
+  for (char c : s.substr(0, 40)) r += (static_cast<unsigned char>(c) < 32 || c == 127) ? '?' : c;
+  if (s.size() > 40) r += "...";
+  return r + "'";
+}
+
+// Deepest nesting of JSON arrays and objects (outside strings); stops
+// counting once past `limit`.
+size_t json_depth(std::string_view s, size_t limit) {
+  size_t depth = 0, deepest = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const char c = s[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > deepest && (deepest = depth) > limit) return deepest;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// tinygltf's messages: several lines, each ending in '\n'.
+std::string clean_message(const std::string& s) {
+  std::string r;
+  bool line_end = false;
+  for (char c : s) {
+    if (c == '\n' || c == '\r') {
+      line_end = true;
+      continue;
+    }
+    if (line_end && !r.empty()) r += "; ";
+    line_end = false;
+    r += c;
+  }
+  while (!r.empty() && (r.back() == ' ' || r.back() == ';')) r.pop_back();
+  if (r.size() > 400) r = r.substr(0, 400) + "...";
+  return r.empty() ? "tinygltf gave no reason" : r;
+}
+
+// ---------------------------------------------------------------------------
+// External buffer files (tinygltf's file system callbacks)
+
+struct FsContext {
+  std::string dir;     // empty: external files are refused
+  std::string prefix;  // dir + '/'
+  std::string error;   // why a file was refused or could not be read
+};
+
+bool fs_exists(const std::string& path, void* user) {
+  auto* ctx = static_cast<FsContext*>(user);
+  const std::string rel = path.size() > ctx->prefix.size() ? path.substr(ctx->prefix.size()) : std::string();
+  if (ctx->dir.empty()) {
+    if (ctx->error.empty())
+      ctx->error = "buffer file " + shown_name(path) +
+                   ": external files are not read here (the glTF did not come from a file: give the .gltf file's "
+                   "path, or set ReadOptions::external_files_dir)";
+    return false;
+  }
+  // tinygltf tries the folder, then the current directory: only the folder.
+  if (path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
+  if (rel.empty() || rel[0] == '/' || rel.find('\0') != std::string::npos || rel.find("://") != std::string::npos) {
+    if (ctx->error.empty()) ctx->error = "buffer uri " + shown_name(rel) + " is not a relative file name";
+    return false;
+  }
+  struct stat st = {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (ctx->error.empty()) ctx->error = "buffer file " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    if (ctx->error.empty()) ctx->error = "buffer file " + path + " is not a regular file";
+    return false;
+  }
+  return true;
+}
+
+std::string fs_expand(const std::string& path, void*) { return path; }
+
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  auto* ctx = static_cast<FsContext*>(user);
+  std::string bytes;
+  Status s = read_file(path, bytes);
+  if (!s.ok()) {
+    if (ctx->error.empty()) ctx->error = s.message();
+    if (err) *err += s.message();
+    return false;
+  }
+  out->assign(bytes.begin(), bytes.end());
+  return true;
+}
+
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "tsm does not write files through tinygltf";
+  return false;
+}
+
+// Images are never decoded; their bytes are dropped.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+bool is_identity(const tinygltf::Node& n) {
+  static const double kIdentity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (!n.matrix.empty() && !std::equal(n.matrix.begin(), n.matrix.end(), kIdentity, kIdentity + 16)) return false;
+  for (double t : n.translation)
+    if (t != 0) return false;
+  for (double s : n.scale)
+    if (s != 1) return false;
+  if (!n.rotation.empty() && !(n.rotation.size() == 4 && n.rotation[0] == 0 && n.rotation[1] == 0 &&
+                               n.rotation[2] == 0 && n.rotation[3] == 1))
+    return false;
+  return true;
+}
+
+// Parses "PREFIX<digits>" (no sign, no leading '+'); -1 otherwise.
+long semantic_index(const std::string& s, const char* prefix) {
+  const size_t n = std::strlen(prefix);
+  if (s.size() <= n || s.size() > n + 6 || s.compare(0, n, prefix) != 0) return -1;
+  long v = 0;
+  for (size_t i = n; i < s.size(); ++i) {
+    if (s[i] < '0' || s[i] > '9') return -1;
+    v = v * 10 + (s[i] - '0');
+  }
+  if (s.size() > n + 1 && s[n] == '0') return -1;  // "TEXCOORD_01"
+  return v;
+}
+
+// ---------------------------------------------------------------------------
+// The reader
+
+// One attribute of one vertex group, as read.
+struct RawAttribute {
+  std::string slot;  // the tsm name ("normal", "texcoord0", "color", "TANGENT")
+  std::string semantic;
+  AttributeKind kind = AttributeKind::generic;
+  AttributeType type = AttributeType::f32;
+  uint32_t components = 1;
+  std::vector<float> values;
+};
+
+// Vertices of the primitives sharing one set of vertex accessors.
+struct VertexGroup {
+  uint32_t base = 0;
+  uint32_t count = 0;
+  std::vector<RawAttribute> attributes;
+};
+
+// A checked accessor: every byte it names lies inside its buffer.
+struct AccessorView {
+  int component_type = 0;
+  bool normalized = false;
+  uint32_t components = 0;
+  size_t count = 0;
+  size_t csize = 0;
+  size_t stride = 0;
+  const unsigned char* data = nullptr;  // nullptr: all zeros
+  // sparse substitution
+  size_t sparse_count = 0;
+  int sparse_index_type = 0;
+  const unsigned char* sparse_indices = nullptr;
+  const unsigned char* sparse_values = nullptr;
+};
+
+class GltfReader {
+ public:
+  GltfReader(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options, ReadInfo* info)
+      : bytes_(bytes), name_(name), out_(out), options_(options), info_(info) {}
+
+  Status run() {
+    out_.clear();
+    Status s;
+    try {
+      s = parse();
+      if (s.ok()) s = build();
+    } catch (const std::bad_alloc&) {
+      s = Status(ErrorCode::limit_exceeded, name_ + ": out of memory while reading the glTF");
+    } catch (const std::exception& e) {
+      s = error(std::string("invalid glTF: ") + e.what());
+    }
+    if (!s.ok()) {
+      out_.clear();
+      return s;
+    }
+    if (info_) {
+      info_->format = binary_ ? MeshFormat::glb : MeshFormat::gltf;
+      info_->binary = binary_;
+      info_->skipped_elements += skipped_;
+      if (!notes_.empty()) {
+        if (!info_->notes.empty()) info_->notes += "; ";
+        info_->notes += notes_;
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  Status error(const std::string& what) const { return Status(ErrorCode::parse_error, name_ + ": " + what); }
+  Status limit(const std::string& what) const { return Status(ErrorCode::limit_exceeded, name_ + ": " + what); }
+
+  void note(const std::string& s) {
+    if (++note_count_ > 12) {
+      if (note_count_ == 13) notes_ += "; ...";
+      return;
+    }
+    if (!notes_.empty()) notes_ += "; ";
+    notes_ += s;
+  }
+
+  // ----- container and JSON -----
+
+  Status parse() {
+    const auto* u = reinterpret_cast<const unsigned char*>(bytes_.data());
+    std::string_view json;
+    size_t glb_size = 0;
+    if (bytes_.size() >= 4 && load_u32(u) == kGlbMagic) {
+      binary_ = true;
+      TSM_RETURN_IF_ERROR(check_glb(json, glb_size));
+    } else {
+      size_t i = 0;
+      if (bytes_.substr(0, 3) == "\xEF\xBB\xBF") i = 3;  // UTF-8 byte order mark
+      while (i < bytes_.size() && (bytes_[i] == ' ' || bytes_[i] == '\t' || bytes_[i] == '\n' || bytes_[i] == '\r')) ++i;
+      if (i == bytes_.size() || bytes_[i] != '{')
+        return error("not a glTF file: a .gltf file is a JSON object (starts with '{') and a .glb file starts with "
+                     "'glTF'");
+      json = bytes_;
+    }
+    if (json.size() > std::numeric_limits<unsigned int>::max())
+      return limit("the glTF JSON is larger than 4 GiB");
+    if (json_depth(json, kMaxJsonDepth) > kMaxJsonDepth)
+      return error("the JSON nests arrays and objects more than " + std::to_string(kMaxJsonDepth) +
+                   " deep; refused (no glTF needs that)");
+
+    FsContext fs;
+    fs.dir = options_.external_files_dir;
+    if (!fs.dir.empty()) fs.prefix = fs.dir.back() == '/' ? fs.dir : fs.dir + "/";
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, &fs});
+    loader.SetImageLoader(&skip_image, nullptr);
+    std::string err, warn;
+    bool ok;
+    if (binary_) {
+      ok = loader.LoadBinaryFromMemory(&model_, &err, &warn, reinterpret_cast<const unsigned char*>(bytes_.data()),
+                                       static_cast<unsigned int>(glb_size), fs.dir);
+    } else {
+      ok = loader.LoadASCIIFromString(&model_, &err, &warn, json.data(), static_cast<unsigned int>(json.size()),
+                                      fs.dir);
+    }
+    if (!ok) {
+      if (!fs.error.empty()) return error(fs.error);
+      return error("invalid glTF: " + clean_message(err));
+    }
+    if (model_.asset.version.empty() || model_.asset.version[0] != '2')
+      return error("asset.version is " + shown_name(model_.asset.version) + "; only glTF 2.0 is read");
+    input_bytes_ = bytes_.size();
+    for (const tinygltf::Buffer& b : model_.buffers) input_bytes_ += b.data.size();
+    return Status::Ok();
+  }
+
+  Status check_glb(std::string_view& json, size_t& glb_size) {
+    const auto* u = reinterpret_cast<const unsigned char*>(bytes_.data());
+    const size_t size = bytes_.size();
+    if (size < 12)
+      return error("truncated GLB: " + std::to_string(size) + " bytes, and its header alone takes 12");
+    const uint32_t version = load_u32(u + 4);
+    if (version != 2)
+      return error("byte 4: GLB version " + std::to_string(version) + "; only version 2 (glTF 2.0) is read");
+    const uint32_t length = load_u32(u + 8);
+    if (length > size)
+      return error("truncated GLB: its header says " + std::to_string(length) + " bytes but there are only " +
+                   std::to_string(size));
+    if (length < 20) return error("byte 8: GLB length " + std::to_string(length) + " leaves no room for the JSON chunk");
+    if (length < size) note(std::to_string(size - length) + " bytes after the end of the GLB ignored");
+    const uint32_t json_length = load_u32(u + 12);
+    const uint32_t json_type = load_u32(u + 16);
+    if (json_type != kChunkJson)
+      return error("byte 16: the first GLB chunk must be JSON (type 0x4E4F534A), not " + hex32(json_type));
+    if (json_length == 0) return error("byte 12: the GLB's JSON chunk is empty");
+    if (json_length > length - 20)
+      return error("byte 12: the JSON chunk's length " + std::to_string(json_length) + " runs past the end of the GLB (" +
+                   std::to_string(length) + " bytes)");
+    const size_t bin_at = 20 + static_cast<size_t>(json_length);
+    if (bin_at < length) {
+      if (length - bin_at < 8)
+        return error("byte " + std::to_string(bin_at) + ": truncated chunk header after the JSON chunk");
+      const uint32_t bin_length = load_u32(u + bin_at);
+      const uint32_t bin_type = load_u32(u + bin_at + 4);
+      if (bin_type != kChunkBin)
+        return error("byte " + std::to_string(bin_at + 4) + ": the second GLB chunk must be BIN (type 0x004E4942), not " +
+                     hex32(bin_type));
+      if (bin_length > length - bin_at - 8)
+        return error("byte " + std::to_string(bin_at) + ": the BIN chunk's length " + std::to_string(bin_length) +
+                     " runs past the end of the GLB (" + std::to_string(length) + " bytes)");
+      if (bin_length < 4 || bin_length % 4 != 0)
+        return error("byte " + std::to_string(bin_at) + ": the BIN chunk's length " + std::to_string(bin_length) +
+                     " is not a positive multiple of 4");
+    }
+    json = bytes_.substr(20, json_length);
+    glb_size = length;
+    return Status::Ok();
+  }
+
+  // ----- scene -----
+
+  // Meshes of the default scene, each once, in the order the node tree meets them.
+  Status collect_meshes(std::vector<int>& order) {
+    const size_t nmeshes = model_.meshes.size();
+    std::vector<size_t> uses(nmeshes, 0);
+    if (model_.scenes.empty()) {
+      for (size_t m = 0; m < nmeshes; ++m) order.push_back(static_cast<int>(m));
+      if (nmeshes > 0 && !model_.nodes.empty()) note("no scene: read all " + std::to_string(nmeshes) + " mesh(es)");
+      return Status::Ok();
+    }
+    int scene = model_.defaultScene;
+    if (scene < 0) scene = 0;
+    if (static_cast<size_t>(scene) >= model_.scenes.size())
+      return error("scene " + std::to_string(scene) + " is the default scene, but there are " +
+                   std::to_string(model_.scenes.size()) + " scenes");
+    if (model_.scenes.size() > 1)
+      note("read scene " + std::to_string(scene) + " of " + std::to_string(model_.scenes.size()));
+    const size_t nnodes = model_.nodes.size();
+    std::vector<bool> seen(nnodes, false);
+    size_t transformed = 0, repeated = 0;
+    const std::vector<int>& roots = model_.scenes[static_cast<size_t>(scene)].nodes;
+    std::vector<int> stack(roots.rbegin(), roots.rend());  // depth first, in order
+    while (!stack.empty()) {
+      const int n = stack.back();
+      stack.pop_back();
+      if (n < 0 || static_cast<size_t>(n) >= nnodes)
+        return error("scene " + std::to_string(scene) + " uses node " + std::to_string(n) + ", but there are " +
+                     std::to_string(nnodes) + " nodes");
+      if (seen[static_cast<size_t>(n)]) {  // a node with two parents, or a cycle: the spec forbids both
+        ++repeated;
+        continue;
+      }
+      seen[static_cast<size_t>(n)] = true;
+      const tinygltf::Node& node = model_.nodes[static_cast<size_t>(n)];
+      if (!is_identity(node)) ++transformed;
+      if (node.mesh >= 0) {
+        if (static_cast<size_t>(node.mesh) >= nmeshes)
+          return error("node " + std::to_string(n) + " uses mesh " + std::to_string(node.mesh) + ", but there are " +
+                       std::to_string(nmeshes) + " meshes");
+        if (uses[static_cast<size_t>(node.mesh)]++ == 0) order.push_back(node.mesh);
+      } else if (node.mesh < -1) {
+        return error("node " + std::to_string(n) + " uses mesh " + std::to_string(node.mesh));
+      }
+      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
+        if (*it < 0 || static_cast<size_t>(*it) >= nnodes)
+          return error("node " + std::to_string(n) + " has child " + std::to_string(*it) + ", but there are " +
+                       std::to_string(nnodes) + " nodes");
+        stack.push_back(*it);
+      }
+    }
+    if (repeated > 0) note(std::to_string(repeated) + " repeated node reference(s) (not a tree) read once");
+    if (transformed > 0)
+      note("node transforms not applied (" + std::to_string(transformed) + " node(s) have one): positions as stored");
+    size_t instanced = 0, unused = 0;
+    for (size_t m = 0; m < nmeshes; ++m) {
+      if (uses[m] > 1) ++instanced;
+      if (uses[m] == 0) ++unused;
+    }
+    if (instanced > 0) note(std::to_string(instanced) + " mesh(es) used by several nodes read once");
+    if (unused > 0) note(std::to_string(unused) + " mesh(es) not in the scene not read");
+    return Status::Ok();
+  }
+
+  // ----- accessors -----
+
+  Status check_view(int view_index, const std::string& what, const tinygltf::BufferView*& view,
+                    const tinygltf::Buffer*& buffer) const {
+    if (view_index < 0 || static_cast<size_t>(view_index) >= model_.bufferViews.size())
+      return error(what + ": buffer view " + std::to_string(view_index) + " does not exist (there are " +
+                   std::to_string(model_.bufferViews.size()) + ")");
+    view = &model_.bufferViews[static_cast<size_t>(view_index)];
+    if (view->buffer < 0 || static_cast<size_t>(view->buffer) >= model_.buffers.size())
+      return error(what + ": buffer view " + std::to_string(view_index) + " names buffer " +
+                   std::to_string(view->buffer) + ", which does not exist (there are " +
+                   std::to_string(model_.buffers.size()) + ")");
+    buffer = &model_.buffers[static_cast<size_t>(view->buffer)];
+    const size_t size = buffer->data.size();
+    if (view->byteOffset > size || view->byteLength > size - view->byteOffset)
+      return error(what + ": buffer view " + std::to_string(view_index) + " (bytes " + std::to_string(view->byteOffset) +
+                   " + " + std::to_string(view->byteLength) + ") runs past the end of buffer " +
+                   std::to_string(view->buffer) + " (" + std::to_string(size) + " bytes)");
+    return Status::Ok();
+  }
+
+  // Bytes [offset, offset + (count - 1) * stride + elem) inside a view of `length` bytes.
+  static bool fits(size_t offset, size_t count, size_t stride, size_t elem, size_t length) {
+    if (count == 0) return offset <= length;
+    if (offset > length || elem > length - offset) return false;
+    const size_t room = length - offset - elem;
+    return stride == 0 || count - 1 <= room / stride;
+  }
+
+  // Charges `n` produced values against the budget (a multiple of the input's bytes).
+  Status charge(uint64_t n, const std::string& what) {
+    const uint64_t budget = 8 * static_cast<uint64_t>(input_bytes_) + (1u << 16);
+    if (n > budget || produced_ > budget - n)
+      return limit(what + ": the primitives would produce more than " + std::to_string(budget) +
+                   " values from " + std::to_string(input_bytes_) +
+                   " bytes of data (accessors reused many times?); refused");
+    produced_ += n;
+    return Status::Ok();
+  }
+
+  Status view_accessor(int index, const std::string& what, AccessorView& v) {
+    if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+      return error(what + ": accessor " + std::to_string(index) + " does not exist (there are " +
+                   std::to_string(model_.accessors.size()) + ")");
+    const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(index)];
+    const std::string at = what + " (accessor " + std::to_string(index) + ")";
+    v = AccessorView();
+    v.component_type = a.componentType;
+    v.normalized = a.normalized;
+    v.components = type_components(a.type);
+    v.count = a.count;
+    v.csize = component_size(a.componentType);
+    if (v.csize == 0)
+      return error(at + ": component type " + std::to_string(a.componentType) + " (" +
+                   component_name(a.componentType) + ") is not a glTF 2.0 accessor type");
+    if (v.components == 0) return error(at + ": type " + type_name(a.type) + " is not a vector or scalar");
+    if (a.count > kMaxIndex)
+      return limit(at + ": " + std::to_string(a.count) + " elements; tsm handles at most " + std::to_string(kMaxIndex));
+    const size_t elem = v.csize * v.components;
+    if (a.bufferView >= 0) {
+      const tinygltf::BufferView* view;
+      const tinygltf::Buffer* buffer;
+      TSM_RETURN_IF_ERROR(check_view(a.bufferView, at, view, buffer));
+      v.stride = view->byteStride ? view->byteStride : elem;
+      if (view->byteStride != 0 && view->byteStride < elem)
+        return error(at + ": buffer view " + std::to_string(a.bufferView) + " has byteStride " +
+                     std::to_string(view->byteStride) + ", less than the " + std::to_string(elem) + "-byte element");
+      if (!fits(a.byteOffset, a.count, v.stride, elem, view->byteLength))
+        return error(at + ": " + std::to_string(a.count) + " elements of " + std::to_string(elem) + " bytes (stride " +
+                     std::to_string(v.stride) + ") from byte " + std::to_string(a.byteOffset) +
+                     " run past the end of buffer view " + std::to_string(a.bufferView) + " (" +
+                     std::to_string(view->byteLength) + " bytes)");
+      v.data = buffer->data.data() + view->byteOffset + a.byteOffset;
+    } else if (a.bufferView < -1) {
+      return error(at + ": buffer view " + std::to_string(a.bufferView) + " does not exist");
+    }
+    if (a.sparse.isSparse) {
+      const auto& sp = a.sparse;
+      const std::string sat = at + ": sparse";
+      if (sp.count < 1 || static_cast<size_t>(sp.count) > a.count)
+        return error(sat + " count " + std::to_string(sp.count) + " is not in 1.." + std::to_string(a.count));
+      v.sparse_count = static_cast<size_t>(sp.count);
+      v.sparse_index_type = sp.indices.componentType;
+      if (v.sparse_index_type != kUByte && v.sparse_index_type != kUShort && v.sparse_index_type != kUInt)
+        return error(sat + " indices have component type " + std::to_string(v.sparse_index_type) +
+                     "; expected unsigned byte, short or int");
+      if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0) return error(sat + " byteOffset is negative");
+      const tinygltf::BufferView* view;
+      const tinygltf::Buffer* buffer;
+      TSM_RETURN_IF_ERROR(check_view(sp.indices.bufferView, sat + " indices", view, buffer));
+      const size_t isize = component_size(v.sparse_index_type);
+      if (!fits(static_cast<size_t>(sp.indices.byteOffset), v.sparse_count, isize, isize, view->byteLength))
+        return error(sat + " indices run past the end of buffer view " + std::to_string(sp.indices.bufferView));
+      v.sparse_indices = buffer->data.data() + view->byteOffset + static_cast<size_t>(sp.indices.byteOffset);
+      TSM_RETURN_IF_ERROR(check_view(sp.values.bufferView, sat + " values", view, buffer));
+      if (!fits(static_cast<size_t>(sp.values.byteOffset), v.sparse_count, elem, elem, view->byteLength))
+        return error(sat + " values run past the end of buffer view " + std::to_string(sp.values.bufferView));
+      v.sparse_values = buffer->data.data() + view->byteOffset + static_cast<size_t>(sp.values.byteOffset);
+      for (size_t k = 0; k < v.sparse_count; ++k) {
+        const uint32_t i = load_index(v.sparse_index_type, v.sparse_indices + k * isize);
+        if (i >= a.count)
+          return error(sat + " index " + std::to_string(k) + " is " + std::to_string(i) + ", but the accessor has " +
+                       std::to_string(a.count) + " elements");
+      }
+    }
+    return Status::Ok();
+  }
+
+  // Appends the accessor's values (count * components floats) to `out`.
+  Status read_floats(const AccessorView& v, bool normalized, const std::string& what, std::vector<float>& out) {
+    TSM_RETURN_IF_ERROR(charge(static_cast<uint64_t>(v.count) * v.components, what));
+    const size_t start = out.size();
+    out.resize(start + v.count * v.components, 0.0f);
+    float* dst = out.data() + start;
+    if (v.data) {
+      for (size_t i = 0; i < v.count; ++i) {
+        const unsigned char* p = v.data + i * v.stride;
+        for (uint32_t c = 0; c < v.components; ++c)
+          dst[i * v.components + c] = load_value(v.component_type, normalized, p + c * v.csize);
+      }
+    }
+    const size_t isize = component_size(v.sparse_index_type);
+    for (size_t k = 0; k < v.sparse_count; ++k) {
+      const uint32_t i = load_index(v.sparse_index_type, v.sparse_indices + k * isize);
+      const unsigned char* p = v.sparse_values + k * v.csize * v.components;
+      for (uint32_t c = 0; c < v.components; ++c)
+        dst[static_cast<size_t>(i) * v.components + c] = load_value(v.component_type, normalized, p + c * v.csize);
+    }
+    if (!options_.allow_nonfinite && v.component_type == kFloat) {
+      for (size_t i = 0; i < v.count * v.components; ++i)
+        if (!std::isfinite(dst[i])) {
+          const size_t e = i / v.components;
+          std::string vals;
+          for (uint32_t c = 0; c < v.components; ++c)
+            vals += (c ? ", " : "(") + float_text(dst[e * v.components + c]);
+          return error(what + ": element " + std::to_string(e) + " is " + vals +
+                       "), not finite; pass --allow-nonfinite (ReadOptions::allow_nonfinite) to accept it");
+        }
+    }
+    return Status::Ok();
+  }
+
+  Status read_indices(const AccessorView& v, const std::string& what, std::vector<uint32_t>& out) {
+    if (v.components != 1) return error(what + ": indices must be SCALAR");
+    if (v.component_type != kUByte && v.component_type != kUShort && v.component_type != kUInt)
+      return error(what + ": indices have component type " + component_name(v.component_type) +
+                   "; expected unsigned byte, short or int");
+    TSM_RETURN_IF_ERROR(charge(v.count, what));
+    out.assign(v.count, 0);
+    if (v.data)
+      for (size_t i = 0; i < v.count; ++i) out[i] = load_index(v.component_type, v.data + i * v.stride);
+    const size_t isize = component_size(v.sparse_index_type);
+    for (size_t k = 0; k < v.sparse_count; ++k) {
+      const uint32_t i = load_index(v.sparse_index_type, v.sparse_indices + k * isize);
+      out[i] = load_index(v.component_type, v.sparse_values + k * v.csize);
+    }
+    return Status::Ok();
+  }
+
+  // ----- primitives -----
+
+  Status read_attribute(const std::string& semantic, int accessor, size_t vertex_count, const std::string& where,
+                        VertexGroup& g) {
+    const std::string what = where + " " + semantic;
+    AccessorView v;
+    TSM_RETURN_IF_ERROR(view_accessor(accessor, what, v));
+    if (v.count != vertex_count)
+      return error(what + " (accessor " + std::to_string(accessor) + ") has " + std::to_string(v.count) +
+                   " elements, but POSITION has " + std::to_string(vertex_count));
+    RawAttribute r;
+    r.semantic = semantic;
+    r.components = v.components;
+    const std::string shape = std::string(type_name(model_.accessors[static_cast<size_t>(accessor)].type)) + " of " +
+                              component_name(v.component_type);
+    bool normalized = v.normalized;
+    const long texcoord = semantic_index(semantic, "TEXCOORD_");
+    const long color = semantic_index(semantic, "COLOR_");
+    if (semantic == "NORMAL") {
+      if (v.components != 3) {
+        note(where + " NORMAL is " + shape + ", not VEC3: not kept");
+        return Status::Ok();
+      }
+      r.slot = "normal";
+      r.kind = AttributeKind::normal;
+    } else if (texcoord >= 0) {
+      if (v.components != 2) {
+        note(what + " is " + shape + ", not VEC2: not kept");
+        return Status::Ok();
+      }
+      r.slot = "texcoord" + std::to_string(texcoord);
+      r.kind = AttributeKind::texcoord;
+    } else if (color >= 0) {
+      if (v.components < 3) {
+        note(what + " is " + shape + ", not VEC3 or VEC4: not kept");
+        return Status::Ok();
+      }
+      r.slot = color == 0 ? "color" : "color" + std::to_string(color);
+      r.kind = AttributeKind::color;
+      if (v.normalized && v.component_type == kUByte) {
+        r.type = AttributeType::u8;
+        normalized = false;  // the integers 0..255
+      } else if (v.normalized && v.component_type == kUShort) {
+        r.type = AttributeType::u16;
+        normalized = false;
+      }
+    } else {
+      r.slot = semantic;
+      r.kind = AttributeKind::generic;
+      switch (v.component_type) {
+        case kUByte: r.type = AttributeType::u8; break;
+        case kUShort: r.type = AttributeType::u16; break;
+        case kByte:
+        case kShort: r.type = AttributeType::i32; break;
+        case kUInt:
+          note(what + " is unsigned int (not a glTF vertex attribute type): not kept");
+          return Status::Ok();
+        default: break;
+      }
+      if (r.type != AttributeType::f32) {
+        if (normalized && semantic_index(semantic, "WEIGHTS_") < 0)
+          note(what + ": kept as the stored integers; its 'normalized' flag is not kept");
+        normalized = false;
+      }
+    }
+    TSM_RETURN_IF_ERROR(read_floats(v, normalized, what + " (accessor " + std::to_string(accessor) + ")", r.values));
+    g.attributes.push_back(std::move(r));
+    return Status::Ok();
+  }
+
+  Status read_group(const std::map<std::string, int>& attributes, const std::string& where, size_t& group_index) {
+    const std::string what = where + " POSITION";
+    AccessorView pv;
+    TSM_RETURN_IF_ERROR(view_accessor(attributes.at("POSITION"), what, pv));
+    if (pv.components != 3)
+      return error(what + " (accessor " + std::to_string(attributes.at("POSITION")) + ") is " +
+                   type_name(model_.accessors[static_cast<size_t>(attributes.at("POSITION"))].type) + "; expected VEC3");
+    const uint64_t total = static_cast<uint64_t>(out_.vertex_count()) + pv.count;
+    if (options_.max_vertices > 0 && total > options_.max_vertices)
+      return limit("the primitives hold " + std::to_string(total) + " or more vertices, more than the limit of " +
+                   std::to_string(options_.max_vertices) + " (ReadOptions::max_vertices)");
+    if (total > kMaxIndex)
+      return limit("the primitives hold " + std::to_string(total) + " or more vertices; tsm handles at most " +
+                   std::to_string(kMaxIndex));
+    VertexGroup g;
+    g.base = static_cast<uint32_t>(out_.vertex_count());
+    g.count = static_cast<uint32_t>(pv.count);
+    TSM_RETURN_IF_ERROR(read_floats(pv, pv.normalized, what + " (accessor " + std::to_string(attributes.at("POSITION")) + ")",
+                                    out_.positions));
+    for (const auto& [semantic, accessor] : attributes)
+      if (semantic != "POSITION") TSM_RETURN_IF_ERROR(read_attribute(semantic, accessor, pv.count, where, g));
+    group_index = groups_.size();
+    groups_.push_back(std::move(g));
+    return Status::Ok();
+  }
+
+  Status read_primitive(int mesh_index, size_t prim_index) {
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
+    const tinygltf::Primitive& p = mesh.primitives[prim_index];
+    std::string where = "mesh " + std::to_string(mesh_index);
+    if (!mesh.name.empty()) where += " " + shown_name(mesh.name);
+    where += " primitive " + std::to_string(prim_index);
+    if (p.mode < 0 || p.mode > 6)
+      return error(where + ": unknown primitive mode " + std::to_string(p.mode) + " (glTF has 0..6)");
+    if (!p.targets.empty()) ++morphed_;
+    auto pos = p.attributes.find("POSITION");
+    if (pos == p.attributes.end()) {
+      note(where + " has no POSITION: skipped");
+      ++skipped_;
+      return Status::Ok();
+    }
+    if (p.extensions.count("KHR_draco_mesh_compression")) {
+      // Not required by the file: the accessors must hold an uncompressed copy.
+      const int a = pos->second;
+      if (a < 0 || static_cast<size_t>(a) >= model_.accessors.size() ||
+          model_.accessors[static_cast<size_t>(a)].bufferView < 0)
+        return Status(ErrorCode::unsupported, name_ + ": " + where +
+                                                  " is Draco-compressed (KHR_draco_mesh_compression) without an "
+                                                  "uncompressed copy, and tsm does not decode Draco");
+      note(where + ": read the uncompressed copy of a Draco-compressed primitive");
+    }
+    if (!seen_primitives_.insert(std::make_tuple(p.attributes, p.indices, p.mode)).second) {
+      ++repeated_primitives_;
+      return Status::Ok();
+    }
+    size_t gi = 0;
+    auto found = group_of_.find(p.attributes);
+    if (found != group_of_.end()) {
+      gi = found->second;
+    } else {
+      TSM_RETURN_IF_ERROR(read_group(p.attributes, where, gi));
+      group_of_[p.attributes] = gi;
+    }
+    const uint32_t base = groups_[gi].base;
+    const uint32_t n = groups_[gi].count;
+
+    std::vector<uint32_t> idx;
+    if (p.indices >= 0) {
+      const std::string what = where + " indices";
+      AccessorView iv;
+      TSM_RETURN_IF_ERROR(view_accessor(p.indices, what, iv));
+      TSM_RETURN_IF_ERROR(read_indices(iv, what + " (accessor " + std::to_string(p.indices) + ")", idx));
+      for (size_t i = 0; i < idx.size(); ++i)
+        if (idx[i] >= n)
+          return error(what + " (accessor " + std::to_string(p.indices) + "): index " + std::to_string(i) + " is " +
+                       std::to_string(idx[i]) + ", but POSITION has " + std::to_string(n) + " vertices");
+    } else if (p.indices < -1) {
+      return error(where + ": indices accessor " + std::to_string(p.indices) + " does not exist");
+    } else if (p.mode >= TINYGLTF_MODE_TRIANGLES) {
+      TSM_RETURN_IF_ERROR(charge(n, where));
+      idx.resize(n);
+      for (uint32_t i = 0; i < n; ++i) idx[i] = i;
+    }
+
+    if (p.mode < TINYGLTF_MODE_TRIANGLES) {
+      static const char* kModes[] = {"points", "lines", "line loop", "line strip"};
+      const size_t count = p.indices >= 0 ? idx.size() : n;
+      const size_t elements = p.mode == 0 ? count : p.mode == 1 ? count / 2 : p.mode == 2 ? count : count ? count - 1 : 0;
+      skipped_ += elements;
+      if (elements > 0)
+        note(where + ": " + std::to_string(elements) + " " + kModes[p.mode] +
+             (p.mode == 0 ? "" : " segment(s)") + " skipped (their vertices are kept)");
+      return Status::Ok();
+    }
+    size_t tris = 0;
+    if (p.mode == TINYGLTF_MODE_TRIANGLES) {
+      if (idx.size() % 3 != 0)
+        return error(where + ": " + std::to_string(idx.size()) + " triangle corners, not a multiple of 3");
+      tris = idx.size() / 3;
+    } else {
+      tris = idx.size() >= 3 ? idx.size() - 2 : 0;
+    }
+    const uint64_t faces = static_cast<uint64_t>(out_.face_count()) + tris;
+    if (options_.max_faces > 0 && faces > options_.max_faces)
+      return limit("the primitives hold " + std::to_string(faces) + " or more faces, more than the limit of " +
+                   std::to_string(options_.max_faces) + " (ReadOptions::max_faces)");
+    if (static_cast<uint64_t>(out_.corner_count()) + 3 * static_cast<uint64_t>(tris) > kMaxIndex)
+      return limit("the primitives hold more than " + std::to_string(kMaxIndex) + " face corners; tsm handles at most that");
+    TSM_RETURN_IF_ERROR(charge(4 * static_cast<uint64_t>(tris), where));
+    out_.indices.reserve(out_.indices.size() + 3 * tris);
+    out_.face_offsets.reserve(out_.face_offsets.size() + tris);
+    size_t dropped = 0;
+    for (size_t t = 0; t < tris; ++t) {
+      uint32_t a, b, c;
+      if (p.mode == TINYGLTF_MODE_TRIANGLES) {
+        a = idx[3 * t], b = idx[3 * t + 1], c = idx[3 * t + 2];
+      } else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        a = idx[t];
+        b = idx[t + 1 + t % 2];
+        c = idx[t + 2 - t % 2];
+      } else {  // fan
+        a = idx[t + 1], b = idx[t + 2], c = idx[0];
+      }
+      if (p.mode != TINYGLTF_MODE_TRIANGLES && (a == b || b == c || a == c)) {
+        ++dropped;
+        continue;
+      }
+      out_.add_triangle(base + a, base + b, base + c);
+    }
+    if (dropped > 0) note(where + ": " + std::to_string(dropped) + " degenerate strip/fan triangle(s) dropped");
+    return Status::Ok();
+  }
+
+  // ----- attributes of all groups into the mesh -----
+
+  static int kind_rank(AttributeKind k) {
+    switch (k) {
+      case AttributeKind::normal: return 0;
+      case AttributeKind::texcoord: return 1;
+      case AttributeKind::color: return 2;
+      default: return 3;
+    }
+  }
+
+  static float type_max(AttributeType t) { return t == AttributeType::u8 ? 255.0f : t == AttributeType::u16 ? 65535.0f : 1.0f; }
+
+  Status merge_attributes() {
+    struct Slot {
+      const RawAttribute* first = nullptr;
+      long number = 0;
+      size_t present = 0;
+      bool same = true;  // every group stores the same type and components
+      uint32_t components = 0;
+      bool any_float = false, any_u16 = false, any_i32 = false;
+    };
+    std::map<std::string, Slot> slots;
+    for (const VertexGroup& g : groups_)
+      for (const RawAttribute& r : g.attributes) {
+        Slot& s = slots[r.slot];
+        if (!s.first) {
+          s.first = &r;
+          s.number = std::max({semantic_index(r.semantic, "TEXCOORD_"), semantic_index(r.semantic, "COLOR_"), 0L});
+        } else if (s.first->type != r.type || s.first->components != r.components) {
+          s.same = false;
+        }
+        ++s.present;
+        s.components = std::max(s.components, r.components);
+        s.any_float |= r.type == AttributeType::f32;
+        s.any_u16 |= r.type == AttributeType::u16;
+        s.any_i32 |= r.type == AttributeType::i32;
+      }
+    std::vector<std::pair<std::string, Slot*>> order;
+    for (auto& [name, s] : slots) order.emplace_back(name, &s);
+    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) {
+      return std::make_tuple(kind_rank(x.second->first->kind), x.second->number, x.first) <
+             std::make_tuple(kind_rank(y.second->first->kind), y.second->number, y.first);
+    });
+    const size_t nv = out_.vertex_count();
+    for (auto& [name, sp] : order) {
+      const Slot& s = *sp;
+      Attribute a;
+      a.name = name;
+      a.kind = s.first->kind;
+      a.domain = AttributeDomain::vertex;
+      a.components = s.components;
+      if (s.same) {
+        a.type = s.first->type;
+      } else if (a.kind == AttributeKind::color) {
+        a.type = s.any_float || s.any_i32 ? AttributeType::f32 : s.any_u16 ? AttributeType::u16 : AttributeType::u8;
+      } else {
+        a.type = s.any_float ? AttributeType::f32 : s.any_i32 ? AttributeType::i32 : s.any_u16 ? AttributeType::u16 : AttributeType::u8;
+      }
+      if (!s.same) note(s.first->semantic + ": primitives store it differently; kept as " +
+                        std::to_string(a.components) + " component(s) of " +
+                        (a.type == AttributeType::f32 ? "float" : a.type == AttributeType::u16 ? "u16" : a.type == AttributeType::u8 ? "u8" : "i32"));
+      if (s.present < groups_.size())
+        note(s.first->semantic + " missing in " + std::to_string(groups_.size() - s.present) + " of " +
+             std::to_string(groups_.size()) + " vertex group(s): filled with " +
+             (a.kind == AttributeKind::color ? "opaque white" : "zeros"));
+      // Default value: zeros, colours opaque white.
+      const float full = type_max(a.type);
+      std::vector<float> fill(a.components, a.kind == AttributeKind::color ? full : 0.0f);
+      TSM_RETURN_IF_ERROR(charge(static_cast<uint64_t>(nv) * a.components, "attribute " + name));
+      a.values.assign(nv * a.components, 0.0f);
+      for (const VertexGroup& g : groups_) {
+        const RawAttribute* r = nullptr;
+        for (const RawAttribute& x : g.attributes)
+          if (x.slot == name) r = &x;
+        float* dst = a.values.data() + static_cast<size_t>(g.base) * a.components;
+        for (uint32_t v = 0; v < g.count; ++v)
+          for (uint32_t c = 0; c < a.components; ++c) {
+            float x;
+            if (!r) {
+              x = fill[c];
+            } else if (c >= r->components) {
+              x = a.kind == AttributeKind::color ? full : 0.0f;  // alpha of an RGB colour
+            } else {
+              x = r->values[static_cast<size_t>(v) * r->components + c];
+              if (a.kind == AttributeKind::color && r->type != a.type) {
+                if (a.type == AttributeType::f32) {
+                  x /= type_max(r->type);  // u8 / u16 to 0..1
+                } else if (a.type == AttributeType::u16 && r->type == AttributeType::u8) {
+                  x *= 257.0f;  // 255 -> 65535 exactly
+                }
+              }
+            }
+            dst[static_cast<size_t>(v) * a.components + c] = x;
+          }
+      }
+      out_.attributes.push_back(std::move(a));
+    }
+    return Status::Ok();
+  }
+
+  Status build() {
+    {
+      bool meshopt = false;
+      for (const std::string& e : model_.extensionsRequired) {
+        if (e == "KHR_draco_mesh_compression")
+          return Status(ErrorCode::unsupported, name_ + ": the file requires Draco compression "
+                                                        "(KHR_draco_mesh_compression), which tsm does not decode");
+        if (e.find("meshopt_compression") != std::string::npos) meshopt = true;
+      }
+      if (meshopt)
+        return Status(ErrorCode::unsupported, name_ + ": the file requires meshopt compression "
+                                                      "(EXT_meshopt_compression), which tsm does not decode");
+    }
+    std::vector<int> order;
+    TSM_RETURN_IF_ERROR(collect_meshes(order));
+    size_t prims = 0;
+    for (int m : order) {
+      const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(m)];
+      for (size_t p = 0; p < mesh.primitives.size(); ++p) TSM_RETURN_IF_ERROR(read_primitive(m, p));
+      prims += mesh.primitives.size();
+    }
+    if (prims > 1)
+      note(std::to_string(prims) + " primitives of " + std::to_string(order.size()) + " mesh(es) concatenated");
+    if (repeated_primitives_ > 0)
+      note(std::to_string(repeated_primitives_) + " primitive(s) repeating another one read once");
+    TSM_RETURN_IF_ERROR(merge_attributes());
+
+    // What is not kept.
+    std::string dropped;
+    auto count = [&](size_t n, const char* what) {
+      if (n == 0) return;
+      if (!dropped.empty()) dropped += ", ";
+      dropped += std::to_string(n) + " " + what;
+    };
+    count(model_.materials.size(), model_.materials.size() == 1 ? "material" : "materials");
+    count(model_.textures.size(), model_.textures.size() == 1 ? "texture" : "textures");
+    count(model_.images.size(), model_.images.size() == 1 ? "image" : "images");
+    count(model_.samplers.size(), model_.samplers.size() == 1 ? "sampler" : "samplers");
+    count(model_.animations.size(), model_.animations.size() == 1 ? "animation" : "animations");
+    count(model_.skins.size(), model_.skins.size() == 1 ? "skin" : "skins");
+    count(model_.cameras.size(), model_.cameras.size() == 1 ? "camera" : "cameras");
+    count(model_.lights.size(), model_.lights.size() == 1 ? "light" : "lights");
+    count(morphed_, morphed_ == 1 ? "primitive's morph targets" : "primitives' morph targets");
+    if (!dropped.empty()) note(dropped + " not kept");
+    if (!model_.extensionsUsed.empty()) {
+      std::string ext;
+      for (const std::string& e : model_.extensionsUsed) ext += (ext.empty() ? "" : ", ") + e;
+      note("extensions not kept: " + ext);
+    }
+    return Status::Ok();
+  }
+
+  std::string_view bytes_;
+  const std::string& name_;
+  Mesh& out_;
+  const ReadOptions& options_;
+  ReadInfo* info_;
+  tinygltf::Model model_;
+  bool binary_ = false;
+  size_t input_bytes_ = 0;
+  uint64_t produced_ = 0;
+  std::vector<VertexGroup> groups_;
+  std::map<std::map<std::string, int>, size_t> group_of_;
+  std::set<std::tuple<std::map<std::string, int>, int, int>> seen_primitives_;
+  size_t repeated_primitives_ = 0;
+  size_t morphed_ = 0;
+  size_t skipped_ = 0;
+  std::string notes_;
+  size_t note_count_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// The writer
+
+const char* type_text(AttributeType t) {
+  switch (t) {
+    case AttributeType::f32: return "f32";
+    case AttributeType::u8: return "u8";
+    case AttributeType::u16: return "u16";
+    case AttributeType::i32: return "i32";
+  }
+  return "?";
+}
+
+class GltfWriter {
+ public:
+  explicit GltfWriter(const Mesh& mesh) : mesh_(mesh) {}
+
+  Status run(bool binary, std::string& out) {
+    TSM_RETURN_IF_ERROR(check());
+    model_.asset.version = "2.0";
+    model_.asset.generator = "tsm " TSM_VERSION;
+    const size_t nv = mesh_.vertex_count();
+    if (nv > 0) {  // else: no scene, no mesh (an empty scene would be written as null)
+      tinygltf::Primitive prim;
+      prim.mode = mesh_.face_count() > 0 ? TINYGLTF_MODE_TRIANGLES : TINYGLTF_MODE_POINTS;
+      prim.attributes["POSITION"] = add_positions();
+      TSM_RETURN_IF_ERROR(add_attributes(prim));
+      if (mesh_.face_count() > 0) prim.indices = add_indices();
+      tinygltf::Mesh m;
+      m.primitives.push_back(std::move(prim));
+      model_.meshes.push_back(std::move(m));
+      tinygltf::Node node;
+      node.mesh = 0;
+      model_.nodes.push_back(std::move(node));
+      model_.scenes.emplace_back();
+      model_.scenes[0].nodes.push_back(0);
+      model_.defaultScene = 0;
+      if (data_.size() > std::numeric_limits<uint32_t>::max() - (1u << 24))
+        return Status(ErrorCode::limit_exceeded, "cannot write glTF: the mesh needs " + std::to_string(data_.size()) +
+                                                     " bytes of buffer; a glTF buffer holds less than 4 GiB");
+      tinygltf::Buffer buffer;
+      buffer.data = std::move(data_);
+      model_.buffers.push_back(std::move(buffer));
+    }
+    tinygltf::TinyGLTF writer;
+    std::ostringstream os;
+    if (!writer.WriteGltfSceneToStream(&model_, os, !binary, binary) || !os)
+      return Status(ErrorCode::internal, "cannot write glTF: tinygltf failed to serialize the model");
+    out = os.str();
+    return Status::Ok();
+  }
+
+ private:
+  Status check() const {
+    std::string why;
+    if (!mesh_.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write glTF: the mesh is invalid: " + why);
+    size_t other = 0, first = 0;
+    for (size_t f = mesh_.face_count(); f-- > 0;)
+      if (mesh_.face_size(f) != 3) {
+        ++other;
+        first = f;
+      }
+    if (other > 0)
+      return Status(ErrorCode::unsupported,
+                    "cannot write glTF: it stores triangles only, and " + std::to_string(other) + " of the mesh's " +
+                        std::to_string(mesh_.face_count()) + " faces are not triangles (face " + std::to_string(first) +
+                        " has " + std::to_string(mesh_.face_size(first)) +
+                        " corners); write PLY or OBJ to keep polygons, or triangulate the mesh first");
+    for (const Attribute& a : mesh_.attributes) {
+      if (a.domain == AttributeDomain::corner)
+        return Status(ErrorCode::unsupported,
+                      "cannot write glTF: attribute " + shown_name(a.name) +
+                          " is per face corner (seams), and glTF has per-vertex attributes only; tsm does not split "
+                          "vertices silently: write PLY or OBJ to keep it");
+      if (a.domain == AttributeDomain::face)
+        return Status(ErrorCode::unsupported,
+                      "cannot write glTF: attribute " + shown_name(a.name) +
+                          " is per face, and glTF has per-vertex attributes only; tsm does not split vertices "
+                          "silently: write PLY or OBJ to keep it");
+    }
+    for (size_t i = 0; i < mesh_.positions.size(); ++i)
+      if (!std::isfinite(mesh_.positions[i]))
+        return Status(ErrorCode::unsupported, "cannot write glTF: vertex " + std::to_string(i / 3) +
+                                                  " has a non-finite coordinate, and glTF needs the POSITION bounds "
+                                                  "(min / max) as finite numbers");
+    return Status::Ok();
+  }
+
+  // Appends a buffer view of `elements` elements of `elem` bytes each,
+  // filled by put(i, dst); returns its index. Vertex data gets a stride
+  // that is a multiple of 4 (the spec's alignment rule: u8 RGB colours take
+  // 4 bytes each); indices are packed.
+  template <typename Put>
+  int add_view(size_t elements, size_t elem, int target, Put put) {
+    const size_t stride = target == TINYGLTF_TARGET_ARRAY_BUFFER ? (elem + 3) & ~size_t{3} : elem;
+    while (data_.size() % 4) data_.push_back(0);
+    const size_t at = data_.size();
+    data_.resize(at + elements * stride, 0);
+    for (size_t i = 0; i < elements; ++i) put(i, data_.data() + at + i * stride);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = at;
+    view.byteLength = elements * stride;
+    view.byteStride = target == TINYGLTF_TARGET_ARRAY_BUFFER && stride != elem ? stride : 0;
+    view.target = target;
+    model_.bufferViews.push_back(std::move(view));
+    return static_cast<int>(model_.bufferViews.size() - 1);
+  }
+
+  int add_accessor(int view, int component_type, bool normalized, uint32_t components, size_t count) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = component_type;
+    a.normalized = normalized;
+    a.type = type_for_components(components);
+    a.count = count;
+    model_.accessors.push_back(std::move(a));
+    return static_cast<int>(model_.accessors.size() - 1);
+  }
+
+  int add_positions() {
+    const size_t nv = mesh_.vertex_count();
+    const float* p = mesh_.positions.data();
+    const int view = add_view(nv, 12, TINYGLTF_TARGET_ARRAY_BUFFER, [&](size_t i, unsigned char* d) {
+      for (size_t c = 0; c < 3; ++c) store_f32(d + 4 * c, p[3 * i + c]);
+    });
+    const int acc = add_accessor(view, kFloat, false, 3, nv);
+    tinygltf::Accessor& a = model_.accessors.back();
+    a.minValues.assign(3, 0.0);
+    a.maxValues.assign(3, 0.0);
+    for (size_t c = 0; c < 3; ++c) {
+      float lo = p[c], hi = p[c];
+      for (size_t i = 1; i < nv; ++i) {
+        lo = std::min(lo, p[3 * i + c]);
+        hi = std::max(hi, p[3 * i + c]);
+      }
+      a.minValues[c] = lo;
+      a.maxValues[c] = hi;
+    }
+    return acc;
+  }
+
+  int add_indices() {
+    const size_t n = mesh_.corner_count();
+    const bool small = mesh_.vertex_count() <= 0xFFFF;  // 0xFFFF itself is the restart value, never used
+    const uint32_t* idx = mesh_.indices.data();
+    const int view =
+        small ? add_view(n, 2, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                         [&](size_t i, unsigned char* d) { store_u16(d, static_cast<uint16_t>(idx[i])); })
+              : add_view(n, 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, [&](size_t i, unsigned char* d) { store_u32(d, idx[i]); });
+    return add_accessor(view, small ? kUShort : kUInt, false, 1, n);
+  }
+
+  static bool is_gltf_semantic(const Attribute& a) {
+    if (!a.name.empty() && a.name[0] == '_') return true;
+    if (a.name == "TANGENT") return a.components == 4 && a.type == AttributeType::f32;
+    if (semantic_index(a.name, "JOINTS_") >= 0)
+      return a.components == 4 && (a.type == AttributeType::u8 || a.type == AttributeType::u16);
+    if (semantic_index(a.name, "WEIGHTS_") >= 0) return a.components == 4 && a.type != AttributeType::i32;
+    return false;
+  }
+
+  Status add_attributes(tinygltf::Primitive& prim) {
+    // Semantics: NORMAL for the first normal, TEXCOORD_n / COLOR_n numbered
+    // in order (texcoord0, texcoord1, ... by their number first), the rest
+    // as custom attributes.
+    std::vector<const Attribute*> texcoords, colors;
+    std::vector<std::pair<std::string, const Attribute*>> named;
+    bool have_normal = false;
+    for (const Attribute& a : mesh_.attributes) {
+      if (a.kind == AttributeKind::normal && !have_normal && a.components == 3) {
+        have_normal = true;
+        named.emplace_back("NORMAL", &a);
+      } else if (a.kind == AttributeKind::texcoord && a.components == 2) {
+        texcoords.push_back(&a);
+      } else if (a.kind == AttributeKind::color && a.components >= 3) {
+        colors.push_back(&a);
+      } else {
+        named.emplace_back(is_gltf_semantic(a) ? a.name : "_" + a.name, &a);
+      }
+    }
+    auto by_number = [](const char* prefix) {
+      return [prefix](const Attribute* x, const Attribute* y) {
+        long nx = semantic_index(x->name, prefix), ny = semantic_index(y->name, prefix);
+        if (nx < 0) nx = std::numeric_limits<long>::max();
+        if (ny < 0) ny = std::numeric_limits<long>::max();
+        return nx < ny;
+      };
+    };
+    std::stable_sort(texcoords.begin(), texcoords.end(), by_number("texcoord"));
+    std::stable_sort(colors.begin(), colors.end(), [](const Attribute* x, const Attribute* y) {
+      auto number = [](const Attribute* a) {
+        if (a->name == "color") return 0L;
+        long n = semantic_index(a->name, "color");
+        return n < 0 ? std::numeric_limits<long>::max() : n;
+      };
+      return number(x) < number(y);
+    });
+    for (size_t i = 0; i < texcoords.size(); ++i) named.emplace_back("TEXCOORD_" + std::to_string(i), texcoords[i]);
+    for (size_t i = 0; i < colors.size(); ++i) named.emplace_back("COLOR_" + std::to_string(i), colors[i]);
+
+    for (auto& [semantic, a] : named) {
+      if (prim.attributes.count(semantic))
+        return Status(ErrorCode::invalid_argument, "cannot write glTF: two attributes would both be " + shown_name(semantic) +
+                                                       "; rename attribute " + shown_name(a->name));
+      int ct = kFloat;
+      bool normalized = false;
+      const bool is_color = semantic.compare(0, 6, "COLOR_") == 0;
+      const bool is_weights = semantic_index(semantic, "WEIGHTS_") >= 0;
+      if (a->type == AttributeType::u8 || a->type == AttributeType::u16) {
+        if (a->kind == AttributeKind::color || a->kind == AttributeKind::generic) {
+          ct = a->type == AttributeType::u8 ? kUByte : kUShort;
+          normalized = is_color || is_weights;
+          const float top = a->type == AttributeType::u8 ? 255.0f : 65535.0f;
+          for (size_t i = 0; i < a->values.size(); ++i) {
+            const float x = a->values[i];
+            if (!(x >= 0 && x <= top && x == std::floor(x)))
+              return Status(ErrorCode::invalid_argument,
+                            "cannot write glTF: attribute " + shown_name(a->name) + " has type " + type_text(a->type) +
+                                " but value " + float_text(x) + " (vertex " + std::to_string(i / a->components) +
+                                ") is not an integer in 0.." + float_text(top));
+          }
+        }
+      }
+      const size_t csize = component_size(ct);
+      const uint32_t comps = a->components;
+      const float* src = a->values.data();
+      const int view = add_view(mesh_.vertex_count(), csize * comps, TINYGLTF_TARGET_ARRAY_BUFFER,
+                                [&](size_t i, unsigned char* d) {
+                                  for (uint32_t c = 0; c < comps; ++c) {
+                                    const float x = src[i * comps + c];
+                                    if (ct == kFloat) {
+                                      store_f32(d + 4 * c, x);
+                                    } else if (ct == kUByte) {
+                                      d[c] = static_cast<unsigned char>(x);
+                                    } else {
+                                      store_u16(d + 2 * c, static_cast<uint16_t>(x));
+                                    }
+                                  }
+                                });
+      prim.attributes[semantic] = add_accessor(view, ct, normalized, comps, mesh_.vertex_count());
+    }
+    return Status::Ok();
+  }
+
+  const Mesh& mesh_;
+  tinygltf::Model model_;
+  std::vector<unsigned char> data_;
+};
+
+}  // namespace
+
+Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options,
+                 ReadInfo* info) {
+  return GltfReader(bytes, name, out, options, info).run();
+}
+
+Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary) {
+  (void)options;
+  out.clear();
+  try {
+    return GltfWriter(mesh).run(binary, out);
+  } catch (const std::bad_alloc&) {
+    out.clear();
+    return Status(ErrorCode::limit_exceeded, "cannot write glTF: out of memory");
+  }
+}
+
+}  // namespace tsm
