@@ -598,7 +598,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             reject('two-vertex component')
         # -- jump edges (stream 5)
         nj = o_count.decode(do)
-        if nj > 2 * n + 8 or nj % 2 or overrun():
+        if nj > 730 * (len(s5) + 8) // 6 or nj % 2 or overrun():
             reject('jump count')
         jumps = []
         corner = 0

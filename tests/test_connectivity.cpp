@@ -235,3 +235,22 @@ TEST(Connectivity, MidpointKruskalTreeRoundTrips) {
     }
   }
 }
+
+// Found by fuzz_roundtrip (2026-11-22, build/fuzz/artifacts crash-305b0d64):
+// 100 triangles on 7 vertices (3 distinct points), mostly repeated faces.
+// Paired into a closed surface it is one component with many handles on few
+// vertices: more jump edges than the decoder's old bound of 2n + 8, so the
+// encoder's output was refused ("bad jump edge count"). The bound is now the
+// topology stream's size (FORMAT.md §8.3).
+TEST(Connectivity, DenseComponentWithManyHandlesOnFewVertices) {
+  static const uint32_t kCorners[] = {0, 1, 2, 2, 3, 6, 2, 6, 5, 6, 0, 1, 6, 3, 2, 5, 6, 2, 6, 3, 2, 2, 3, 6, 2, 6, 5, 2, 3, 6, 2, 6, 5, 5, 6, 2, 6, 3, 2, 2, 3, 6, 2, 6, 5, 5, 6, 2, 6, 3, 2, 1, 5, 4, 5, 6, 2, 6, 3, 2, 0, 1, 4, 1, 2, 5, 1, 5, 4, 2, 3, 6, 2, 6, 5, 0, 1, 4, 0, 4, 3, 2, 3, 6, 2, 6, 5, 3, 4, 0, 5, 6, 2, 5, 2, 1, 6, 0, 2, 5, 2, 1, 2, 3, 6, 2, 6, 5, 3, 4, 0, 5, 6, 2, 5, 2, 1, 6, 3, 2, 1, 2, 5, 1, 5, 4, 2, 3, 6, 2, 6, 5, 3, 4, 0, 4, 5, 1, 4, 1, 0, 5, 6, 2, 5, 2, 1, 6, 3, 2, 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 2, 3, 6, 2, 6, 5, 4, 5, 1, 4, 1, 0, 5, 6, 2, 5, 2, 1, 6, 3, 2, 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 2, 3, 6, 2, 6, 5, 4, 5, 1, 4, 1, 0, 5, 1, 6, 4, 5, 1, 4, 1, 0, 5, 6, 2, 6, 3, 2, 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 2, 3, 6, 2, 6, 5, 4, 5, 1, 4, 1, 0, 5, 1, 6, 4, 5, 1, 4, 1, 0, 5, 6, 2, 5, 2, 1, 6, 3, 2, 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 3, 4, 0, 4, 5, 1, 4, 1, 0, 5, 6, 2, 5, 2, 1, 6, 3, 2, 0, 1, 4, 0, 4, 1};
+  Mesh m;
+  for (int i = 0; i < 7; ++i) {
+    const float k = static_cast<float>(i % 3);
+    m.add_vertex(k, 2 * k, 3 * k);
+  }
+  for (size_t i = 0; i < sizeof kCorners / sizeof kCorners[0]; i += 3) m.add_triangle(kCorners[i], kCorners[i + 1], kCorners[i + 2]);
+  ConnectivityStats st = stats_of(m);
+  EXPECT_GE(st.jump_edges, 8u);  // one of its components has 16 jump endpoints on fewer than 4 vertices
+  expect_round_trip(m, "dense component", 22, false);
+}

@@ -262,6 +262,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   // Pre-order vertices: real + duplicates + virtual; the latter two are at
   // most one per corner each.
   const uint64_t max_positions = vertex_count + 2 * corner_count;
+  const uint64_t max_jumps = 730 * (static_cast<uint64_t>(in.topology.size()) + 8) / 6;
   const uint32_t C = om.count.decode(dop);
   const bool polygons = dop.bit(om.has_polygons);
   if (C > max_positions) return corrupt("more components than vertices");
@@ -309,8 +310,11 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     local_parent.resize(n);
     for (uint32_t i = 0; i < n; ++i) local_parent[i] = parent[start + i] == kNone ? kNone : parent[start + i] - start;
     // Jumps.
+    // Jump endpoints: a dense component (duplicate faces, many handles on
+    // few vertices) can have far more than its vertices, so the bound is the
+    // stream's: each endpoint's corner costs at least 6 coded decisions.
     uint32_t nj = om.count.decode(dop);
-    if (nj > 2 * n + 8 || nj % 2 || overrun()) return corrupt("bad jump edge count");
+    if (nj > max_jumps || nj % 2 || overrun()) return corrupt("bad jump edge count");
     std::vector<JumpEndpoint> jumps(nj);
     uint32_t corner = 0;
     for (uint32_t i = 0; i < nj; ++i) {
