@@ -60,6 +60,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 30))->capture_default_str();
   enc->add_option("-l,--level", ea.level, "Level 0 (fastest decode) .. 9 (smallest)")
       ->check(CLI::Range(0, 9))->capture_default_str();
+  enc->add_option("--normal-bits", ea.attribute_bits.normal, "Float normals: octahedral bits per axis, 1..24")
+      ->check(CLI::Range(1, 24))->capture_default_str();
+  enc->add_option("--texcoord-bits", ea.attribute_bits.texcoord, "Float texture coordinates: grid bits, 1..24")
+      ->check(CLI::Range(1, 24))->capture_default_str();
+  enc->add_option("--color-bits", ea.attribute_bits.color, "Float colours: grid bits, 1..24 (8/16-bit colours are exact)")
+      ->check(CLI::Range(1, 24))->capture_default_str();
+  enc->add_option("--generic-bits", ea.attribute_bits.generic,
+                  "Other float attributes (e.g. PLY confidence): grid bits, 1..24 (integer ones are exact)")
+      ->check(CLI::Range(1, 24))->capture_default_str();
   enc->add_option("--segment-faces", ea.segment_faces,
                   "Code meshes with more faces as segments of at most this many (streaming, parallel decoding); "
                   "0 = default (262144)")

@@ -255,3 +255,19 @@ TEST(Attributes, DamagedAttributeStreamsAreRefused) {
     EXPECT_FALSE(decode(bytes.substr(0, n), back).ok());
   }
 }
+
+TEST(Attributes, QuantizationBitsAreTheCallers) {
+  const Mesh m = sphere_with_vertex_attributes(3);
+  EncodeOptions eo;
+  eo.attribute_bits.normal = 6;
+  eo.attribute_bits.texcoord = 20;
+  std::string coarse;
+  ASSERT_TRUE(encode(m, eo, coarse).ok());
+  Mesh back;
+  ASSERT_TRUE(decode(coarse, back).ok());
+  EXPECT_TRUE(compare_meshes(m, back, 14, eo.attribute_bits).equal);
+  EXPECT_GT(max_error(m.attributes[0], back.attributes[0]), 4e-3);  // 6-bit normals are coarse
+  EXPECT_LT(max_error(m.attributes[2], back.attributes[2]), 1e-5);  // 20-bit UVs are fine
+  eo.attribute_bits.generic = 25;
+  EXPECT_EQ(encode(m, eo, coarse).code(), ErrorCode::invalid_argument);
+}

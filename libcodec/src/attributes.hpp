@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "tsm/compare.hpp"
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
@@ -31,9 +32,7 @@ struct AttributeHeader {
   double extent = 0;             // grid: largest extent of the values
 };
 
-struct AttributeBits {
-  int normal = 10, texcoord = 12, color = 10, generic = 16;
-};
+using AttributeBits = AttributeQuantization;
 
 // The headers for a mesh's attributes (grids from all of their values).
 std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const AttributeBits& bits);

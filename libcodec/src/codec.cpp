@@ -534,7 +534,11 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
                                                          std::to_string(x) + " (integers up to 2^30 only)");
   if (mesh.attributes.size() > 64)
     return Status(ErrorCode::invalid_argument, "more than 64 attributes");
-  const std::vector<AttributeHeader> headers = attribute_headers(mesh, AttributeBits{});
+  const AttributeQuantization& ab = options.attribute_bits;
+  for (int b : {ab.normal, ab.texcoord, ab.color, ab.generic})
+    if (b < 1 || b > 24)
+      return Status(ErrorCode::invalid_argument, "attribute quantization bits must be 1..24, got " + std::to_string(b));
+  const std::vector<AttributeHeader> headers = attribute_headers(mesh, ab);
   const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());

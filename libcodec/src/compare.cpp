@@ -210,7 +210,8 @@ std::string describe_vertex(const Labelled& l, size_t v, const Grid& grid) {
 
 }  // namespace
 
-CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits) {
+CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits,
+                             const AttributeQuantization& attribute_bits) {
   CompareResult r;
   std::string why;
   if (!original.valid(&why)) { r.difference = "original mesh is invalid: " + why; return r; }
@@ -243,7 +244,7 @@ CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits
       return r;
     }
   }
-  const std::vector<AttributeHeader> headers = attribute_headers(original, AttributeBits{});
+  const std::vector<AttributeHeader> headers = attribute_headers(original, attribute_bits);
   const AttributeKeys ka = attribute_keys(original, headers), kb = attribute_keys(decoded, headers);
   if (ka.unused != kb.unused) {
     r.difference = "the values no corner uses differ (" + std::to_string(kb.unused.size()) + ", expected " +

@@ -23,6 +23,16 @@ struct Grid {
   double dequantize(int64_t q, int axis) const;
 };
 
+// Bits of the float attributes (integer-typed ones are coded exactly):
+// normals octahedral bits per axis; texture coordinates, float colours and
+// other float values as grid bits over the attribute's bounding box; 1..24.
+struct AttributeQuantization {
+  int normal = 10;
+  int texcoord = 12;
+  int color = 10;
+  int generic = 16;
+};
+
 struct CompareResult {
   bool equal = false;
   std::string difference;       // first difference found, for test messages
@@ -34,6 +44,9 @@ struct CompareResult {
 // matched by a canonical labelling that starts from the quantized position
 // and is refined by the oriented faces around each vertex, so meshes with
 // coincident vertices still compare correctly in practice.
-CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits);
+// Attributes are compared through the integers the codec codes them as, with
+// the bits the encoder was given (EncodeOptions::attribute_bits).
+CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits,
+                             const AttributeQuantization& attribute_bits = AttributeQuantization());
 
 }  // namespace tsm

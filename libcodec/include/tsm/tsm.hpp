@@ -33,6 +33,8 @@ struct EncodeOptions {
   // Threads coding segments in parallel; 0 = one per core. The bytes do not
   // depend on it.
   int threads = 0;
+  // Quantization of float attributes (integer-typed ones are coded exactly).
+  AttributeQuantization attribute_bits{};
 };
 
 struct DecodeOptions {
