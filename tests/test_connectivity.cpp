@@ -254,3 +254,20 @@ TEST(Connectivity, DenseComponentWithManyHandlesOnFewVertices) {
   EXPECT_GE(st.jump_edges, 8u);  // one of its components has 16 jump endpoints on fewer than 4 vertices
   expect_round_trip(m, "dense component", 22, false);
 }
+
+// Found by fuzz_roundtrip in CI's smoke run (2026-11-22, crash-32698725): a
+// pentagon whose vertex 15 is joined to the rest only through edges the
+// spiral tree's path rule left out, and through the pentagon's diagonal; the
+// tree took the diagonal, the diagonal was cut, the pentagon came back as
+// several faces ("more faces than the header says"). Left-out same-ring
+// edges are now tried before any diagonal.
+TEST(Connectivity, PolygonDiagonalNeverInTheVertexTree) {
+  Mesh m;
+  for (int i = 0; i < 42; ++i) m.add_vertex(static_cast<float>(i), static_cast<float>(i * i % 17), static_cast<float>(i * i * i % 19));
+  const uint32_t f1[] = {7, 13, 14}, f2[] = {0, 14, 16}, f3[] = {0, 16, 15, 2, 37}, f4[] = {15, 16, 2};
+  m.add_face(f1, 3);
+  m.add_face(f2, 3);
+  m.add_face(f3, 5);
+  m.add_face(f4, 3);
+  expect_round_trip(m, "pentagon reached through its diagonal", 8, false);
+}

@@ -134,12 +134,16 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
   std::vector<uint8_t> ring_deg(nv, 0);
+  std::vector<uint32_t> skipped;  // same-ring edges left out for the path rule
   size_t i = 0;
   for (; i < edges.size() && (edges[i].key >> 60) <= 1; ++i) {
     const Edge& e = edges[i];
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     const bool same_ring = (e.key >> 60) == 1 && !midpoint;
-    if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) continue;
+    if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) {
+      skipped.push_back(e.h);
+      continue;
+    }
     if (uf.unite(a, b)) {
       f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
       if (same_ring) {
@@ -168,8 +172,17 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     if (ex != ey) return ex < ey;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
   });
+  bool retried = false;
   for (; i < edges.size(); ++i) {
     const Edge& e = edges[i];
+    if (!retried && (e.key >> 60) >= 4) {
+      // Before any polygon diagonal: the same-ring edges the path rule left
+      // out, so that a diagonal joins the tree only when nothing else can
+      // (a diagonal in the tree would be cut and split its polygon).
+      retried = true;
+      for (uint32_t h : skipped)
+        if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
+    }
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
   }
