@@ -384,6 +384,21 @@ struct AttributeWalk {
 uint32_t attribute_key_size(const AttributeHeader& h) { return int_components(h); }
 void attribute_key(const AttributeHeader& h, const float* value, int32_t* out) { to_ints(h, value, out); }
 
+Attribute described_like(const Attribute& a) {
+  Attribute b;
+  b.name = a.name;
+  b.kind = a.kind;
+  b.domain = a.domain;
+  b.type = a.type;
+  b.components = a.components;
+  return b;
+}
+
+bool same_description(const Attribute& a, const Attribute& b) {
+  return a.name == b.name && a.kind == b.kind && a.domain == b.domain && a.type == b.type &&
+         a.components == b.components;
+}
+
 float attribute_grid_value(const AttributeHeader& h, int c, int64_t x) {
   const double v = static_cast<double>(h.origin[c]) + static_cast<double>(x) * grid_step(h);
   constexpr double kMax = static_cast<double>(std::numeric_limits<float>::max());

@@ -67,6 +67,11 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
 uint32_t attribute_key_size(const AttributeHeader& h);
 void attribute_key(const AttributeHeader& h, const float* value, int32_t* out);
 
+// An attribute's description (name, kind, domain, type, components) with
+// no values; whether two attributes have the same description.
+Attribute described_like(const Attribute& a);
+bool same_description(const Attribute& a, const Attribute& b);
+
 // Float value of grid index x on component c of a grid attribute.
 float attribute_grid_value(const AttributeHeader& h, int c, int64_t x);
 

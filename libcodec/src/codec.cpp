@@ -198,23 +198,20 @@ double grid_value(const Header& h, double step, int axis, uint32_t q) {
   return x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
 }
 
-// Appends a decoded part to the mesh: its own vertices get the next ids,
-// its faces follow the faces so far. Frees the part's buffers.
 // The parts of a file carry the same attributes (names, kinds, domains,
 // types, components), each with its own values.
-Status merge_attributes(const Mesh& out, bool first, const std::vector<Attribute>& part) {
+Status check_same_attributes(const Mesh& out, bool first, const std::vector<Attribute>& part) {
   if (first) return Status::Ok();
   bool same = part.size() == out.attributes.size();
-  for (size_t i = 0; same && i < part.size(); ++i) {
-    const Attribute &a = part[i], &b = out.attributes[i];
-    same = a.name == b.name && a.kind == b.kind && a.domain == b.domain && a.type == b.type &&
-           a.components == b.components;
-  }
+  for (size_t i = 0; same && i < part.size(); ++i) same = same_description(part[i], out.attributes[i]);
   return same ? Status::Ok() : corrupt("the segments disagree on the attributes they carry");
 }
 
+// Appends a decoded part to the mesh: its own vertices get the next ids,
+// its faces follow the faces so far, its attribute values follow theirs.
+// Frees the part's buffers.
 Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
-  TSM_RETURN_IF_ERROR(merge_attributes(out, first, part.faces.attributes));
+  TSM_RETURN_IF_ERROR(check_same_attributes(out, first, part.faces.attributes));
   const double step = grid_step(h);
   const uint32_t base = static_cast<uint32_t>(out.vertex_count());
   if (first) {
@@ -227,29 +224,24 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
       for (uint32_t x : p.indices) o.indices.push_back(value_base + x);
     }
   }
-  if (out.face_count() == 0 && base == 0 && part.counts.reference_count == 0) {  // the first part: no copy
-    out.face_offsets = std::move(part.faces.face_offsets);
-    out.indices = std::move(part.faces.indices);
-    out.positions.resize(part.q.size());
-    for (size_t i = 0; i < part.q.size(); ++i)
-      out.positions[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
-    part.faces.clear();
-    part.q = std::vector<uint32_t>();
-    part.global = std::vector<uint32_t>();
-    return Status::Ok();
-  }
-  std::vector<uint32_t> id(part.global.size());
-  uint32_t own = 0;
-  for (size_t v = 0; v < id.size(); ++v) id[v] = part.global[v] != kNone ? part.global[v] : base + own++;
   out.positions.resize(out.positions.size() + part.q.size());
   float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
-  for (size_t i = 0; i < part.q.size(); ++i) pos[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
-  const uint32_t corner_base = static_cast<uint32_t>(out.indices.size());
-  out.indices.reserve(out.indices.size() + part.faces.indices.size());
-  for (uint32_t x : part.faces.indices) out.indices.push_back(id[x]);
-  out.face_offsets.reserve(out.face_offsets.size() + part.faces.face_count());
-  for (size_t f = 1; f < part.faces.face_offsets.size(); ++f)
-    out.face_offsets.push_back(corner_base + part.faces.face_offsets[f]);
+  for (size_t i = 0; i < part.q.size(); ++i)
+    pos[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
+  if (first) {  // the first part has no references: its faces as they are, no copy
+    out.face_offsets = std::move(part.faces.face_offsets);
+    out.indices = std::move(part.faces.indices);
+  } else {
+    std::vector<uint32_t> id(part.global.size());
+    uint32_t own = 0;
+    for (size_t v = 0; v < id.size(); ++v) id[v] = part.global[v] != kNone ? part.global[v] : base + own++;
+    const uint32_t corner_base = static_cast<uint32_t>(out.indices.size());
+    out.indices.reserve(out.indices.size() + part.faces.indices.size());
+    for (uint32_t x : part.faces.indices) out.indices.push_back(id[x]);
+    out.face_offsets.reserve(out.face_offsets.size() + part.faces.face_count());
+    for (size_t f = 1; f < part.faces.face_offsets.size(); ++f)
+      out.face_offsets.push_back(corner_base + part.faces.face_offsets[f]);
+  }
   part.faces.clear();
   part.q = std::vector<uint32_t>();
   part.global = std::vector<uint32_t>();
@@ -368,12 +360,7 @@ std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<ui
                                           const std::vector<uint32_t>& faces, bool last) {
   std::vector<Attribute> out;
   for (const Attribute& a : mesh.attributes) {
-    Attribute b;
-    b.name = a.name;
-    b.kind = a.kind;
-    b.domain = a.domain;
-    b.type = a.type;
-    b.components = a.components;
+    Attribute b = described_like(a);
     const size_t c = a.components;
     auto take = [&](size_t j) { b.values.insert(b.values.end(), a.values.begin() + c * j, a.values.begin() + c * (j + 1)); };
     if (a.domain == AttributeDomain::vertex) {

@@ -237,10 +237,9 @@ CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits
     return r;
   }
   for (size_t i = 0; i < original.attributes.size(); ++i) {
-    const Attribute &x = original.attributes[i], &y = decoded.attributes[i];
-    if (x.name != y.name || x.kind != y.kind || x.domain != y.domain || x.type != y.type ||
-        x.components != y.components) {
-      r.difference = "attribute " + std::to_string(i) + " ('" + x.name + "') is described differently in the decoded mesh";
+    if (!same_description(original.attributes[i], decoded.attributes[i])) {
+      r.difference = "attribute " + std::to_string(i) + " ('" + original.attributes[i].name +
+                     "') is described differently in the decoded mesh";
       return r;
     }
   }
