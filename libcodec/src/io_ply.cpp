@@ -1535,28 +1535,35 @@ Status plan_layout(const Mesh& mesh, OutLayout& out) {
   return Status::Ok();
 }
 
+// The header both writers share: positions, then `vertex_props`; the face
+// list, then `face_props`. Returns whether face sizes need a uint count
+// (some face has more than 255 corners).
+bool write_header(const Mesh& mesh, const WriteOptions& options, const std::string& vertex_props,
+                  const std::string& face_props, std::string& out) {
+  uint32_t largest = 0;
+  for (size_t f = 0; f < mesh.face_count(); ++f) largest = std::max(largest, mesh.face_size(f));
+  const bool wide_count = largest > 255;
+  out.clear();
+  out += "ply\n";
+  out += options.ascii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
+  out += "comment written by tsm\n";
+  out += "element vertex " + std::to_string(mesh.vertex_count()) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\n";
+  out += vertex_props;
+  out += "element face " + std::to_string(mesh.face_count()) + "\n";
+  out += wide_count ? "property list uint uint vertex_indices\n" : "property list uchar uint vertex_indices\n";
+  out += face_props;
+  out += "end_header\n";
+  return wide_count;
+}
+
 // write_ply for a mesh with attributes (the plain layout keeps its fast path).
 Status write_ply_with_attributes(const Mesh& mesh, const WriteOptions& options, std::string& out) {
   OutLayout L;
   TSM_RETURN_IF_ERROR(plan_layout(mesh, L));
   const size_t nv = mesh.vertex_count();
   const size_t nf = mesh.face_count();
-  uint32_t largest = 0;
-  for (size_t f = 0; f < nf; ++f) largest = std::max(largest, mesh.face_size(f));
-  const bool wide_count = largest > 255;
-
-  out.clear();
-  out += "ply\n";
-  out += options.ascii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
-  out += "comment written by tsm\n";
-  out += "element vertex " + std::to_string(nv) + "\n";
-  out += "property float x\nproperty float y\nproperty float z\n";
-  out += L.vertex_props;
-  out += "element face " + std::to_string(nf) + "\n";
-  out += wide_count ? "property list uint uint vertex_indices\n" : "property list uchar uint vertex_indices\n";
-  out += L.face_props;
-  out += L.corner_props;
-  out += "end_header\n";
+  const bool wide_count = write_header(mesh, options, L.vertex_props, L.face_props + L.corner_props, out);
 
   // Value of attribute a at vertex v, face f, or corner c (component j).
   auto scalar = [](const OutScalar& s, size_t item) { return s.a->values[item * s.a->components + s.comp]; };
@@ -1656,19 +1663,7 @@ Status write_ply(const Mesh& mesh, const WriteOptions& options, std::string& out
   if (!mesh.attributes.empty()) return write_ply_with_attributes(mesh, options, out);
   const size_t nv = mesh.vertex_count();
   const size_t nf = mesh.face_count();
-  uint32_t largest = 0;
-  for (size_t f = 0; f < nf; ++f) largest = std::max(largest, mesh.face_size(f));
-  const bool wide_count = largest > 255;
-
-  out.clear();
-  out += "ply\n";
-  out += options.ascii ? "format ascii 1.0\n" : "format binary_little_endian 1.0\n";
-  out += "comment written by tsm\n";
-  out += "element vertex " + std::to_string(nv) + "\n";
-  out += "property float x\nproperty float y\nproperty float z\n";
-  out += "element face " + std::to_string(nf) + "\n";
-  out += wide_count ? "property list uint uint vertex_indices\n" : "property list uchar uint vertex_indices\n";
-  out += "end_header\n";
+  const bool wide_count = write_header(mesh, options, "", "", out);
 
   if (!options.ascii) {
     const size_t header = out.size();
