@@ -11,21 +11,11 @@
 #include <vector>
 
 #include "connectivity.hpp"
+#include "bench_timing.hpp"
 #include "tsm/io.hpp"
 
-namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double now_ms() {
-  using clock = std::chrono::steady_clock;
-  return std::chrono::duration<double, std::milli>(clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
+using tsm::bench::median;
+using tsm::bench::now_ms;
 
 int main(int argc, char** argv) {
   int runs = 5;

@@ -1,5 +1,6 @@
 // Draco comparison adapter for `tsm bench` (not part of the library).
 #include "bench_draco.hpp"
+#include "bench_timing.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -15,11 +16,6 @@
 namespace tsm::bench {
 
 namespace {
-[[maybe_unused]] double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 [[maybe_unused]] double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -14,19 +14,13 @@
 #include <thread>
 #include <vector>
 
+#include "bench_timing.hpp"
 #include "tsm/tsm.hpp"
 
+using tsm::bench::median;
+using tsm::bench::now_ms;
+
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double now_ms() {
-  using clock = std::chrono::steady_clock;
-  return std::chrono::duration<double, std::milli>(clock::now().time_since_epoch()).count();
-}
 
 constexpr double kLinkBytesPerMs = 1250.0;  // 10 Mbit/s
 constexpr size_t kChunk = 16384;

@@ -10,16 +10,14 @@
 
 #include "bench_draco.hpp"
 #include "cli_util.hpp"
+#include "bench_timing.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm::cli {
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
+using tsm::bench::median;
 
 // Draco takes triangles only: the same fan triangulation it is given, for its oracle check.
 Mesh fan_triangulated(const Mesh& m) {
