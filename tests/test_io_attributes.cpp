@@ -28,25 +28,12 @@ using tsm::ReadInfo;
 using tsm::ReadOptions;
 using tsm::Status;
 using tsm::WriteOptions;
+using tsm_test::bits;
+using tsm_test::from_bits;
+using tsm_test::contains;
 
 using tsm_test::Faces;
 using tsm_test::faces_of;
-
-uint32_t bits(float x) {
-  uint32_t b;
-  std::memcpy(&b, &x, 4);
-  return b;
-}
-float from_bits(uint32_t b) {
-  float x;
-  std::memcpy(&x, &b, 4);
-  return x;
-}
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
 
 ::testing::AssertionResult same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   if (a.size() != b.size()) return ::testing::AssertionFailure() << "sizes " << a.size() << " vs " << b.size();

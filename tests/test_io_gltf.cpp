@@ -29,17 +29,8 @@ using tsm::ReadInfo;
 using tsm::ReadOptions;
 using tsm::Status;
 using tsm::WriteOptions;
-
-uint32_t bits(float x) {
-  uint32_t b;
-  std::memcpy(&b, &x, 4);
-  return b;
-}
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
-}
+using tsm_test::bits;
+using tsm_test::contains;
 
 // Positions, faces and attributes identical, floats bit for bit.
 ::testing::AssertionResult identical(const Mesh& a, const Mesh& b) {

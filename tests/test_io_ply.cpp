@@ -26,20 +26,12 @@ using tsm::ReadInfo;
 using tsm::ReadOptions;
 using tsm::Status;
 using tsm::WriteOptions;
+using tsm_test::bits;
+using tsm_test::from_bits;
+using tsm_test::contains;
 
 using tsm_test::Faces;
 using tsm_test::faces_of;
-
-uint32_t bits(float x) {
-  uint32_t b;
-  std::memcpy(&b, &x, 4);
-  return b;
-}
-float from_bits(uint32_t b) {
-  float x;
-  std::memcpy(&x, &b, 4);
-  return x;
-}
 
 // Same vertex count, bit-identical positions, identical faces.
 ::testing::AssertionResult bit_identical(const Mesh& a, const Mesh& b) {
@@ -52,11 +44,6 @@ float from_bits(uint32_t b) {
   if (a.face_offsets != b.face_offsets) return ::testing::AssertionFailure() << "face offsets differ";
   if (a.indices != b.indices) return ::testing::AssertionFailure() << "face indices differ";
   return ::testing::AssertionSuccess();
-}
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
 }
 
 Status ply(const std::string& bytes, Mesh& m, const ReadOptions& o = {}, ReadInfo* info = nullptr) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -19,6 +20,24 @@ inline std::string corpus_dir() {
 }
 inline bool have_corpus() { return std::filesystem::is_directory(corpus_dir()); }
 inline std::string corpus_file(const std::string& rel) { return corpus_dir() + "/" + rel; }
+
+// The bits of a float and back, for bit-exact comparisons.
+inline uint32_t bits(float x) {
+  uint32_t b;
+  std::memcpy(&b, &x, 4);
+  return b;
+}
+inline float from_bits(uint32_t b) {
+  float x;
+  std::memcpy(&x, &b, 4);
+  return x;
+}
+
+// `part` occurs in `text` (an error message, a file), with both shown if not.
+inline ::testing::AssertionResult contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << part << "' not found in: " << text;
+}
 
 // Faces as corner lists, for exact comparisons.
 using Faces = std::vector<std::vector<uint32_t>>;
