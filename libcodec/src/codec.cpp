@@ -151,6 +151,15 @@ void parallel_for(size_t n, int threads, F&& f) {
   for (size_t i = 0; i < n; ++i) f(i);
 }
 
+// A segment section as a part: its streams (views into the section) and counts.
+Status read_part(const Section& sec, PartStreams& s, PartCounts& c) {
+  SegmentPayload p;
+  TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
+  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
+  c = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
+  return Status::Ok();
+}
+
 // The file's parts, from its parsed sections.
 Status collect_parts(const Header& h, const std::vector<Section>& sections, std::vector<PartStreams>& streams,
                      std::vector<DecodedPart>& parts) {
@@ -172,15 +181,15 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
   PartCounts sum;
   for (const Section& sec : sections) {
     if (sec.id != kSectionSegment) continue;
-    SegmentPayload p;
-    TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
+    PartStreams s;
+    PartCounts c;
+    TSM_RETURN_IF_ERROR(read_part(sec, s, c));
     streams.push_back(s);
     parts.emplace_back();
-    parts.back().counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
-    sum.vertex_count += p.vertex_count - p.reference_count;
-    sum.face_count += p.face_count;
-    sum.corner_count += p.corner_count;
+    parts.back().counts = c;
+    sum.vertex_count += c.vertex_count - c.reference_count;
+    sum.face_count += c.face_count;
+    sum.corner_count += c.corner_count;
   }
   if (parts.size() != h.segment_count)
     return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
@@ -641,11 +650,10 @@ struct StreamDecoder::Impl {
   }
 
   Status segment(const Section& sec) {
-    SegmentPayload p;
-    TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-    PartStreams s{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
+    PartStreams s;
     DecodedPart part;
-    part.counts = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
+    TSM_RETURN_IF_ERROR(read_part(sec, s, part.counts));
+    const PartCounts& p = part.counts;
     // Against the header before anything is allocated: the header's counts
     // passed the caller's limits.
     const uint64_t own = p.vertex_count - std::min(p.reference_count, p.vertex_count);
