@@ -85,6 +85,43 @@ tsm::Mesh bunny_with_normals_and_uvs(const std::string& path) {
   return m;
 }
 
+// The same texture coordinates per corner, with a seam where u wraps from 1
+// to 0 (corners of faces across it get u + 1, a value of their own, as an
+// unwrapped atlas would have), and the normals per vertex.
+tsm::Mesh with_corner_uvs(const tsm::Mesh& m) {
+  tsm::Mesh out = m;
+  const tsm::Attribute& t = m.attributes[1];
+  tsm::Attribute c;
+  c.name = t.name;
+  c.kind = t.kind;
+  c.components = 2;
+  c.domain = tsm::AttributeDomain::corner;
+  c.values = t.values;  // value v = vertex v's; wrapped copies appended
+  std::vector<uint32_t> wrapped(m.vertex_count(), UINT32_MAX);
+  for (size_t f = 0; f < m.face_count(); ++f) {
+    float lo = 2, hi = -1;
+    for (uint32_t k = 0; k < m.face_size(f); ++k) {
+      lo = std::min(lo, t.values[2 * m.face(f)[k]]);
+      hi = std::max(hi, t.values[2 * m.face(f)[k]]);
+    }
+    for (uint32_t k = 0; k < m.face_size(f); ++k) {
+      const uint32_t v = m.face(f)[k];
+      if (hi - lo > 0.5f && t.values[2 * v] < 0.5f) {
+        if (wrapped[v] == UINT32_MAX) {
+          wrapped[v] = static_cast<uint32_t>(c.values.size() / 2);
+          c.values.push_back(t.values[2 * v] + 1.0f);
+          c.values.push_back(t.values[2 * v + 1]);
+        }
+        c.indices.push_back(wrapped[v]);
+      } else {
+        c.indices.push_back(v);
+      }
+    }
+  }
+  out.attributes[1] = c;
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,7 +150,10 @@ int main(int argc, char** argv) {
     meshes.push_back({fs::path(f).filename().string(), std::move(m)});
   }
   tsm::Mesh bunny = bunny_with_normals_and_uvs(corpus + "/bun_zipper.ply");
-  if (bunny.vertex_count()) meshes.push_back({"bun_zipper.ply + normals + uv", std::move(bunny)});
+  if (bunny.vertex_count()) {
+    meshes.push_back({"bun_zipper.ply + normals + uv (per corner, seam)", with_corner_uvs(bunny)});
+    meshes.push_back({"bun_zipper.ply + normals + uv", std::move(bunny)});
+  }
   int k = 0;
   for (auto& [name, m] : meshes) {
     const std::string tag = "m" + std::to_string(k++);

@@ -4,8 +4,9 @@
 //
 // Input layout (make_seeds.cpp writes seeds in it):
 //   byte 0   quantization bits, 1 + b % 30; bit 7: with attributes (a u8
-//            colour and a normal per vertex, an i32 per face, and when not in
-//            segments a texture coordinate per corner with seams)
+//            colour and a normal per vertex, an i32 per face, and a texture
+//            coordinate per corner with seams and values shared far apart,
+//            across segment borders too)
 //   byte 1   level b % 10 (low nibble), position mode (b >> 4) % 4, bit 6:
 //            also check that a second encode gives the same bytes, bit 7:
 //            segments of at most 8 + byte 2 % 32 faces, also decoded
@@ -96,9 +97,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     f.type = tsm::AttributeType::i32;
     for (size_t k = 0; k < m.face_count(); ++k) f.values.push_back(static_cast<float>(static_cast<int64_t>(mix(k) % 4001) - 2000));
     m.attributes = {c, n, f};
-    // Corner values shared across a segment border are stored once per
-    // segment (FORMAT.md §10): the oracle would see the sharing differ.
-    if (!options.segment_faces) {
+    {
       t.name = "texcoord";
       t.kind = tsm::AttributeKind::texcoord;
       t.domain = tsm::AttributeDomain::corner;

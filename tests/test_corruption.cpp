@@ -217,6 +217,13 @@ Mesh point_set(int n) {
   return m;
 }
 
+std::string random_bytes_fixed(size_t n) {
+  std::mt19937 rng(5);
+  std::string s(n, '\0');
+  for (char& c : s) c = static_cast<char>(rng() & 0xff);
+  return s;
+}
+
 // Small files of different kinds (a few hundred bytes to a few kilobytes).
 std::vector<std::string> small_files() {
   Mesh cube = tsm_test::cube_quads();
@@ -232,6 +239,9 @@ std::vector<std::string> small_files() {
   out.push_back(encode_ok(point_set(12), 14));
   out.push_back(encode_ok(Mesh(), 14));
   out.push_back(encode_ok(tsm_test::icosphere(1), 12, tsm::kDefaultLevel, 20));  // 4 segments
+  Mesh with_metadata = tsm_test::icosphere(1);
+  with_metadata.metadata = {{"gltf", std::string(300, 'x') + "materials"}, {"k", std::string("\0\1\2", 3)}};
+  out.push_back(encode_ok(with_metadata, 12));
   return out;
 }
 
@@ -245,6 +255,9 @@ std::vector<std::string> damage_files() {
   out.push_back(encode_ok(tsm_test::flipped_face_sphere(1), 16));
   out.push_back(encode_ok(tsm_test::icosphere(2), 12, tsm::kDefaultLevel, 40));  // 8 segments
   out.push_back(encode_ok(tsm_test::copies(tsm_test::cube_quads(), 4), 9, tsm::kDefaultLevel, 5));
+  Mesh with_metadata = tsm_test::icosphere(2);
+  with_metadata.metadata = {{"notes", "a few words of text, and more of them"}, {"blob", random_bytes_fixed(200)}};
+  out.push_back(encode_ok(with_metadata, 12, tsm::kDefaultLevel, 100));
   return out;
 }
 
@@ -733,3 +746,54 @@ TEST(Corruption, RegressionFiles) {
 }
 
 }  // namespace
+
+// The metadata section (FORMAT.md §4.6) forged every way a payload can be
+// wrong: each is refused with corrupt_data, quickly and within the ceiling.
+TEST(Corruption, ForgedMetadataRefused) {
+  Mesh m = tsm_test::icosphere(1);
+  m.metadata = {{"a", "one"}};
+  const Container good = parse(encode_ok(m, 12));
+  size_t at = good.sections.size();
+  for (size_t i = 0; i < good.sections.size(); ++i)
+    if (good.sections[i].id == 9) at = i;
+  ASSERT_LT(at, good.sections.size()) << "no metadata section";
+  auto entry = [](const std::string& key, const std::string& value) {
+    std::string e(1, static_cast<char>(key.size()));
+    e += key;
+    tsm_fuzz::put_varint(e, value.size());
+    return e + value;
+  };
+  auto count = [](uint64_t n) {
+    std::string s;
+    tsm_fuzz::put_varint(s, n);
+    return s;
+  };
+  const std::vector<std::pair<std::string, std::string>> forged = {
+      {"duplicate keys", count(2) + entry("a", "1") + entry("a", "2")},
+      {"empty key", count(1) + entry("", "1")},
+      {"huge count", count(uint64_t{1} << 40) + entry("a", "1")},
+      {"count above the entries", count(3) + entry("a", "1") + entry("b", "2")},
+      {"bytes after the entries", count(1) + entry("a", "1") + "zz"},
+      {"value longer than the payload", count(1) + std::string("\1a") + count(uint64_t{1} << 33) + "abc"},
+      {"key cut off", count(1) + std::string("\tab")},
+      {"empty payload", ""},
+  };
+  for (const auto& [what, payload] : forged) {
+    Container c = good;
+    c.sections[at].codec = 0;
+    c.sections[at].stored = payload;
+    const DecodeResult r = guarded_decode(build(c));
+    expect_clean(r, what);
+    EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << what << ": " << describe(r);
+    // The stream decoder refuses it too.
+    tsm::StreamDecoder sd;
+    const std::string bytes = build(c);
+    tsm::Status s = sd.feed(bytes);
+    if (s.ok()) s = sd.finish();
+    EXPECT_EQ(s.code(), ErrorCode::corrupt_data) << what << " (stream): " << s.to_string();
+  }
+  Container twice = good;
+  twice.sections.insert(twice.sections.begin() + static_cast<std::ptrdiff_t>(at), good.sections[at]);
+  EXPECT_EQ(guarded_decode(build(twice)).status.code(), ErrorCode::corrupt_data) << "two metadata sections";
+}
+

@@ -119,23 +119,26 @@ bool in_range(const AttributeHeader& h, int64_t x) {
 }
 
 struct Models {
-  SIntModelT<4> res[4][2];
+  SIntModelT<4> res[3][4][2];  // [prediction class][component][previous residual of the component was 0]
   UIntModel symbol[6];
   UIntModel far;
   UIntModel unused;
+  UIntModel imported[2];    // [the corner's vertex is a reference]: is a new value one of an earlier segment
+  SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
 };
 
-// Residual coding of one value against a prediction; ctx per component: was
-// the previous residual zero.
+// Residual coding of one value against a prediction; contexts: the
+// prediction's class (predictor 2: 0 no triangle, 1 one, 2 several; else 0)
+// and per component whether its previous residual was zero.
 template <class Coder>
 struct ValueCoder {
   Coder& io;
   Models m;
   int last_zero[4] = {1, 1, 1, 1};
-  bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x) {
+  bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls = 0) {
     const uint32_t n = int_components(h);
     for (uint32_t c = 0; c < n; ++c) {
-      int32_t r = io.sint(m.res[c][last_zero[c]], static_cast<int64_t>(x[c]) - pred[c]);
+      int32_t r = io.sint(m.res[cls][c][last_zero[c]], static_cast<int64_t>(x[c]) - pred[c]);
       const int64_t v = static_cast<int64_t>(pred[c]) + r;
       if (!in_range(h, v)) return false;
       x[c] = static_cast<int32_t>(v);
@@ -206,6 +209,88 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
   }
 }
 
+// Texture coordinates from the geometry (predictor 2, FORMAT.md §8.12): the
+// triangle (a, b, w), in the cyclic order of its face, has its texture
+// coordinates at a and b; w is placed in the texture plane as it lies in
+// space relative to the edge a-b: at the same fraction t along the edge, and
+// across it by its distance h from the edge's line. When the triangle across
+// the edge, (b, a, c), has its texture coordinates too, the texture vector of
+// a unit step away from the edge is c's (an affine map, so stretched and
+// sheared charts are followed) and w goes the other way; otherwise it is the
+// edge's texture vector turned a quarter (a conformal map) to the side
+// `sigma` says (the sign of the texture triangle's area, which a chart keeps
+// from face to face). Positions are grid indices.
+void uv_from_triangle(const uint32_t* pw, const uint32_t* pa, const uint32_t* pb, const int32_t* ua,
+                      const int32_t* ub, const uint32_t* pc, const int32_t* uc, int sigma, double out[2]) {
+  const double ex = double(pb[0]) - pa[0], ey = double(pb[1]) - pa[1], ez = double(pb[2]) - pa[2];
+  const double l2 = ex * ex + ey * ey + ez * ez;
+  const double dx = double(ub[0]) - ua[0], dy = double(ub[1]) - ua[1];
+  if (l2 == 0) {
+    out[0] = ua[0];
+    out[1] = ua[1];
+    return;
+  }
+  const double wx = double(pw[0]) - pa[0], wy = double(pw[1]) - pa[1], wz = double(pw[2]) - pa[2];
+  const double t = (wx * ex + wy * ey + wz * ez) / l2;
+  const double px = wx - t * ex, py = wy - t * ey, pz = wz - t * ez;
+  const double hw = std::sqrt(px * px + py * py + pz * pz);
+  if (pc) {
+    const double cx = double(pc[0]) - pa[0], cy = double(pc[1]) - pa[1], cz = double(pc[2]) - pa[2];
+    const double tc = (cx * ex + cy * ey + cz * ez) / l2;
+    const double qx = cx - tc * ex, qy = cy - tc * ey, qz = cz - tc * ez;
+    const double hc = std::sqrt(qx * qx + qy * qy + qz * qz);
+    if (hc > 0) {
+      const double mx = (double(uc[0]) - ua[0] - tc * dx) / hc, my = (double(uc[1]) - ua[1] - tc * dy) / hc;
+      out[0] = ua[0] + t * dx - hw * mx;
+      out[1] = ua[1] + t * dy - hw * my;
+      return;
+    }
+  }
+  const double h = hw / std::sqrt(l2) * sigma;
+  out[0] = ua[0] + t * dx - h * dy;
+  out[1] = ua[1] + t * dy + h * dx;
+}
+
+// The sign of the texture-space area of a face's corners (shoelace), 0 if none.
+int uv_orientation(const int32_t* const* uv, uint32_t k) {
+  // Each product is below 2^48 (24-bit grids); the sum wraps modulo 2^64
+  // (a polygon of tens of thousands of corners could exceed int64).
+  uint64_t area = 0;
+  for (uint32_t i = 0; i < k; ++i) {
+    const int32_t* a = uv[i];
+    const int32_t* b = uv[(i + 1) % k];
+    area += static_cast<uint64_t>(int64_t{a[0]} * b[1]) - static_cast<uint64_t>(int64_t{b[0]} * a[1]);
+  }
+  const int64_t signed_area = static_cast<int64_t>(area);
+  return signed_area > 0 ? 1 : signed_area < 0 ? -1 : 0;
+}
+
+// Rounds an averaged prediction to the attribute's integer range.
+int32_t round_to_grid(double x, int bits) {
+  const double top = std::ldexp(1.0, bits) - 1;
+  const double r = std::floor(x + 0.5);
+  return static_cast<int32_t>(r < 0 ? 0 : r > top ? top : r);
+}
+
+// Faces around each part vertex (a face once per corner at the vertex).
+struct VertexFaces {
+  std::vector<uint32_t> start, face, corner;  // corner: position in the face
+  void build(const Mesh& faces, size_t V) {
+    start.assign(V + 1, 0);
+    for (uint32_t v : faces.indices) ++start[v + 1];
+    for (size_t v = 0; v < V; ++v) start[v + 1] += start[v];
+    face.resize(faces.indices.size());
+    corner.resize(faces.indices.size());
+    std::vector<uint32_t> at(start.begin(), start.end() - 1);
+    for (uint32_t f = 0; f < faces.face_count(); ++f)
+      for (uint32_t i = 0; i < faces.face_size(f); ++i) {
+        const uint32_t v = faces.face(f)[i];
+        face[at[v]] = f;
+        corner[at[v]++] = i;
+      }
+  }
+};
+
 void write_header(ByteWriter& w, const AttributeHeader& h) {
   w.varint(h.name.size());
   w.bytes(h.name);
@@ -261,20 +346,119 @@ struct AttributeWalk {
   const std::vector<uint32_t>& rank;  // per part vertex: own rank or kNone
   const std::vector<int32_t>* gnormal;  // per own rank: geometry normal (octahedral)
   const std::vector<uint8_t>* ghas;
+  const std::vector<uint32_t>* q = nullptr;  // own vertices' grid positions (predictor 2)
+  const VertexFaces* around = nullptr;        // faces around each vertex (predictor 2)
+
+  // Predictor 2 for the value at position i of face f (vertex w): the mean
+  // of the texture-space placements from the face's triangles (w, i+1, i+2)
+  // and, for polygons, (i-2, i-1, w) whose other two corners are known
+  // (`known(position)` gives their integers or nullptr) and own vertices.
+  // For each, the first face around a (in `around` order) other than f that
+  // has the edge a-b and a third corner c, an own vertex other than w, whose
+  // value `across(F, position of a, of b, of c in F, ia, ib)` gives, is the
+  // triangle across the edge.
+  template <class Known, class Across>
+  int uv_triangles(uint32_t f, uint32_t i, int sigma, Known known, Across across, double sum[2]) const {
+    const uint32_t k = faces.face_size(f);
+    const uint32_t* c = faces.face(f);
+    int count = 0;
+    const uint32_t w = c[i];
+    if (k < 3 || rank[w] == kNone) return 0;
+    for (uint32_t side = 0; side < (k > 3 ? 2u : 1u); ++side) {
+      const uint32_t ia = side == 0 ? (i + 1) % k : (i + k - 2) % k;
+      const uint32_t ib = side == 0 ? (i + 2) % k : (i + k - 1) % k;
+      const uint32_t a = c[ia], b = c[ib];
+      if (a == w || b == w || a == b || rank[a] == kNone || rank[b] == kNone) continue;
+      const int32_t* ua = known(ia);
+      const int32_t* ub = known(ib);
+      if (!ua || !ub) continue;
+      const uint32_t* pc = nullptr;
+      const int32_t* uc = nullptr;
+      for (uint32_t j = around->start[a]; j < around->start[a + 1] && !uc; ++j) {
+        const uint32_t F = around->face[j], pa = around->corner[j], kf = faces.face_size(F);
+        if (F == f || kf < 3) continue;
+        const uint32_t* fc = faces.face(F);
+        uint32_t pb, pcf;
+        if (fc[(pa + 1) % kf] == b) {
+          pb = (pa + 1) % kf;
+          pcf = (pa + 2) % kf;
+        } else if (fc[(pa + kf - 1) % kf] == b) {
+          pb = (pa + kf - 1) % kf;
+          pcf = (pa + kf - 2) % kf;
+        } else {
+          continue;
+        }
+        const uint32_t cv = fc[pcf];
+        if (cv == w || cv == a || cv == b || rank[cv] == kNone) continue;
+        uc = across(F, pa, pb, pcf, ia, ib);
+        if (uc) pc = &(*q)[3 * static_cast<size_t>(rank[cv])];
+      }
+      double p[2];
+      uv_from_triangle(&(*q)[3 * static_cast<size_t>(rank[w])], &(*q)[3 * static_cast<size_t>(rank[a])],
+                       &(*q)[3 * static_cast<size_t>(rank[b])], ua, ub, pc, uc, sigma, p);
+      sum[0] += p[0];
+      sum[1] += p[1];
+      ++count;
+    }
+    return count;
+  }
 
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
   bool vertices(int predictor, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
     int32_t prev[4] = {0, 0, 0, 0};
-    const size_t count = x.size() / n;
-    for (size_t r = 0; r < count; ++r) {
+    int sigma = 1;
+    std::vector<const int32_t*> uv;
+    for (size_t v = 0; v < rank.size(); ++v) {
+      const uint32_t r = rank[v];
+      if (r == kNone) continue;
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
       if (predictor == 1 && (*ghas)[r]) {
         pred[0] = (*gnormal)[2 * r];
         pred[1] = (*gnormal)[2 * r + 1];
       }
-      if (!vc.value(h, pred, &x[n * r])) return false;
-      std::copy(&x[n * r], &x[n * r] + n, prev);
+      int cls = 0;
+      if (predictor == 2) {
+        double sum[2] = {0, 0};
+        int count = 0;
+        for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+          const uint32_t f = around->face[j];
+          const uint32_t* c = faces.face(f);
+          count += uv_triangles(
+              f, around->corner[j], sigma,
+              [&](uint32_t at) -> const int32_t* {
+                const uint32_t ra = rank[c[at]];
+                return ra < r ? &x[2 * static_cast<size_t>(ra)] : nullptr;
+              },
+              [&](uint32_t F, uint32_t, uint32_t, uint32_t pc, uint32_t, uint32_t) -> const int32_t* {
+                const uint32_t rc = rank[faces.face(F)[pc]];
+                return rc < r ? &x[2 * static_cast<size_t>(rc)] : nullptr;
+              },
+              sum);
+        }
+        if (count > 0) {
+          pred[0] = round_to_grid(sum[0] / count, h.bits);
+          pred[1] = round_to_grid(sum[1] / count, h.bits);
+        }
+        cls = std::min(count, 2);
+      }
+      if (!vc.value(h, pred, &x[n * static_cast<size_t>(r)], cls)) return false;
+      std::copy(&x[n * static_cast<size_t>(r)], &x[n * static_cast<size_t>(r)] + n, prev);
+      if (predictor == 2) {  // faces completed by this vertex give the chart's orientation
+        for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+          const uint32_t f = around->face[j], k = faces.face_size(f);
+          const uint32_t* c = faces.face(f);
+          bool complete = k >= 3;
+          uv.clear();
+          for (uint32_t i = 0; i < k && complete; ++i) {
+            complete = rank[c[i]] <= r;
+            if (complete) uv.push_back(&x[2 * static_cast<size_t>(rank[c[i]])]);
+          }
+          if (!complete) continue;
+          const int o = uv_orientation(uv.data(), k);
+          if (o != 0) sigma = o;
+        }
+      }
     }
     return true;
   }
@@ -291,71 +475,152 @@ struct AttributeWalk {
   // index), `in_ints` the input values; out: the part's value list in
   // first-use order (then the unused ones), `index` per corner.
   // max_unused: a bound from the stream's size (each value costs at least
-  // one coded decision).
-  bool corners(const std::vector<uint32_t>& in_value, const std::vector<int32_t>& in_ints, size_t in_count,
-               uint64_t max_unused, std::vector<int32_t>& values, std::vector<uint32_t>& index) {
+  // one coded decision). With predictor 2 the corners of a face are visited
+  // known vertices first (those with candidates when the face starts), so
+  // that a new value has its face's other values to be predicted from.
+  //
+  // In a segment (`segmented`), each new value says whether it is a value of
+  // an earlier segment (`imported`, per input value: its id in the file's
+  // value list, or kNone) and then which; `alias` gets per output value that
+  // id or kNone. `in_of`: per output value its input value (encoder).
+  bool corners(int predictor, bool segmented, const std::vector<uint32_t>* imported,
+               const std::vector<uint32_t>& in_value, const std::vector<int32_t>& in_ints, size_t in_count,
+               uint64_t max_unused, std::vector<int32_t>& values, std::vector<uint32_t>& index,
+               std::vector<uint32_t>& alias, std::vector<uint32_t>& in_of) {
     const uint32_t n = int_components(h);
     const size_t K = faces.indices.size();
     const size_t V = rank.size();
     std::vector<uint32_t> cand(4 * V, kNone);
     std::vector<uint8_t> ncand(V, 0);
     std::vector<uint32_t> out_of(Coder::kEncoder ? in_count : 0, kNone);  // encoder: input value -> output id
-    std::vector<uint32_t> in_of;                                          // encoder: output id -> input value
+    in_of.clear();
+    alias.clear();
+    int64_t last_import = 0;
     index.assign(K, 0);
     values.clear();
     int32_t prev[4] = {0, 0, 0, 0};
-    for (size_t k = 0; k < K; ++k) {
-      const uint32_t w = faces.indices[k];
-      const uint32_t nc = ncand[w];
-      uint32_t s = 0, id = kNone;
-      if constexpr (Coder::kEncoder) {
-        id = out_of[in_value[k]];
-        if (id == kNone) {
-          s = nc;
-        } else {
-          s = nc + 1;
-          for (uint32_t i = 0; i < nc; ++i)
-            if (cand[4 * w + i] == id) s = i;
-        }
-      }
-      s = io.uint(vc.m.symbol[std::min<uint32_t>(nc, 5)], s);
-      const uint32_t have = static_cast<uint32_t>(values.size() / n);
-      if (s < nc) {
-        id = cand[4 * w + s];
-      } else if (s == nc) {  // a new value
-        id = have;
-        values.resize(values.size() + n);
-        int32_t* x = &values[n * static_cast<size_t>(id)];
-        if constexpr (Coder::kEncoder) {
-          std::copy(&in_ints[n * static_cast<size_t>(in_value[k])], &in_ints[n * static_cast<size_t>(in_value[k])] + n, x);
-          out_of[in_value[k]] = id;
-          in_of.push_back(in_value[k]);
-        }
-        int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
-        const uint32_t r = rank[w];
-        if (gnormal && r != kNone && (*ghas)[r]) {
-          pred[0] = (*gnormal)[2 * r];
-          pred[1] = (*gnormal)[2 * r + 1];
-        }
-        if (!vc.value(h, pred, x)) return false;
-        std::copy(x, x + n, prev);
-      } else if (s == nc + 1) {  // a value met elsewhere
-        uint32_t back = 0;
-        if constexpr (Coder::kEncoder) back = have - 1 - id;
-        back = io.uint(vc.m.far, back);
-        if (back >= have) return false;
-        id = have - 1 - back;
+    int sigma = 1;
+    std::vector<uint32_t> visit;     // positions of the face in visiting order
+    std::vector<uint8_t> done;       // per position: value known
+    std::vector<const int32_t*> uv;  // per position: its value's integers
+    for (uint32_t g = 0; g < faces.face_count(); ++g) {
+      const uint32_t fk = faces.face_size(g);
+      const uint32_t* fc = faces.face(g);
+      visit.clear();
+      if (predictor == 2) {
+        for (uint32_t i = 0; i < fk; ++i)
+          if (ncand[fc[i]] > 0) visit.push_back(i);
+        for (uint32_t i = 0; i < fk; ++i)
+          if (ncand[fc[i]] == 0) visit.push_back(i);
       } else {
-        return false;
+        for (uint32_t i = 0; i < fk; ++i) visit.push_back(i);
       }
-      index[k] = id;
-      if (s >= nc && nc < 4) {
-        bool seen = false;
-        for (uint32_t i = 0; i < nc; ++i) seen = seen || cand[4 * w + i] == id;
-        if (!seen) {
-          cand[4 * w + nc] = id;
-          ncand[w] = static_cast<uint8_t>(nc + 1);
+      done.assign(fk, 0);
+      for (uint32_t i : visit) {
+        const size_t k = faces.face_offsets[g] + i;
+        const uint32_t w = fc[i];
+        const uint32_t nc = ncand[w];
+        uint32_t s = 0, id = kNone;
+        if constexpr (Coder::kEncoder) {
+          id = out_of[in_value[k]];
+          if (id == kNone) {
+            s = nc;
+          } else {
+            s = nc + 1;
+            for (uint32_t j = 0; j < nc; ++j)
+              if (cand[4 * w + j] == id) s = j;
+          }
         }
+        s = io.uint(vc.m.symbol[std::min<uint32_t>(nc, 5)], s);
+        const uint32_t have = static_cast<uint32_t>(values.size() / n);
+        if (s < nc) {
+          id = cand[4 * w + s];
+        } else if (s == nc) {  // a new value
+          id = have;
+          int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
+          int cls = 0;
+          const uint32_t r = rank[w];
+          if (gnormal && r != kNone && (*ghas)[r]) {
+            pred[0] = (*gnormal)[2 * r];
+            pred[1] = (*gnormal)[2 * r + 1];
+          }
+          if (predictor == 2) {
+            double sum[2] = {0, 0};
+            const uint32_t* off = faces.face_offsets.data();
+            const int count = uv_triangles(
+                g, i, sigma,
+                [&](uint32_t at) -> const int32_t* {
+                  return done[at] ? &values[n * static_cast<size_t>(index[off[g] + at])] : nullptr;
+                },
+                [&](uint32_t F, uint32_t pa, uint32_t pb, uint32_t pc, uint32_t ia, uint32_t ib) -> const int32_t* {
+                  if (F >= g || index[off[F] + pa] != index[off[g] + ia] || index[off[F] + pb] != index[off[g] + ib])
+                    return nullptr;
+                  return &values[n * static_cast<size_t>(index[off[F] + pc])];
+                },
+                sum);
+            cls = std::min(count, 2);
+            if (count > 0) {
+              pred[0] = round_to_grid(sum[0] / count, h.bits);
+              pred[1] = round_to_grid(sum[1] / count, h.bits);
+            } else {
+              for (uint32_t j : visit)
+                if (done[j]) {
+                  const int32_t* u = &values[n * static_cast<size_t>(index[faces.face_offsets[g] + j])];
+                  std::copy(u, u + n, pred);
+                  break;
+                }
+            }
+          }
+          uint32_t from = kNone;
+          if (segmented) {
+            uint32_t flag = 0;
+            if constexpr (Coder::kEncoder) flag = (*imported)[in_value[k]] != kNone;
+            flag = io.uint(vc.m.imported[r == kNone], flag);
+            if (flag > 1) return false;
+            if (flag) {
+              int64_t delta = 0;
+              if constexpr (Coder::kEncoder) delta = int64_t{(*imported)[in_value[k]]} - last_import;
+              const int64_t gid = last_import + io.sint(vc.m.import_id, delta);
+              if (gid < 0 || gid >= int64_t{kNone}) return false;
+              last_import = gid;
+              from = static_cast<uint32_t>(gid);
+            }
+          }
+          alias.push_back(from);
+          values.resize(values.size() + n);
+          int32_t* x = &values[n * static_cast<size_t>(id)];
+          if constexpr (Coder::kEncoder) {
+            std::copy(&in_ints[n * static_cast<size_t>(in_value[k])], &in_ints[n * static_cast<size_t>(in_value[k])] + n, x);
+            out_of[in_value[k]] = id;
+            in_of.push_back(in_value[k]);
+          }
+          if (!vc.value(h, pred, x, cls)) return false;
+          std::copy(x, x + n, prev);
+        } else if (s == nc + 1) {  // a value met elsewhere
+          uint32_t back = 0;
+          if constexpr (Coder::kEncoder) back = have - 1 - id;
+          back = io.uint(vc.m.far, back);
+          if (back >= have) return false;
+          id = have - 1 - back;
+        } else {
+          return false;
+        }
+        index[k] = id;
+        done[i] = 1;
+        if (s >= nc && nc < 4) {
+          bool seen = false;
+          for (uint32_t j = 0; j < nc; ++j) seen = seen || cand[4 * w + j] == id;
+          if (!seen) {
+            cand[4 * w + nc] = id;
+            ncand[w] = static_cast<uint8_t>(nc + 1);
+          }
+        }
+      }
+      if (predictor == 2 && fk >= 3) {
+        uv.clear();
+        for (uint32_t i = 0; i < fk; ++i) uv.push_back(&values[n * static_cast<size_t>(index[faces.face_offsets[g] + i])]);
+        const int o = uv_orientation(uv.data(), fk);
+        if (o != 0) sigma = o;
       }
     }
     // The values no corner uses, in input order.
@@ -367,9 +632,11 @@ struct AttributeWalk {
     for (uint32_t u = 0; u < unused; ++u) {
       const size_t at = values.size();
       values.resize(at + n);
+      alias.push_back(kNone);
       if constexpr (Coder::kEncoder) {
         while (out_of[next_in] != kNone) ++next_in;
         std::copy(&in_ints[n * next_in], &in_ints[n * next_in] + n, &values[at]);
+        in_of.push_back(static_cast<uint32_t>(next_in));
         ++next_in;
       }
       if (!vc.value(h, prev, &values[at])) return false;
@@ -441,6 +708,20 @@ std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const Attribute
   return out;
 }
 
+namespace {
+
+// The predictors an attribute may use, as bits (1 << predictor): 0 previous
+// value; 1 geometry normal (vertex normals, octahedral); 2 texture placement
+// from the geometry (two-component grid values per vertex or corner).
+unsigned predictors_for(const AttributeHeader& h) {
+  unsigned p = 1;
+  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2;
+  if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
+  return p;
+}
+
+}  // namespace
+
 Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out) {
   out.clear();
   if (headers.empty()) return Status::Ok();
@@ -500,62 +781,89 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   }
   std::vector<int32_t> gnormal;
   std::vector<uint8_t> ghas;
-  std::string body;
-  ByteWriter w(body);
-  w.varint(headers.size());
-  for (const AttributeHeader& h : headers) write_header(w, h);
-  // Per attribute: the predictor byte, chosen by size for vertex normals.
-  std::vector<int> predictor(headers.size(), 0);
-  for (size_t i = 0; i < headers.size(); ++i) {
-    const AttributeHeader& h = headers[i];
-    if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) predictor[i] = 1;
-    w.u8(static_cast<uint8_t>(predictor[i]));
-  }
-  Enc enc;
-  for (size_t i = 0; i < headers.size(); ++i) {
+  VertexFaces around;
+  bool need_around = false;
+  for (const AttributeHeader& h : headers) need_around = need_around || predictors_for(h) & 4;
+  if (need_around) around.build(faces, V);
+  // One attribute's values into `enc` with `predictor`.
+  std::vector<uint32_t>* own_values = nullptr;
+  auto code = [&](Enc& enc, size_t i, int predictor) {
     const AttributeHeader& h = headers[i];
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
-    const std::vector<int32_t>* gn = nullptr;
-    const std::vector<uint8_t>* gh = nullptr;
-    if (h.quant == AttributeQuant::octahedral) {
-      geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
-      gn = &gnormal;
-      gh = &ghas;
-    }
     ValueCoder<Enc> vc{enc, {}};
-    AttributeWalk<Enc> walk{h, vc, enc, faces, rank, gn, gh};
+    const bool oct = h.quant == AttributeQuant::octahedral;
+    AttributeWalk<Enc> walk{h, vc, enc, faces, rank, oct ? &gnormal : nullptr, oct ? &ghas : nullptr, in.q, &around};
     if (h.domain == AttributeDomain::vertex) {
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
         if (rank[v] != kNone) to_ints(h, &a.values[h.components * static_cast<size_t>(order[v])], &x[n * rank[v]]);
-      if (!walk.vertices(predictor[i], x)) return Status(ErrorCode::internal, "attributes: vertex values out of range");
-    } else if (h.domain == AttributeDomain::face) {
+      return walk.vertices(predictor, x);
+    }
+    if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
       for (size_t g = 0; g < faces.face_count(); ++g) to_ints(h, &a.values[h.components * static_cast<size_t>(face_of[g])], &x[n * g]);
-      if (!walk.face_values(x)) return Status(ErrorCode::internal, "attributes: face values out of range");
-    } else {
-      const size_t count = a.value_count();
-      std::vector<int32_t> ints(n * count);
-      for (size_t j = 0; j < count; ++j) to_ints(h, &a.values[h.components * j], &ints[n * j]);
-      std::vector<uint32_t> in_value(faces.indices.size());
-      for (uint32_t g = 0; g < faces.face_count(); ++g) {
-        const uint32_t k = faces.face_size(g), f = face_of[g];
-        for (uint32_t c = 0; c < k; ++c)
-          in_value[faces.face_offsets[g] + c] = a.indices[part.face_offsets[f] + (c + shift[g]) % k];
-      }
-      std::vector<int32_t> values;
-      std::vector<uint32_t> index;
-      if (!walk.corners(in_value, ints, count, UINT64_MAX, values, index))
-        return Status(ErrorCode::internal, "attributes: corner values out of range");
+      return walk.face_values(x);
     }
+    const size_t count = a.value_count();
+    std::vector<int32_t> ints(n * count);
+    for (size_t j = 0; j < count; ++j) to_ints(h, &a.values[h.components * j], &ints[n * j]);
+    std::vector<uint32_t> in_value(faces.indices.size());
+    for (uint32_t g = 0; g < faces.face_count(); ++g) {
+      const uint32_t k = faces.face_size(g), f = face_of[g];
+      for (uint32_t c = 0; c < k; ++c)
+        in_value[faces.face_offsets[g] + c] = a.indices[part.face_offsets[f] + (c + shift[g]) % k];
+    }
+    std::vector<int32_t> values;
+    std::vector<uint32_t> index, alias, in_of;
+    const std::vector<uint32_t>* imported = in.imported ? &(*in.imported)[i] : nullptr;
+    if (!walk.corners(predictor, in.segmented, imported, in_value, ints, count, UINT64_MAX, values, index, alias, in_of))
+      return false;
+    if (own_values) {  // the values this part adds to the file's list, in its order
+      own_values->clear();
+      for (size_t j = 0; j < in_of.size(); ++j)
+        if (alias[j] == kNone) own_values->push_back(in_of[j]);
+    }
+    return true;
+  };
+  std::string body;
+  ByteWriter w(body);
+  w.varint(headers.size());
+  for (const AttributeHeader& h : headers) write_header(w, h);
+  // Per attribute: the predictor, the one that codes it smallest.
+  std::vector<int> predictor(headers.size(), 0);
+  for (size_t i = 0; i < headers.size(); ++i) {
+    const AttributeHeader& h = headers[i];
+    if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
+    const unsigned choices = predictors_for(h);
+    size_t best = SIZE_MAX;
+    for (int p = 0; p < 3 && choices != 1; ++p) {
+      if (!(choices >> p & 1)) continue;
+      Enc trial;
+      if (!code(trial, i, p)) return Status(ErrorCode::internal, "attributes: values out of range");
+      const size_t size = trial.e.finish().size();
+      if (size < best) {
+        best = size;
+        predictor[i] = p;
+      }
+    }
+    w.u8(static_cast<uint8_t>(predictor[i]));
+  }
+  Enc enc;
+  if (in.own_values) in.own_values->assign(headers.size(), {});
+  for (size_t i = 0; i < headers.size(); ++i) {
+    if (headers[i].quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, headers[i].bits, gnormal, ghas);
+    own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
+    if (!code(enc, i, predictor[i])) return Status(ErrorCode::internal, "attributes: values out of range");
   }
   out = body + enc.e.finish();
   return Status::Ok();
 }
 
-Status decode_attributes(std::string_view bytes, const AttributePart& in, std::vector<Attribute>& out) {
+Status decode_attributes(std::string_view bytes, const AttributePart& in, std::vector<Attribute>& out,
+                         std::vector<std::vector<uint32_t>>* alias) {
   out.clear();
+  if (alias) alias->clear();
   if (bytes.empty()) return Status::Ok();
   const Mesh& faces = *in.faces;
   const std::vector<uint32_t>& global = *in.global;
@@ -567,9 +875,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   std::vector<int> predictor(headers.size());
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
-    if (!r.u8(p) || p > 1 || (p == 1 && (headers[i].domain != AttributeDomain::vertex ||
-                                         headers[i].quant != AttributeQuant::octahedral)))
-      return corrupt("bad predictor");
+    if (!r.u8(p) || p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
   std::string_view coded;
@@ -579,6 +885,9 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   uint32_t own = 0;
   for (size_t v = 0; v < V; ++v)
     if (global[v] == kNone) rank[v] = own++;
+  VertexFaces around;
+  for (size_t i = 0; i < headers.size(); ++i)
+    if (predictor[i] == 2 && around.start.empty()) around.build(faces, V);
   Dec dec;
   dec.d.init(coded);
   for (size_t i = 0; i < headers.size(); ++i) {
@@ -589,7 +898,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gn, gh);
     ValueCoder<Dec> vc{dec, {}};
     AttributeWalk<Dec> walk{h, vc, dec, faces, rank, h.quant == AttributeQuant::octahedral ? &gn : nullptr,
-                            h.quant == AttributeQuant::octahedral ? &gh : nullptr};
+                            h.quant == AttributeQuant::octahedral ? &gh : nullptr, in.q, &around};
     Attribute a;
     a.name = h.name;
     a.kind = h.kind;
@@ -604,11 +913,15 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       x.assign(n * faces.face_count(), 0);
       if (!walk.face_values(x)) return corrupt("face values of '" + h.name + "' out of range");
     } else {
-      std::vector<uint32_t> none;
+      std::vector<uint32_t> none, aliases, in_of;
       std::vector<int32_t> no_ints;
       const uint64_t budget = 730 * (static_cast<uint64_t>(coded.size()) + 8);
-      if (!walk.corners(none, no_ints, 0, budget, x, a.indices))
+      if (!walk.corners(predictor[i], in.segmented, nullptr, none, no_ints, 0, budget, x, a.indices, aliases, in_of))
         return corrupt("corner values of '" + h.name + "' are invalid");
+      if (alias) {
+        alias->resize(headers.size());
+        (*alias)[i] = std::move(aliases);
+      }
     }
     if (dec.d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("stream is truncated");
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));

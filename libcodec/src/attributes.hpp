@@ -49,6 +49,14 @@ struct AttributeInput {
   const std::vector<uint8_t>* is_ref = nullptr;  // per output vertex, 1 = reference (may be empty)
   const Mesh* faces = nullptr;
   const std::vector<uint32_t>* q = nullptr;
+  // Segments (FORMAT.md §8.12, "values of earlier segments"): per attribute,
+  // per part input value of a corner attribute, its id in the file's value
+  // list when an earlier segment holds it, else kNone (null: none).
+  bool segmented = false;
+  const std::vector<std::vector<uint32_t>>* imported = nullptr;
+  // Out (optional): per attribute, the part input values that this part adds
+  // to the file's value list, in the order the decoder appends them.
+  std::vector<std::vector<uint32_t>>* own_values = nullptr;
 };
 Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out);
 
@@ -59,8 +67,13 @@ struct AttributePart {
   const Mesh* faces = nullptr;                     // the part's decoded faces (part output ids)
   const std::vector<uint32_t>* global = nullptr;   // per part vertex: kNone own, else a reference
   const std::vector<uint32_t>* q = nullptr;        // own vertices' grid indices
+  bool segmented = false;                          // a segment's payload (may name earlier values)
 };
-Status decode_attributes(std::string_view bytes, const AttributePart& in, std::vector<Attribute>& out);
+// `alias` (optional) gets per attribute, per value of the part's value list,
+// the id in the file's value list of an earlier segment's value it stands
+// for, or kNone (empty for vertex and face attributes).
+Status decode_attributes(std::string_view bytes, const AttributePart& in, std::vector<Attribute>& out,
+                         std::vector<std::vector<uint32_t>>* alias = nullptr);
 
 // The integers a value is coded as (2 for octahedral, else the components):
 // the oracle compares attributes through them.

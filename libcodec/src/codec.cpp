@@ -97,6 +97,7 @@ struct DecodedPart {
   Mesh faces;                    // corners are the part's output vertex ids
   std::vector<uint32_t> q;       // grid indices, 3 per own vertex
   std::vector<uint32_t> global;  // per part vertex: the earlier segment's vertex it is, kNone if own
+  std::vector<std::vector<uint32_t>> alias;  // per attribute, per corner value: an earlier segment's value, or kNone
   ConnectivityStats cstats;
   GeometryStats gstats;
   Status status;
@@ -124,7 +125,8 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.faces = &out.faces;
   ap.global = &out.global;
   ap.q = &out.q;
-  return decode_attributes(s.attributes, ap, out.faces.attributes);
+  ap.segmented = s.segmented;
+  return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
 }
 
 // Runs f(0..n-1) on up to `threads` threads (0 = one per core); each index
@@ -229,10 +231,35 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
     for (size_t i = 0; i < out.attributes.size(); ++i) {
       Attribute &o = out.attributes[i], &p = part.faces.attributes[i];
       const uint32_t value_base = static_cast<uint32_t>(o.value_count());
-      o.values.insert(o.values.end(), p.values.begin(), p.values.end());
-      for (uint32_t x : p.indices) o.indices.push_back(value_base + x);
+      const std::vector<uint32_t>* alias = i < part.alias.size() && !part.alias[i].empty() ? &part.alias[i] : nullptr;
+      if (!alias) {
+        o.values.insert(o.values.end(), p.values.begin(), p.values.end());
+        for (uint32_t x : p.indices) o.indices.push_back(value_base + x);
+        continue;
+      }
+      // Values of earlier segments are not added again: their corners use the earlier ones.
+      std::vector<uint32_t> id(alias->size());
+      uint32_t next = value_base;
+      for (size_t j = 0; j < id.size(); ++j) {
+        const uint32_t a = (*alias)[j];
+        if (a == kNone) {
+          id[j] = next++;
+          o.values.insert(o.values.end(), p.values.begin() + static_cast<std::ptrdiff_t>(p.components * j),
+                          p.values.begin() + static_cast<std::ptrdiff_t>(p.components * (j + 1)));
+        } else if (a < value_base) {
+          id[j] = a;
+        } else {
+          return corrupt("attribute '" + p.name + "': a value names value " + std::to_string(a) +
+                         " of the segments before, which hold " + std::to_string(value_base));
+        }
+      }
+      for (uint32_t x : p.indices) o.indices.push_back(id[x]);
     }
   }
+  if (first)
+    for (const std::vector<uint32_t>& alias : part.alias)
+      for (uint32_t a : alias)
+        if (a != kNone) return corrupt("the first segment names values of segments before it");
   out.positions.resize(out.positions.size() + part.q.size());
   float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
   for (size_t i = 0; i < part.q.size(); ++i)
@@ -281,6 +308,13 @@ struct EncodedPart {
   std::string attributes;
   std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
   std::vector<uint8_t> contexts;   // per output vertex, for the references stream
+  // A segment's attributes are coded after the parallel pass (their values
+  // may be earlier segments'), from what that pass keeps here.
+  Mesh part;                        // the segment's mesh with its attributes
+  std::vector<std::vector<uint32_t>> value_origin;  // per attribute, per part value: the mesh's value
+  Mesh faces;                       // as the decoder gives them
+  std::vector<uint8_t> ref_out;     // per output vertex: a reference
+  std::vector<uint32_t> q;          // own vertices' grid indices
   Status status;
 };
 
@@ -341,19 +375,21 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
-    Mesh faces;
     GeometryLayout scratch;
     TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(),
-                                            faces, scratch));
-    std::vector<uint8_t> ref_out(mark.size());
-    for (size_t v = 0; v < mark.size(); ++v) ref_out[v] = mark[v] != kNone;
-    AttributeInput ai;
-    ai.part = &mesh;
-    ai.order = &ce.vertex_order;
-    ai.is_ref = &ref_out;
-    ai.faces = &faces;
-    ai.q = &q;
-    TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, out.attributes));
+                                            out.faces, scratch));
+    out.ref_out.resize(mark.size());
+    for (size_t v = 0; v < mark.size(); ++v) out.ref_out[v] = mark[v] != kNone;
+    out.q = std::move(q);
+    if (is_ref.empty()) {  // a whole mesh: now
+      AttributeInput ai;
+      ai.part = &mesh;
+      ai.order = &ce.vertex_order;
+      ai.is_ref = &out.ref_out;
+      ai.faces = &out.faces;
+      ai.q = &out.q;
+      TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, out.attributes));
+    }
   }
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
@@ -366,8 +402,10 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
 // input order), and the last segment also those no corner uses. A value
 // used on both sides of a border is stored in each segment that uses it.
 std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<uint32_t>& in,
-                                          const std::vector<uint32_t>& faces, bool last) {
+                                          const std::vector<uint32_t>& faces, bool last,
+                                          std::vector<std::vector<uint32_t>>& origin) {
   std::vector<Attribute> out;
+  origin.assign(mesh.attributes.size(), {});
   for (const Attribute& a : mesh.attributes) {
     Attribute b = described_like(a);
     const size_t c = a.components;
@@ -389,6 +427,7 @@ std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<ui
       for (size_t j = 0; j < a.value_count(); ++j)
         if (mine[j] || (last && !used_anywhere[j])) {
           local[j] = static_cast<uint32_t>(b.value_count());
+          origin[out.size()].push_back(static_cast<uint32_t>(j));
           take(j);
         }
       for (uint32_t f : faces)
@@ -446,9 +485,16 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       for (uint32_t i = 0; i < mesh.face_size(f); ++i) corners.push_back(local[mesh.face(f)[i]]);
       part.add_face(corners.data(), corners.size());
     }
-    part.attributes = segment_attributes(mesh, in, segments[k], k + 1 == S);
+    part.attributes = segment_attributes(mesh, in, segments[k], k + 1 == S, parts[k].value_origin);
     parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
+    parts[k].part = std::move(part);
   });
+  // Per corner attribute, per value of the mesh: its id in the file's value
+  // list once a segment has added it.
+  std::vector<std::vector<uint32_t>> value_id(mesh.attributes.size());
+  std::vector<uint32_t> value_count(mesh.attributes.size(), 0);
+  for (size_t i = 0; i < mesh.attributes.size(); ++i)
+    if (mesh.attributes[i].domain == AttributeDomain::corner) value_id[i].assign(mesh.attributes[i].value_count(), kNone);
   std::vector<uint32_t> final_id(V, kNone);
   uint32_t next = 0;
   for (size_t k = 0; k < S; ++k) {
@@ -466,6 +512,25 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       }
     }
     const std::string references = encode_references(p.contexts, global);
+    if (!headers.empty()) {
+      std::vector<std::vector<uint32_t>> imported(headers.size()), own_values;
+      for (size_t i = 0; i < headers.size(); ++i)
+        if (!value_id[i].empty())
+          for (uint32_t x : p.value_origin[i]) imported[i].push_back(value_id[i][x]);
+      AttributeInput ai;
+      ai.part = &p.part;
+      ai.order = &p.order;
+      ai.is_ref = &p.ref_out;
+      ai.faces = &p.faces;
+      ai.q = &p.q;
+      ai.segmented = true;
+      ai.imported = &imported;
+      ai.own_values = &own_values;
+      TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, p.attributes));
+      for (size_t i = 0; i < headers.size(); ++i)
+        if (!value_id[i].empty())
+          for (uint32_t local : own_values[i]) value_id[i][p.value_origin[i][local]] = value_count[i]++;
+    }
     SegmentPayload sp;
     sp.vertex_count = p.order.size();
     sp.face_count = segments[k].size();
@@ -539,6 +604,11 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());
   ContainerWriter cw(h);
+  // Metadata first, so that a streaming client has it before any geometry.
+  if (!mesh.metadata.empty()) {
+    const std::string md = write_metadata(mesh.metadata);
+    cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
+  }
   if (segments.size() == 1) {
     EncodedPart p;
     TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
@@ -565,6 +635,7 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   TSM_RETURN_IF_ERROR(decode_parts(h, sections, options.threads, parts, streams));
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
   for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
+  if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
   return Status::Ok();
 }
 
@@ -708,7 +779,9 @@ struct StreamDecoder::Impl {
         break;
       }
       TSM_RETURN_IF_ERROR(rules.admit(s, h.segment_count));
-      if (s.id == kSectionSegment)
+      if (s.id == kSectionMetadata)
+        TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
+      else if (s.id == kSectionSegment)
         TSM_RETURN_IF_ERROR(segment(s));
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));

@@ -243,6 +243,18 @@ CompareResult compare_meshes(const Mesh& original, const Mesh& decoded, int bits
       return r;
     }
   }
+  if (original.metadata.size() != decoded.metadata.size()) {
+    r.difference = std::to_string(decoded.metadata.size()) + " metadata entries, expected " +
+                   std::to_string(original.metadata.size());
+    return r;
+  }
+  for (size_t i = 0; i < original.metadata.size(); ++i) {
+    const MetadataEntry &x = original.metadata[i], &y = decoded.metadata[i];
+    if (x.key != y.key || x.value != y.value) {
+      r.difference = "metadata entry " + std::to_string(i) + " ('" + x.key + "') differs in the decoded mesh";
+      return r;
+    }
+  }
   const std::vector<AttributeHeader> headers = attribute_headers(original, attribute_bits);
   const AttributeKeys ka = attribute_keys(original, headers), kb = attribute_keys(decoded, headers);
   if (ka.unused != kb.unused) {

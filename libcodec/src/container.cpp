@@ -29,6 +29,7 @@ const char* section_name(uint16_t id) {
     case kSectionGeometry: return "geometry";
     case kSectionSegment: return "segment";
     case kSectionAttributes: return "attributes";
+    case kSectionMetadata: return "metadata";
   }
   return "unknown";
 }
@@ -250,6 +251,45 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
   }
   if (offset != bytes.size())
     return corrupt(std::to_string(bytes.size() - offset) + " unexpected bytes after the end marker");
+  return Status::Ok();
+}
+
+std::string write_metadata(const std::vector<MetadataEntry>& entries) {
+  std::string out;
+  ByteWriter w(out);
+  w.varint(entries.size());
+  for (const MetadataEntry& e : entries) {
+    w.u8(static_cast<uint8_t>(e.key.size()));
+    w.bytes(e.key);
+    w.varint(e.value.size());
+    w.bytes(e.value);
+  }
+  return out;
+}
+
+Status read_metadata(std::string_view payload, std::vector<MetadataEntry>& entries) {
+  entries.clear();
+  ByteReader r(payload);
+  uint64_t count = 0;
+  // Each entry takes at least 3 bytes (key length, a key byte, value length).
+  if (!r.varint(count) || count > r.remaining() / 3) return corrupt("metadata: bad entry count");
+  entries.reserve(static_cast<size_t>(count));
+  for (uint64_t i = 0; i < count; ++i) {
+    uint8_t key_len = 0;
+    uint64_t value_len = 0;
+    std::string_view key, value;
+    if (!r.u8(key_len) || key_len == 0 || !r.bytes(key_len, key) || !r.varint(value_len) ||
+        value_len > r.remaining() || !r.bytes(static_cast<size_t>(value_len), value))
+      return corrupt("metadata: entry " + std::to_string(i) + " is truncated or has an empty key");
+    entries.push_back({std::string(key), std::string(value)});
+  }
+  if (r.remaining() != 0) return corrupt("metadata: " + std::to_string(r.remaining()) + " bytes after the last entry");
+  std::vector<std::string_view> keys;
+  keys.reserve(entries.size());
+  for (const MetadataEntry& e : entries) keys.push_back(e.key);
+  std::sort(keys.begin(), keys.end());
+  for (size_t i = 1; i < keys.size(); ++i)
+    if (keys[i] == keys[i - 1]) return corrupt("metadata: key '" + std::string(keys[i]) + "' appears twice");
   return Status::Ok();
 }
 

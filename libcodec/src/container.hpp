@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
 namespace tsm {
@@ -27,6 +28,7 @@ enum SectionId : uint16_t {
   kSectionGeometry = 6,       // predicted quantized positions (range coded)
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
   kSectionAttributes = 8,     // normals, colours, texture coordinates, ... (headers + range coded)
+  kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
 };
 const char* section_name(uint16_t id);
 
@@ -88,5 +90,9 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
                       bool decode_payloads = true);
 
 uint32_t checksum32(std::string_view bytes);
+
+// The metadata section's payload (FORMAT.md §4.6): Mesh::metadata entries.
+std::string write_metadata(const std::vector<MetadataEntry>& entries);
+Status read_metadata(std::string_view payload, std::vector<MetadataEntry>& entries);
 
 }  // namespace tsm

@@ -11,6 +11,7 @@ void Mesh::clear() {
   face_offsets.assign(1, 0);
   indices.clear();
   attributes.clear();
+  metadata.clear();
 }
 
 void Mesh::reserve(size_t vertices, size_t faces, size_t corners) {
@@ -114,7 +115,19 @@ bool Mesh::valid(std::string* why) const {
         break;
     }
   }
+  for (size_t k = 0; k < metadata.size(); ++k) {
+    const std::string& key = metadata[k].key;
+    if (key.empty() || key.size() > 255) return fail("metadata entry " + std::to_string(k) + ": a key has 1..255 bytes");
+    for (size_t j = 0; j < k; ++j)
+      if (metadata[j].key == key) return fail("metadata key '" + key + "' appears twice");
+  }
   return true;
+}
+
+const MetadataEntry* Mesh::find_metadata(const std::string& key) const {
+  for (const MetadataEntry& e : metadata)
+    if (e.key == key) return &e;
+  return nullptr;
 }
 
 const Attribute* Mesh::find_attribute(AttributeKind kind) const {

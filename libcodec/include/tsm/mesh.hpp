@@ -47,11 +47,22 @@ struct Attribute {
   size_t value_count() const { return components ? values.size() / components : 0; }
 };
 
+// Content of the file a mesh came from that the codec does not model (a glTF
+// document's materials, nodes, scenes and images, say), kept as given: the
+// encoder stores every entry (zstd-compressed where that is smaller) and the
+// decoder hands it back byte for byte. Keys are unique, 1..255 bytes; the
+// writers that understand a key use it ("gltf" for the glTF writer).
+struct MetadataEntry {
+  std::string key;
+  std::string value;  // any bytes
+};
+
 struct Mesh {
   std::vector<float> positions;            // 3 * vertex_count()
   std::vector<uint32_t> face_offsets{0};   // face_count() + 1, starts with 0
   std::vector<uint32_t> indices;           // corners of all faces
   std::vector<Attribute> attributes;       // normals, colours, texture coordinates, ...
+  std::vector<MetadataEntry> metadata;     // passed through unchanged (see MetadataEntry)
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t face_count() const { return face_offsets.size() - 1; }
@@ -74,6 +85,7 @@ struct Mesh {
   // True when every position is finite.
   bool all_finite() const;  // positions and attribute values
   const Attribute* find_attribute(AttributeKind kind) const;
+  const MetadataEntry* find_metadata(const std::string& key) const;
   // Internal consistency (offsets monotone, indices in range, attribute
   // sizes matching their domain); for asserts and for checking meshes handed
   // to the encoder by API users.
