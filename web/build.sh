@@ -144,6 +144,13 @@ if grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h"; then
 else
   echo "web/build.sh: no streaming C API in tsm.h yet; whole-file decode only"
 fi
+if grep -q "tsm_mesh_attribute_count" "$LIBCODEC/include/tsm/tsm.h"; then
+  EXPORTS+=",_tsm_mesh_attribute_count,_tsm_mesh_attribute_name,_tsm_mesh_attribute_kind,_tsm_mesh_attribute_domain"
+  EXPORTS+=",_tsm_mesh_attribute_type,_tsm_mesh_attribute_components,_tsm_mesh_attribute_value_count"
+  EXPORTS+=",_tsm_mesh_attribute_values,_tsm_mesh_attribute_index_count,_tsm_mesh_attribute_indices"
+  EXPORTS+=",_tsm_mesh_metadata_count,_tsm_mesh_metadata_key,_tsm_mesh_metadata_value"
+  echo "web/build.sh: attribute and metadata accessors found, exported"
+fi
 emcc "${LOPT[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
   -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTsmModule \
   -sENVIRONMENT=web,worker -sFILESYSTEM=0 \
@@ -156,4 +163,7 @@ echo "web/build.sh: built $OUT/tsm_decoder.js + tsm_decoder.wasm ($(stat -c %s "
 cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$OUT/"
 STREAMING=false
 grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h" && STREAMING=true
-printf '{"version": "%s", "zstd": "%s", "streaming": %s}\n' "$VERSION" "$ZSTD_MODE" "$STREAMING" > "$OUT/build-info.json"
+ATTRIBUTES=false
+grep -q "tsm_mesh_attribute_count" "$LIBCODEC/include/tsm/tsm.h" && ATTRIBUTES=true
+printf '{"version": "%s", "zstd": "%s", "streaming": %s, "attributes": %s}\n' "$VERSION" "$ZSTD_MODE" "$STREAMING" \
+  "$ATTRIBUTES" > "$OUT/build-info.json"

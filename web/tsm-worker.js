@@ -2,7 +2,8 @@
 // (used by decodeStreamInWorker in tsm.js). Messages in: {type:'start',
 // wasmUrl?, decodeOptions?}, {type:'chunk', bytes}, {type:'end'},
 // {type:'cancel'}; a new 'start' drops any stream left unfinished. Out:
-// {type:'segment', segment} (its arrays transferred, not copied), {type:'done'},
+// {type:'segment', segment} (its arrays, attributes' and metadata's too,
+// transferred, not copied), {type:'done'},
 // {type:'error', code, message}.
 import { loadTsm } from './tsm.js';
 
@@ -15,6 +16,11 @@ function send(segments) {
   for (const s of segments) {
     const transfer = [s.positions.buffer, s.indices.buffer];
     if (s.faceOffsets) transfer.push(s.faceOffsets.buffer);
+    for (const a of s.attributes || []) {
+      transfer.push(a.values.buffer);
+      if (a.indices) transfer.push(a.indices.buffer);
+    }
+    for (const e of s.metadata || []) transfer.push(e.value.buffer);
     self.postMessage({ type: 'segment', id: runId, segment: s }, transfer);
   }
 }

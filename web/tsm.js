@@ -7,6 +7,8 @@
 //   mesh.positions  // Float32Array, 3 per vertex
 //   mesh.indices    // Uint32Array, the corners of every face
 //   mesh.faceOffsets // Uint32Array (faceCount + 1), only when some face is not a triangle
+//   mesh.attributes  // [{ name, kind, domain, type, components, values, indices, ... }] (below)
+//   mesh.metadata    // [{ key, value: Uint8Array }]
 //
 //   // streaming: each segment as soon as its bytes are in
 //   for await (const seg of tsm.decodeStream((await fetch('dragon.tsm')).body)) draw(seg);
@@ -28,6 +30,27 @@
 // mesh's corner array: subtract cornerStart to index this segment's indices.
 // bytesIn is the input fed so far, decodeMs the time spent in the decoder so
 // far (feed and finish calls, copies out included).
+//
+// Attributes (normals, colours, texture coordinates, other values; a decoded
+// mesh and every segment have the list, [] when the file has none): { name,
+// kind ('generic' | 'normal' | 'color' | 'texcoord'), domain ('vertex' |
+// 'face' | 'corner'), type ('f32' | 'u8' | 'u16' | 'i32': how the values were
+// stored; they are floats here), components (1..4), values (Float32Array,
+// components per value), valueStart, valueCount, indices (corner domain: a
+// Uint32Array, one entry per face corner in the order of `indices`, naming a
+// value; else null) }. In a decoded mesh valueStart is 0 and values is all of
+// them. In a segment the lists are pieces to append: vertex-domain values are
+// those of the segment's new vertices (valueStart = vertexStart), face-domain
+// ones those of its faces (valueStart = faceStart), and a corner attribute
+// gives the values the segment added to its value list (numbers valueStart..
+// valueStart + valueCount - 1) and the indices of the segment's corners (global
+// value numbers, possibly naming values of earlier segments). Appending each
+// piece's values and indices gives the whole mesh's lists.
+//
+// Metadata (entries the codec passes through, e.g. key 'gltf'): [{ key (a
+// string, UTF-8), value (Uint8Array) }] on a decoded mesh; in a stream, the
+// whole list on the piece where it first appears (that piece may have no
+// vertices or faces), else absent.
 import createTsmModule from './tsm_decoder.js';
 
 const ERR_SIZE = 512;
@@ -38,6 +61,10 @@ export const ErrorCode = Object.freeze({
   UNSUPPORTED: 5, LIMIT_EXCEEDED: 6, INTERNAL: 7,
 });
 const CODE_NAMES = Object.fromEntries(Object.entries(ErrorCode).map(([k, v]) => [v, k.toLowerCase()]));
+// The C API's TSM_KIND_*, TSM_DOMAIN_*, TSM_TYPE_* values, by index.
+export const AttributeKinds = Object.freeze(['generic', 'normal', 'color', 'texcoord']);
+export const AttributeDomains = Object.freeze(['vertex', 'face', 'corner']);
+export const AttributeTypes = Object.freeze(['f32', 'u8', 'u16', 'i32']);
 
 export class TsmError extends Error {
   constructor(code, message) {
@@ -70,9 +97,12 @@ export class TsmDecoder {
     this.errPtr = mod._malloc(ERR_SIZE);
     this.optPtr = mod._malloc(OPTIONS_SIZE);
     this.outPtr = mod._malloc(4); // tsm_mesh* out-parameter
+    this.sizePtr = mod._malloc(4); // size_t out-parameter (metadata sizes)
     this.inPtr = 0;
     this.inCap = 0;
     this.hasStreaming = typeof mod._tsm_stream_new === 'function';
+    this.hasAttributes = typeof mod._tsm_mesh_attribute_count === 'function';
+    this.hasMetadata = typeof mod._tsm_mesh_metadata_count === 'function';
   }
 
   /** The library's version string. */
@@ -80,7 +110,8 @@ export class TsmDecoder {
 
   /** Decodes a whole .tsm file (Uint8Array or ArrayBuffer). options: { maxVertices,
    *  maxFaces, maxCorners } refuse larger files before anything is allocated.
-   *  Returns { positions, indices, faceOffsets?, vertexCount, faceCount }. */
+   *  Returns { positions, indices, faceOffsets?, vertexCount, faceCount, attributes,
+   *  metadata } (see the top of this file). */
   decode(bytes, options) {
     return this.guard(() => this.decodeNow(bytes, options));
   }
@@ -94,7 +125,9 @@ export class TsmDecoder {
     if (rc !== 0) throw new TsmError(rc, this.cstring(this.errPtr));
     const mesh = m.HEAPU32[this.outPtr >> 2];
     try {
-      return this.extract(mesh, 0, 0, m._tsm_mesh_vertex_count(mesh), m._tsm_mesh_face_count(mesh), true);
+      const r = this.extract(mesh, 0, 0, m._tsm_mesh_vertex_count(mesh), m._tsm_mesh_face_count(mesh), true);
+      r.metadata = this.metadata(mesh);
+      return r;
     } finally {
       m._tsm_mesh_free(mesh);
     }
@@ -163,6 +196,7 @@ export class TsmDecoder {
 
   cstring(ptr) {
     const h = this.mod.HEAPU8;
+    ptr >>>= 0;
     let end = ptr;
     while (h[end]) ++end;
     return new TextDecoder().decode(h.subarray(ptr, end));
@@ -170,18 +204,21 @@ export class TsmDecoder {
 
   // Copies vertices [v0, v1) and faces [f0, f1) of a tsm_mesh out of the heap:
   // one slice per array. The heap views are read after the decode, since a
-  // grown memory replaces them.
-  extract(mesh, v0, f0, v1, f1, whole) {
+  // grown memory replaces them. valueStarts[i]: where corner attribute i's
+  // new values start (a stream's values reported so far; 0 when absent).
+  // Pointers come back from WebAssembly as signed 32-bit numbers: >>> makes
+  // them unsigned (a heap above 2 GB).
+  extract(mesh, v0, f0, v1, f1, whole, valueStarts) {
     const m = this.mod;
-    const pos = m._tsm_mesh_positions(mesh) >> 2;
-    const idx = m._tsm_mesh_indices(mesh) >> 2;
+    const pos = m._tsm_mesh_positions(mesh) >>> 2;
+    const idx = m._tsm_mesh_indices(mesh) >>> 2;
     const cornerCount = m._tsm_mesh_index_count(mesh);
     let c0, c1, faceOffsets;
     const allTriangles = cornerCount === 3 * m._tsm_mesh_face_count(mesh);
     if (allTriangles) {
       c0 = 3 * f0; c1 = 3 * f1;
     } else {
-      const off = m._tsm_mesh_face_offsets(mesh) >> 2;
+      const off = m._tsm_mesh_face_offsets(mesh) >>> 2;
       const U = m.HEAPU32;
       c0 = U[off + f0]; c1 = U[off + f1];
       if (c1 - c0 !== 3 * (f1 - f0) || whole) faceOffsets = U.subarray(off + f0, off + f1 + 1).slice();
@@ -192,7 +229,55 @@ export class TsmDecoder {
       indices: m.HEAPU32.subarray(idx + c0, idx + c1).slice(),
     };
     if (faceOffsets) r.faceOffsets = faceOffsets;
+    r.attributes = this.attributes(mesh, v0, f0, v1, f1, c0, c1, valueStarts);
     return r;
+  }
+
+  // The attributes' pieces for vertices [v0, v1), faces [f0, f1), corners
+  // [c0, c1): one slice of values (and of indices) each.
+  attributes(mesh, v0, f0, v1, f1, c0, c1, valueStarts) {
+    const m = this.mod;
+    const out = [];
+    const n = this.hasAttributes ? m._tsm_mesh_attribute_count(mesh) : 0;
+    for (let i = 0; i < n; ++i) {
+      const components = m._tsm_mesh_attribute_components(mesh, i);
+      const domain = m._tsm_mesh_attribute_domain(mesh, i);
+      let s0, s1;
+      if (domain === 0) { s0 = v0; s1 = v1; }
+      else if (domain === 1) { s0 = f0; s1 = f1; }
+      else { s0 = (valueStarts && valueStarts[i]) || 0; s1 = m._tsm_mesh_attribute_value_count(mesh, i) >>> 0; }
+      const vals = m._tsm_mesh_attribute_values(mesh, i) >>> 2;
+      const a = {
+        name: this.cstring(m._tsm_mesh_attribute_name(mesh, i)),
+        kind: AttributeKinds[m._tsm_mesh_attribute_kind(mesh, i)] || 'generic',
+        domain: AttributeDomains[domain],
+        type: AttributeTypes[m._tsm_mesh_attribute_type(mesh, i)] || 'f32',
+        components, valueStart: s0, valueCount: s1 - s0,
+        values: m.HEAPF32.subarray(vals + components * s0, vals + components * s1).slice(),
+        indices: null,
+      };
+      if (domain === 2) {
+        const ix = m._tsm_mesh_attribute_indices(mesh, i) >>> 2;
+        a.indices = m.HEAPU32.subarray(ix + c0, ix + c1).slice();
+      }
+      out.push(a);
+    }
+    return out;
+  }
+
+  // The mesh's metadata entries, keys as strings, values copied out.
+  metadata(mesh) {
+    const m = this.mod;
+    const out = [];
+    const n = this.hasMetadata ? m._tsm_mesh_metadata_count(mesh) : 0;
+    for (let i = 0; i < n; ++i) {
+      const k = m._tsm_mesh_metadata_key(mesh, i, this.sizePtr) >>> 0;
+      const kn = m.HEAPU32[this.sizePtr >> 2];
+      const v = m._tsm_mesh_metadata_value(mesh, i, this.sizePtr) >>> 0;
+      const vn = m.HEAPU32[this.sizePtr >> 2];
+      out.push({ key: new TextDecoder().decode(m.HEAPU8.subarray(k, k + kn)), value: m.HEAPU8.slice(v, v + vn) });
+    }
+    return out;
   }
 }
 
@@ -201,6 +286,8 @@ export class TsmStream {
     this.dec = dec;
     this.m = dec.mod;
     this.v = 0; this.f = 0; this.segIndex = 0; this.bytesIn = 0;
+    this.valueCounts = []; // per corner attribute: its values handed out so far
+    this.metaCount = 0;    // metadata entries handed out (all of them once any)
     this.decodeMs = 0; // time spent decoding (in feed/finish, copies out included)
     this.failed = null;
     if (dec.hasStreaming) {
@@ -265,10 +352,16 @@ export class TsmStream {
     const v1 = m._tsm_mesh_vertex_count(mesh);
     const f1 = m._tsm_mesh_face_count(mesh);
     const done = m._tsm_stream_segments_done(this.s);
-    if (v1 === this.v && f1 === this.f && done === this.segIndex) return [];
+    const metaCount = this.dec.hasMetadata ? m._tsm_mesh_metadata_count(mesh) : 0;
+    if (v1 === this.v && f1 === this.f && done === this.segIndex && metaCount === this.metaCount) return [];
     // Everything finished since the last call comes out as one piece (several
     // segments finished by one chunk are reported together).
-    const seg = this.dec.extract(mesh, this.v, this.f, v1, f1, false);
+    const seg = this.dec.extract(mesh, this.v, this.f, v1, f1, false, this.valueCounts);
+    for (let i = 0; i < seg.attributes.length; ++i) {
+      const a = seg.attributes[i];
+      if (a.domain === 'corner') this.valueCounts[i] = a.valueStart + a.valueCount;
+    }
+    if (metaCount !== this.metaCount) { seg.metadata = this.dec.metadata(mesh); this.metaCount = metaCount; }
     seg.index = this.segIndex;
     seg.segmentsDone = done;
     seg.segmentCount = m._tsm_stream_segment_count(this.s);

@@ -1,8 +1,10 @@
 // The C API (tsm.h) over the C++ API, for bindings and the WebAssembly build.
 // No exception or C++ type crosses it.
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <string>
 
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
@@ -42,6 +44,20 @@ int guarded(char* err, size_t err_size, F&& f) {
     return report(tsm::Status(tsm::ErrorCode::internal, e.what()), err, err_size);
   }
 }
+
+// Attribute number i of a mesh, or null.
+const tsm::Attribute* attribute(const tsm_mesh* m, size_t i) {
+  if (!m || i >= m->get().attributes.size()) return nullptr;
+  return &m->get().attributes[i];
+}
+
+const tsm::MetadataEntry* metadata_entry(const tsm_mesh* m, size_t i, size_t* size) {
+  if (size) *size = 0;
+  if (!m || i >= m->get().metadata.size()) return nullptr;
+  return &m->get().metadata[i];
+}
+
+tsm::Status invalid(const std::string& message) { return tsm::Status(tsm::ErrorCode::invalid_argument, message); }
 
 }  // namespace
 
@@ -110,6 +126,10 @@ int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t*
       if (options->level >= 0) o.level = options->level;
       o.segment_faces = options->segment_faces;
       o.threads = options->threads;
+      if (options->normal_bits) o.attribute_bits.normal = options->normal_bits;
+      if (options->texcoord_bits) o.attribute_bits.texcoord = options->texcoord_bits;
+      if (options->color_bits) o.attribute_bits.color = options->color_bits;
+      if (options->generic_bits) o.attribute_bits.generic = options->generic_bits;
     }
     std::string bytes;
     tsm::Status s = tsm::encode(mesh->get(), o, bytes);
@@ -162,6 +182,114 @@ size_t tsm_mesh_index_count(const tsm_mesh* m) { return m ? m->get().corner_coun
 const float* tsm_mesh_positions(const tsm_mesh* m) { return m ? m->get().positions.data() : nullptr; }
 const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* m) { return m ? m->get().face_offsets.data() : nullptr; }
 const uint32_t* tsm_mesh_indices(const tsm_mesh* m) { return m ? m->get().indices.data() : nullptr; }
+
+size_t tsm_mesh_attribute_count(const tsm_mesh* m) { return m ? m->get().attributes.size() : 0; }
+const char* tsm_mesh_attribute_name(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? a->name.c_str() : nullptr;
+}
+int tsm_mesh_attribute_kind(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? static_cast<int>(a->kind) : -1;
+}
+int tsm_mesh_attribute_domain(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? static_cast<int>(a->domain) : -1;
+}
+int tsm_mesh_attribute_type(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? static_cast<int>(a->type) : -1;
+}
+int tsm_mesh_attribute_components(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? static_cast<int>(a->components) : -1;
+}
+size_t tsm_mesh_attribute_value_count(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? a->value_count() : 0;
+}
+const float* tsm_mesh_attribute_values(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a ? a->values.data() : nullptr;
+}
+size_t tsm_mesh_attribute_index_count(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a && a->domain == tsm::AttributeDomain::corner ? a->indices.size() : 0;
+}
+const uint32_t* tsm_mesh_attribute_indices(const tsm_mesh* m, size_t i) {
+  const tsm::Attribute* a = attribute(m, i);
+  return a && a->domain == tsm::AttributeDomain::corner ? a->indices.data() : nullptr;
+}
+
+int tsm_mesh_add_attribute(tsm_mesh* m, const char* name, int kind, int domain, int type, int components,
+                           const float* values, size_t value_count, const uint32_t* indices, size_t index_count,
+                           char* err, size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!m || !name || (!values && value_count) || (!indices && index_count)) return invalid("null argument");
+    if (m->view) return invalid("a stream's mesh is read-only");
+    if (kind < TSM_KIND_GENERIC || kind > TSM_KIND_TEXCOORD) return invalid("unknown attribute kind " + std::to_string(kind));
+    if (domain < TSM_DOMAIN_VERTEX || domain > TSM_DOMAIN_CORNER)
+      return invalid("unknown attribute domain " + std::to_string(domain));
+    if (type < TSM_TYPE_F32 || type > TSM_TYPE_I32) return invalid("unknown attribute type " + std::to_string(type));
+    if (components < 1 || components > 4)
+      return invalid("attribute '" + std::string(name) + "' has " + std::to_string(components) + " components (1..4)");
+    if (domain != TSM_DOMAIN_CORNER && (indices || index_count))
+      return invalid("attribute '" + std::string(name) + "': indices are for the corner domain only");
+    if (value_count > SIZE_MAX / 4 || static_cast<uint64_t>(value_count) > 0xffffffffu ||
+        static_cast<uint64_t>(index_count) > 0xffffffffu)
+      return tsm::Status(tsm::ErrorCode::limit_exceeded, "more than 2^32 - 1 values or indices");
+    tsm::Attribute a;
+    a.name = name;
+    a.kind = static_cast<tsm::AttributeKind>(kind);
+    a.domain = static_cast<tsm::AttributeDomain>(domain);
+    a.type = static_cast<tsm::AttributeType>(type);
+    a.components = static_cast<uint32_t>(components);
+    a.values.assign(values, values + value_count * a.components);
+    a.indices.assign(indices, indices + index_count);
+    tsm::Mesh& mesh = m->mesh;
+    mesh.attributes.push_back(std::move(a));
+    std::string why;
+    if (!mesh.valid(&why)) {
+      mesh.attributes.pop_back();
+      return invalid(why);
+    }
+    return tsm::Status::Ok();
+  });
+}
+
+size_t tsm_mesh_metadata_count(const tsm_mesh* m) { return m ? m->get().metadata.size() : 0; }
+const char* tsm_mesh_metadata_key(const tsm_mesh* m, size_t i, size_t* size) {
+  const tsm::MetadataEntry* e = metadata_entry(m, i, size);
+  if (!e) return nullptr;
+  if (size) *size = e->key.size();
+  return e->key.c_str();
+}
+const uint8_t* tsm_mesh_metadata_value(const tsm_mesh* m, size_t i, size_t* size) {
+  const tsm::MetadataEntry* e = metadata_entry(m, i, size);
+  if (!e) return nullptr;
+  if (size) *size = e->value.size();
+  return reinterpret_cast<const uint8_t*>(e->value.c_str());
+}
+
+int tsm_mesh_add_metadata(tsm_mesh* m, const char* key, size_t key_size, const uint8_t* value, size_t value_size,
+                          char* err, size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!m || !key || (!value && value_size)) return invalid("null argument");
+    if (m->view) return invalid("a stream's mesh is read-only");
+    tsm::MetadataEntry e;
+    e.key.assign(key, key_size);
+    if (value_size) e.value.assign(reinterpret_cast<const char*>(value), value_size);
+    tsm::Mesh& mesh = m->mesh;
+    mesh.metadata.push_back(std::move(e));
+    std::string why;
+    if (!mesh.valid(&why)) {
+      mesh.metadata.pop_back();
+      return invalid(why);
+    }
+    return tsm::Status::Ok();
+  });
+}
+
 void tsm_mesh_free(tsm_mesh* m) { delete m; }
 void tsm_free(void* buffer) { std::free(buffer); }
 const char* tsm_version(void) { return tsm::version_string(); }

@@ -4,8 +4,17 @@
 // Worker, and checks the vertex, face and corner counts and the FNV-1a
 // checksums of the index and position arrays against the native decoder's
 // (build/web/data/NAME.ref.json, from web/prepare-data.sh). Screenshots go
-// to build/web/screenshots/.
+// to build/web/screenshots/. Then: damaged input is refused, the API by hand,
+// and attributes: corpus files with normals, texture coordinates and colours
+// and a glTF file written here (face attribute, metadata), encoded by the
+// native `tsm encode` (some in several segments), decode in
+// the browser, whole, streamed and in a worker, with the same attribute
+// values, corner indices and metadata (FNV-1a of their bytes) as the native decoder
+// (web/test/attr-ref.c, a C client of tsm.h built here against the native
+// library: $TSM/../../libcodec/libtsm.a).
 //   node web/test/browser.mjs [NAME ...]
+// Env: TSM (the native CLI, default build/release/cli/tsm), CORPUS (../shared/corpus).
+import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -35,6 +44,66 @@ const throttleFor = (m) => {
   const bytes = fs.statSync(path.join(dataDir, `${m.name}.tsm`)).size;
   return Math.max(16384, Math.min(4000000, Math.round(bytes / 2)));
 };
+
+// ---- attribute files and their native reference --------------------------------
+// name, corpus file (or a function making the file), `tsm encode` options:
+// corner normals and UVs with seams (OBJ), vertex normals and corner UVs
+// (PLY), corner normals in 7 segments, u8 vertex colours in 5 segments, and a
+// glTF file of two primitives (vertex normals and UVs, the primitive of each
+// face as a face attribute, the document as metadata).
+const ATTRIBUTE_FILES = [
+  ['att_cube_obj', 'edge/cube_att.obj', []],
+  ['att_cube_ply', 'edge/cube_att.ply', []],
+  ['att_sphere_seg', 'edge/sphere.obj', ['--segment-faces', '32']],
+  ['att_color_seg', 'edge/test_pos_color.ply', ['--segment-faces', '48']],
+  ['att_gltf', twoPrimitiveGltf, []],
+];
+// Two triangles sharing an edge, one primitive each, with normals and UVs.
+function twoPrimitiveGltf() {
+  const f32 = (a) => Buffer.from(new Float32Array(a).buffer);
+  const bin = Buffer.concat([f32([0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]), f32([0, 0, 1, 0, 0, 1, 0.6, 0, 0.8, 0, 0.6, 0.8]),
+    f32([0, 0, 1, 0, 0, 1, 0.5, 0.5]), Buffer.from(new Uint16Array([0, 1, 2, 0, 2, 3]).buffer)]);
+  const prim = (indices, material) => ({ attributes: { POSITION: 0, NORMAL: 1, TEXCOORD_0: 2 }, indices, material });
+  const doc = {
+    asset: { version: '2.0' }, scene: 0, scenes: [{ nodes: [0] }], nodes: [{ mesh: 0, name: 'two' }],
+    meshes: [{ primitives: [prim(3, 0), prim(4, 1)] }], materials: [{ name: 'red' }, { name: 'blue' }],
+    buffers: [{ byteLength: bin.length, uri: `data:application/octet-stream;base64,${bin.toString('base64')}` }],
+    bufferViews: [{ buffer: 0, byteOffset: 0, byteLength: 48 }, { buffer: 0, byteOffset: 48, byteLength: 48 },
+      { buffer: 0, byteOffset: 96, byteLength: 32 }, { buffer: 0, byteOffset: 128, byteLength: 12 }],
+    accessors: [{ bufferView: 0, componentType: 5126, count: 4, type: 'VEC3', min: [0, 0, 0], max: [1, 1, 1] },
+      { bufferView: 1, componentType: 5126, count: 4, type: 'VEC3' },
+      { bufferView: 2, componentType: 5126, count: 4, type: 'VEC2' },
+      { bufferView: 3, byteOffset: 0, componentType: 5123, count: 3, type: 'SCALAR' },
+      { bufferView: 3, byteOffset: 6, componentType: 5123, count: 3, type: 'SCALAR' }],
+  };
+  const file = path.join(dataDir, 'att_gltf.gltf');
+  fs.writeFileSync(file, JSON.stringify(doc));
+  return file;
+}
+const newer = (a, b) => !fs.existsSync(b) || fs.statSync(a).mtimeMs > fs.statSync(b).mtimeMs;
+// Encodes the files natively and prints the native decoder's figures; null
+// (and a reason) when the native tool or library is missing.
+function attributeReferences() {
+  const tsm = process.env.TSM || path.join(root, 'build/release/cli/tsm');
+  const lib = path.resolve(path.dirname(tsm), '../libcodec/libtsm.a');
+  const corpus = process.env.CORPUS || path.resolve(root, '../shared/corpus');
+  if (!fs.existsSync(tsm) || !fs.existsSync(lib)) return { reason: `no native ${tsm} or ${lib}` };
+  const helper = path.join(root, 'build/web/attr-ref');
+  const src = path.join(here, 'attr-ref.c');
+  if (newer(src, helper) || newer(lib, helper)) {
+    execFileSync('cc', ['-std=c99', '-pedantic', '-Wall', '-Wextra', '-Werror', `-I${path.join(root, 'libcodec/include')}`,
+      src, lib, '-lstdc++', '-lzstd', '-lxxhash', '-lm', '-lpthread', '-o', helper], { stdio: 'inherit' });
+  }
+  const out = [];
+  for (const [name, rel, args] of ATTRIBUTE_FILES) {
+    const file = typeof rel === 'function' ? rel() : path.join(corpus, rel);
+    if (!fs.existsSync(file)) { console.log(`note: ${file} missing, ${name} left out`); continue; }
+    const tsmFile = path.join(dataDir, `${name}.tsm`);
+    execFileSync(tsm, ['encode', file, '-o', tsmFile, '-f', '--quiet', ...args]);
+    out.push({ name, ref: JSON.parse(execFileSync(helper, [tsmFile], { encoding: 'utf8' })) });
+  }
+  return { files: out };
+}
 
 const server = await startServer();
 const base = `http://localhost:${server.address().port}`;
@@ -138,6 +207,81 @@ try {
       r.leftAfter >= 1 && same(r.reused1, want.dragon_res4) && same(r.reused2, want.bunny_seg4k) && r.sourceIntact;
     if (ok) { passed++; console.log(`ok   API: byte-by-byte feed (${r.bytewise.pieces} pieces), odd chunks, reused worker left early`); }
     else { failed++; console.log(`FAIL API: ${JSON.stringify(r)}`); }
+  }
+  // Attributes: the browser's values and indices are the native decoder's.
+  {
+    const refs = attributeReferences();
+    if (!refs.files) { failed++; console.log(`FAIL attributes: ${refs.reason}`); }
+    for (const { name, ref } of refs.files || []) {
+      const r = await page.evaluate(async (n) => {
+        const { loadTsm, decodeStreamInWorker } = await import('/dist/tsm.js');
+        const { fnv1a, hex } = await import('/hash.js');
+        const tsm = await loadTsm();
+        const bytes = new Uint8Array(await (await fetch(`/data/${n}.tsm`)).arrayBuffer());
+        // Appends the pieces' attribute lists as a client would, checking
+        // that each piece continues the lists so far; checksums of the whole.
+        const sum = async (pieces) => {
+          let acc = null, pieces_ = 0, vertexCount = 0, faceCount = 0, cornerCount = 0, metadata = [];
+          const errors = [];
+          for await (const p of pieces) {
+            pieces_++;
+            if (p.metadata) metadata = p.metadata.map((e) => ({ key: e.key, valueHash: hex(fnv1a(e.value)) }));
+            if (!acc && p.attributes.length) {
+              acc = p.attributes.map((a) => ({ name: a.name, kind: a.kind, domain: a.domain, type: a.type,
+                components: a.components, valueCount: 0, vh: 0x811c9dc5, ih: a.indices ? 0x811c9dc5 : null }));
+            }
+            p.attributes.forEach((a, i) => {
+              const s = acc[i];
+              const want = a.domain === 'vertex' ? [p.vertexStart, p.vertexCount]
+                : a.domain === 'face' ? [p.faceStart, p.faceCount] : [s.valueCount, a.valueCount];
+              if (a.valueStart !== s.valueCount || a.valueStart !== want[0] || a.valueCount !== want[1] ||
+                  a.values.length !== a.valueCount * a.components || !(a.values instanceof Float32Array))
+                errors.push(`piece ${pieces_} ${a.name}: values ${a.valueStart}+${a.valueCount}, expected ${want}`);
+              if (a.domain === 'corner') {
+                if (!(a.indices instanceof Uint32Array) || a.indices.length !== p.indices.length)
+                  errors.push(`piece ${pieces_} ${a.name}: ${a.indices && a.indices.length} indices for ${p.indices.length} corners`);
+                else if (a.indices.some((x) => x >= a.valueStart + a.valueCount))
+                  errors.push(`piece ${pieces_} ${a.name}: an index names a value not yet given`);
+              } else if (a.indices !== null) errors.push(`piece ${pieces_} ${a.name}: indices outside the corner domain`);
+              s.vh = fnv1a(a.values, s.vh);
+              if (a.indices) s.ih = fnv1a(a.indices, s.ih);
+              s.valueCount += a.valueCount;
+            });
+            vertexCount += p.vertexCount; faceCount += p.faceCount; cornerCount += p.indices.length;
+          }
+          const attributes = (acc || []).map(({ vh, ih, ...d }) => ({ ...d, valuesHash: hex(vh),
+            indicesHash: ih === null ? null : hex(ih) }));
+          return { vertexCount, faceCount, cornerCount, attributes, metadata, pieces: pieces_, errors };
+        };
+        function* sliced(b, k) { for (let i = 0; i < b.length; i += k) yield b.subarray(i, i + k); }
+        return {
+          whole: await sum([tsm.decode(bytes)]),
+          streamed: await sum(tsm.decodeStream(sliced(bytes, 61))),
+          worker: await sum(decodeStreamInWorker(sliced(bytes, 200))),
+        };
+      }, name);
+      const diffs = [];
+      for (const [how, got] of Object.entries(r)) {
+        const { pieces, errors, ...figures } = got;
+        diffs.push(...errors.map((e) => `${how}: ${e}`));
+        if (JSON.stringify(figures) !== JSON.stringify(ref))
+          diffs.push(`${how}: browser ${JSON.stringify(figures)}, native ${JSON.stringify(ref)}`);
+      }
+      const segmented = ATTRIBUTE_FILES.find((f) => f[0] === name)[2].length > 0;
+      if (segmented && !(r.streamed.pieces > 2 && r.worker.pieces > 1))
+        diffs.push(`not in pieces: ${r.streamed.pieces} streamed, ${r.worker.pieces} in the worker`);
+      if (!ref.attributes.length) diffs.push('the native decoder gives no attributes');
+      if (name === 'att_gltf' && !(ref.metadata.length && ref.attributes.some((a) => a.domain === 'face')))
+        diffs.push('the glTF file has no metadata or no face attribute');
+      if (diffs.length) { failed++; console.log(`FAIL attributes ${name}: ${diffs.join('; ')}`); }
+      else {
+        passed++;
+        console.log(`ok   attributes ${name}: ${ref.attributes.map((a) => `${a.name} (${a.domain}, ${a.valueCount} values, ` +
+          `${a.valuesHash}${a.indicesHash ? `/${a.indicesHash}` : ''})`).join(', ')}` +
+          `${ref.metadata.length ? `, metadata ${ref.metadata.map((e) => `${e.key} (${e.valueHash})`).join(', ')}` : ''}; whole, streamed in ` +
+          `${r.streamed.pieces} pieces, worker in ${r.worker.pieces}`);
+      }
+    }
   }
 } finally {
   await browser.close();

@@ -2,7 +2,7 @@
  *
  *   tsm_mesh* m = NULL; char err[256];
  *   if (tsm_decode(bytes, size, NULL, &m, err, sizeof err) != TSM_OK) puts(err);
- *   ... tsm_mesh_positions(m), tsm_mesh_indices(m) ...
+ *   ... tsm_mesh_positions(m), tsm_mesh_indices(m), tsm_mesh_attribute_values(m, 0) ...
  *   tsm_mesh_free(m);
  *
  * Return codes are the values of tsm::ErrorCode (0 = ok). Error messages are
@@ -43,6 +43,12 @@ typedef struct tsm_encode_options {
   int level;             /* 0..9, -1 = default */
   uint32_t segment_faces; /* faces per segment at most; 0 = default (2^18) */
   int threads;            /* segments coded in parallel; 0 = one per core */
+  /* Attribute quantization bits, 1..24; 0 = default (normals 10, octahedral; texture
+   * coordinates 12, float colours 10, other float attributes 16; integer types are exact). */
+  int normal_bits;
+  int texcoord_bits;
+  int color_bits;
+  int generic_bits;
 } tsm_encode_options;
 
 /* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
@@ -55,7 +61,8 @@ int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* optio
 int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t* face_sizes, size_t face_count,
                     const uint32_t* indices, size_t index_count, tsm_mesh** out, char* err, size_t err_size);
 
-/* Encodes a mesh. On success *out is a malloc'ed buffer the caller frees with tsm_free. */
+/* Encodes a mesh (with its attributes and metadata). On success *out is a malloc'ed buffer the
+ * caller frees with tsm_free. */
 int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
                size_t err_size);
 
@@ -80,7 +87,11 @@ size_t tsm_stream_segment_count(const tsm_stream* s);
 size_t tsm_stream_segments_done(const tsm_stream* s);
 /* The mesh decoded so far (vertices and faces of the finished segments; it only grows: the
  * vertices and faces of segment k come after those of segments < k, and faces of segment k only
- * reference vertices of segments <= k). Valid until the next feed/finish/free; read it with tsm_mesh_*. */
+ * reference vertices of segments <= k). Valid until the next feed/finish/free; read it with tsm_mesh_*.
+ * Its attributes appear with the first segment and grow the same way: vertex and face values
+ * follow the vertices and faces, a corner attribute's values of segment k follow those of the
+ * segments before it, and the corner indices of segment k (one per new corner) name values of
+ * segments <= k. */
 const tsm_mesh* tsm_stream_mesh(const tsm_stream* s);
 void tsm_stream_free(tsm_stream* s);
 
@@ -90,6 +101,76 @@ size_t tsm_mesh_index_count(const tsm_mesh* mesh);
 const float* tsm_mesh_positions(const tsm_mesh* mesh);      /* 3 * vertex_count */
 const uint32_t* tsm_mesh_face_offsets(const tsm_mesh* mesh); /* face_count + 1 */
 const uint32_t* tsm_mesh_indices(const tsm_mesh* mesh);      /* index_count */
+
+/* ---- attributes ----------------------------------------------------------
+ * Normals, colours, texture coordinates and other values per vertex, per face
+ * or per face corner (tsm::Attribute in mesh.hpp). Values are always floats
+ * here, components floats per value; the type says how they were stored (an
+ * integer type holds integer values, a u8 colour is 0..255, and is coded
+ * exactly; float ones are quantized: by default normals octahedral with 10
+ * bits per axis, texture coordinates on a grid of 12 bits, colours 10 bits,
+ * others 16 bits). The vertex domain has one value per vertex, the face domain
+ * one per face; the corner domain has one index per face corner (in the order
+ * of tsm_mesh_indices) naming one of its own values (seams, creases), values
+ * possibly shared or unused.
+ *
+ *   for (size_t a = 0; a < tsm_mesh_attribute_count(m); ++a)
+ *     if (tsm_mesh_attribute_kind(m, a) == TSM_KIND_TEXCOORD) {
+ *       const float* uv = tsm_mesh_attribute_values(m, a);        (2 floats per value)
+ *       const uint32_t* ix = tsm_mesh_attribute_indices(m, a);    (corner domain, else NULL)
+ *     }
+ *
+ * The accessors take an attribute number 0..count-1; out of range (or a NULL
+ * mesh) they return NULL, 0 or -1. Pointers stay valid until the mesh is
+ * changed or freed (for a stream's mesh: until the next feed/finish/free). */
+enum { TSM_KIND_GENERIC = 0, TSM_KIND_NORMAL = 1, TSM_KIND_COLOR = 2, TSM_KIND_TEXCOORD = 3 };
+enum { TSM_DOMAIN_VERTEX = 0, TSM_DOMAIN_FACE = 1, TSM_DOMAIN_CORNER = 2 };
+enum { TSM_TYPE_F32 = 0, TSM_TYPE_U8 = 1, TSM_TYPE_U16 = 2, TSM_TYPE_I32 = 3 };
+
+size_t tsm_mesh_attribute_count(const tsm_mesh* mesh);
+/* The attribute's name, NUL-terminated ("normal", "texcoord", "color" or the file's own name). */
+const char* tsm_mesh_attribute_name(const tsm_mesh* mesh, size_t attribute);
+int tsm_mesh_attribute_kind(const tsm_mesh* mesh, size_t attribute);       /* TSM_KIND_*, -1 out of range */
+int tsm_mesh_attribute_domain(const tsm_mesh* mesh, size_t attribute);     /* TSM_DOMAIN_* */
+int tsm_mesh_attribute_type(const tsm_mesh* mesh, size_t attribute);       /* TSM_TYPE_* */
+int tsm_mesh_attribute_components(const tsm_mesh* mesh, size_t attribute); /* 1..4 */
+/* Values (vertex domain: vertex_count, face domain: face_count, corner domain: any). */
+size_t tsm_mesh_attribute_value_count(const tsm_mesh* mesh, size_t attribute);
+const float* tsm_mesh_attribute_values(const tsm_mesh* mesh, size_t attribute); /* components * value_count */
+/* Corner domain: index_count entries, one per face corner, each < value_count. Other domains: 0 and NULL. */
+size_t tsm_mesh_attribute_index_count(const tsm_mesh* mesh, size_t attribute);
+const uint32_t* tsm_mesh_attribute_indices(const tsm_mesh* mesh, size_t attribute);
+
+/* Attaches an attribute to a mesh the caller owns (from tsm_mesh_create or
+ * tsm_decode; not a stream's mesh), for tsm_encode. name is NUL-terminated;
+ * kind, domain and type are TSM_KIND_*, TSM_DOMAIN_*, TSM_TYPE_*; values holds
+ * components * value_count floats; indices (corner domain only, else NULL and
+ * 0) one entry per face corner naming a value. The arrays are copied. Checked
+ * against the mesh: sizes matching the domain (value_count == vertex_count or
+ * face_count, index_count == the mesh's index_count, indices < value_count),
+ * components 1..4 (3 for a normal, 2 for a texture coordinate, 3 or 4 for a
+ * colour); on an error (TSM_INVALID_ARGUMENT and a message naming the
+ * attribute) the mesh is left as it was. Values of an integer type must be
+ * integers (|x| <= 2^30) and every value finite: tsm_encode checks those.
+ * tsm_encode quantizes float attributes with the default bits above. */
+int tsm_mesh_add_attribute(tsm_mesh* mesh, const char* name, int kind, int domain, int type, int components,
+                           const float* values, size_t value_count, const uint32_t* indices, size_t index_count,
+                           char* err, size_t err_size);
+
+/* ---- metadata ------------------------------------------------------------
+ * Entries the codec passes through unchanged (a glTF document's materials and
+ * scenes under the key "gltf", say; tsm::MetadataEntry in mesh.hpp): byte
+ * strings, keys of 1..255 bytes, unique. The key and value pointers are
+ * followed by a NUL (not counted in *size), so text can be read as C strings. */
+size_t tsm_mesh_metadata_count(const tsm_mesh* mesh);
+/* Entry number 0..count-1; NULL (and *size 0) out of range. size may be NULL. */
+const char* tsm_mesh_metadata_key(const tsm_mesh* mesh, size_t entry, size_t* size);
+const uint8_t* tsm_mesh_metadata_value(const tsm_mesh* mesh, size_t entry, size_t* size);
+/* Adds an entry (key of key_size bytes, 1..255, not used yet; value of
+ * value_size bytes, value may be NULL when value_size is 0) to a mesh the
+ * caller owns. The bytes are copied. */
+int tsm_mesh_add_metadata(tsm_mesh* mesh, const char* key, size_t key_size, const uint8_t* value, size_t value_size,
+                          char* err, size_t err_size);
 
 void tsm_mesh_free(tsm_mesh* mesh);
 void tsm_free(void* buffer);
