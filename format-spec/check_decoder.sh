@@ -1,25 +1,135 @@
 #!/bin/sh
-# Checks reference_decoder.py against `tsm decode` (faces and float bits of
-# every position) on the test meshes of test_meshes.py and a corpus mesh.
+# Checks reference_decoder.py against `tsm decode`, bit for bit, on the test
+# meshes of test_meshes.py and on corpus meshes.
+#
 # Usage: check_decoder.sh [TSM_BINARY] [WORK_DIR]
-set -e
+#   TSM_BINARY: the tsm CLI (default: $TSM, else ../build/release/cli/tsm)
+#   CORPUS=DIR: the corpus folder (default: ../../shared/corpus); missing corpus
+#               files are skipped with a note
+#
+# How the outputs are compared (one line per case, IDENTICAL or DIFFERENT):
+# * every case: `tsm decode X.tsm -o X.ply` (binary PLY) against the PLY that
+#   reference_decoder.py writes the way io_ply.cpp does, byte for byte: the
+#   header (so the attribute names, kinds, types and order), the float bits of
+#   every position, the faces, every vertex and face attribute value, and every
+#   corner attribute value as the per-face lists io_ply.cpp writes (one value
+#   per corner);
+# * cases with attributes also: `tsm decode X.tsm -o X.obj` against the
+#   decoder's values (parsed exactly to binary32): positions, the first vertex
+#   colour, and the whole value lists of the first texcoord (or 'texcoord3')
+#   and normal attribute with every corner's index: so the shared value lists
+#   of corner attributes (which values corners share, the values no corner
+#   uses) are compared too, which PLY cannot express. Other corner attributes
+#   are compared per corner through the PLY only.
+# * metadata (section 9, §4.6): the CLI cannot write it, so test_meshes.py
+#   --add-metadata inserts a raw section 9 into an encoded file; well-formed
+#   ones must decode (and compare) on both sides, malformed ones must be
+#   refused by both.
+# Exit status: 0 when every case is IDENTICAL (and every malformed file
+# refused by both), 1 otherwise.
 here=$(cd "$(dirname "$0")" && pwd)
-tsm=${1:-$here/../build/release/cli/tsm}
+tsm=${1:-${TSM:-$here/../build/release/cli/tsm}}
 work=${2:-$(mktemp -d)}
-dragon=$here/../../shared/corpus/dragon_vrip_res4.ply
-python3 "$here/test_meshes.py" "$work"
-check() {  # name mesh q level [segment_faces]
-  "$tsm" encode "$2" -o "$work/$1.tsm" -q "$3" -l "$4" --segment-faces "${5:-0}" -f --quiet
-  "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet
-  python3 "$here/reference_decoder.py" "$work/$1.tsm" --compare "$work/$1.ply"
+corpus=${CORPUS:-$here/../../shared/corpus}
+dec=$here/reference_decoder.py
+failed=""
+cases=0
+python3 "$here/test_meshes.py" "$work" || exit 1
+
+result() {  # name status
+  cases=$((cases + 1))
+  [ "$2" -eq 0 ] || failed="$failed $1"
 }
+encode() {  # name mesh q level [segment_faces]
+  "$tsm" encode "$2" -o "$work/$1.tsm" -q "$3" -l "$4" --segment-faces "${5:-0}" -f --quiet
+}
+check() {  # name mesh q level [segment_faces]: positions, faces and attributes through PLY
+  if encode "$@" && "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet; then
+    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
+    st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
+  else
+    echo "$1: tsm failed"; result "$1" 1
+  fi
+}
+acheck() {  # the same, and the corner value lists through OBJ
+  if encode "$@" && "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet &&
+     "$tsm" decode "$work/$1.tsm" -o "$work/$1.obj" -f --quiet; then
+    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" --compare-obj "$work/$1.obj" > "$work/$1.txt"
+    st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
+  else
+    echo "$1: tsm failed"; result "$1" 1
+  fi
+}
+compare_file() {  # name: an existing $work/name.tsm
+  if "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet; then
+    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
+    st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
+  else
+    echo "$1: tsm decode failed"; result "$1" 1
+  fi
+}
+refused() {  # name: both decoders must refuse $work/name.tsm (corrupt_data)
+  out=$(python3 "$dec" "$work/$1.tsm")
+  py=$?
+  if "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet 2>/dev/null; then cpp=0; else cpp=$?; fi
+  if [ $py -eq 2 ] && [ $cpp -ne 0 ]; then
+    echo "$1: refused by both: ${out#*: }"; result "$1" 0
+  else
+    echo "$1: DIFFERENT: reference_decoder.py exit $py ($out), tsm decode exit $cpp"; result "$1" 1
+  fi
+}
+corpus_case() {  # check-function name file q level [segment_faces]
+  fn=$1; shift
+  if [ -f "$2" ]; then "$fn" "$@"; else echo "$1: skipped, $2 not found"; fi
+}
+
+# ---- connectivity and geometry
 check triangle "$work/triangle.obj" 8 0
 for l in 0 6 9; do check mixed_l$l "$work/mixed.obj" 16 $l; done
 check mixed_small_l9 "$work/mixed_small.obj" 10 9
 for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50
-if [ -f "$dragon" ]; then
-  for l in 0 6 9; do check dragon_l$l "$dragon" 11 $l; done
-  check dragon_segments "$dragon" 11 6 2000
+dragon=$corpus/dragon_vrip_res4.ply
+for l in 0 6 9; do corpus_case check dragon_l$l "$dragon" 11 $l; done
+corpus_case check dragon_segments "$dragon" 11 6 2000
+
+# ---- attributes (§8.12)
+for l in 0 9; do acheck attributes_obj_l$l "$work/attributes.obj" 12 $l; done
+for l in 0 9; do acheck attributes_ply_l$l "$work/attributes.ply" 12 $l; done
+acheck attributes_obj_segments "$work/attributes.obj" 12 6 60
+acheck attributes_ply_segments "$work/attributes.ply" 12 6 100
+edge=$corpus/edge
+for f in cube_att.obj cube_att.ply sphere.obj test_nm.obj Box.ply test_pos_color.ply test_more_datatypes.ply; do
+  corpus_case acheck "$(echo "$f" | tr . _)" "$edge/$f" 11 6
+done
+corpus_case acheck sphere_obj_segments "$edge/sphere.obj" 11 6 50
+corpus_case acheck test_pos_color_ply_segments "$edge/test_pos_color.ply" 11 6 40
+# predictor 2 (texture placement): vertex and corner domain, whole and segmented
+acheck uv_vertex "$work/uv_vertex.ply" 12 6
+acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150
+acheck uv_corner "$work/uv_corner.obj" 12 6
+acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
+corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
+corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000
+
+# ---- metadata (§4.6)
+meta="python3 $here/test_meshes.py --add-metadata"
+$meta "$work/attributes_ply_l0.tsm" "$work/metadata.tsm" gltf='{"asset":{"version":"2.0"}}' note=hello empty= &&
+  compare_file metadata
+$meta "$work/attributes_ply_segments.tsm" "$work/metadata_segments.tsm" k=v && compare_file metadata_segments
+$meta "$work/triangle.tsm" "$work/metadata_none.tsm" --raw 00 && compare_file metadata_none
+if command -v zstd > /dev/null; then  # codec 1: checked if python3 has the zstandard module, else skipped
+  $meta "$work/mixed_l6.tsm" "$work/metadata_zstd.tsm" --zstd "gltf=$(head -c 3000 "$work/mixed.obj")" &&
+    compare_file metadata_zstd
 fi
+for bad in duplicate_key:02016100016100 empty_key:01000000 trailing_byte:01016100ff \
+           count_too_large:02016100 value_too_long:0101610500 truncated_count:80; do
+  $meta "$work/triangle.tsm" "$work/metadata_${bad%%:*}.tsm" --raw "${bad#*:}" && refused "metadata_${bad%%:*}"
+done
+
+if [ -n "$failed" ]; then
+  echo "$cases cases, FAILED:$failed"
+  exit 1
+fi
+echo "$cases cases, all IDENTICAL"

@@ -2,13 +2,26 @@
 """An independent decoder for .tsm files (format version 2), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
-`zstandard` module; the reference encoder never writes them).
+`zstandard` module; the reference encoder writes them only for the metadata
+section, §4.6, when that is smaller).
+
+Decodes connectivity, geometry, segments, attributes (§8.12) and checks the
+metadata section's layout (§4.6).
 
 Usage:
   reference_decoder.py FILE.tsm                      print a summary
-  reference_decoder.py FILE.tsm --compare OUT.ply    compare with `tsm decode FILE.tsm -o OUT.ply`
-                                                     (binary or ASCII PLY): faces and float bits
-  reference_decoder.py FILE.tsm --dump               print faces, grid indices and positions
+  reference_decoder.py FILE.tsm --compare OUT.ply    compare with `tsm decode FILE.tsm -o OUT.ply`:
+                                                     a binary PLY byte for byte (positions, faces and
+                                                     every attribute, as io_ply.cpp writes them);
+                                                     an ASCII PLY by positions' float bits and faces
+  reference_decoder.py FILE.tsm --compare-obj OUT.obj  compare with `tsm decode FILE.tsm -o OUT.obj`:
+                                                     positions, vertex colours, the vt and vn value
+                                                     lists (float bits) and every corner's indices
+                                                     (a corner attribute's shared values, unused ones)
+  reference_decoder.py FILE.tsm --write-ply OUT.ply  write the PLY `tsm decode` would write
+  reference_decoder.py FILE.tsm --dump               print faces, grid indices, positions, attributes
+  reference_decoder.py FILE.tsm --dump-attributes    print attribute headers, values (integers and
+                                                     hex floats) and corner indices
   reference_decoder.py FILE.tsm --trace              also trace the geometry decoding
 
 Exit status: 0 decoded (and equal, with --compare), 1 differs, 2 corrupt/unsupported.
@@ -190,6 +203,12 @@ def read_container(data):
             try:
                 import zstandard
             except ImportError:
+                if sid == 9:        # metadata: only its layout is checked (§4.6); skip it
+                    sections[sid] = None
+                    order.append(sid)
+                    if len(order) > 4096:
+                        reject('too many sections')                 # step 22
+                    continue
                 raise Unsupported('zstd section (install the zstandard module)')
             try:
                 body = zstandard.ZstdDecompressor().decompress(body, max_output_size=raw)
@@ -1168,6 +1187,563 @@ def decode_geometry(payload, layout, qbits, trace=None):
     return q, ginfo
 
 
+# ---------------------------------------------------------------- §8.12 attributes
+
+KIND_NAMES = ('generic', 'normal', 'color', 'texcoord')
+DOMAIN_NAMES = ('vertex', 'face', 'corner')
+TYPE_NAMES = ('f32', 'u8', 'u16', 'i32')
+MAX_ATTRIBUTES = 64
+
+
+class AttrHeader:
+    """One attribute header (§8.12): name (bytes), kind, domain, type, components,
+    quant (0 exact, 1 grid, 2 octahedral), bits, and for quant 1 origin[] and extent."""
+
+    def description(self):
+        return (self.name, self.kind, self.domain, self.type, self.components)
+
+    def ints(self):
+        """Integers per value: 2 for octahedral, else the components."""
+        return 2 if self.quant == 2 else self.components
+
+    def in_range(self, x):
+        if self.quant == 0:
+            return -(1 << 30) <= x <= (1 << 30)
+        return 0 <= x < (1 << self.bits)
+
+
+def read_attribute_header(buf, p):
+    end = len(buf)
+    h = AttrHeader()
+    n, p = read_varint(buf, p, end)
+    if n > 1024 or n > end - p:
+        reject('attributes: truncated attribute header')
+    h.name = bytes(buf[p:p + n])
+    p += n
+    if end - p < 6:
+        reject('attributes: truncated attribute header')
+    h.kind, h.domain, h.type, h.components, h.quant, h.bits = buf[p:p + 6]
+    p += 6
+    if h.kind > 3 or h.domain > 2 or h.type > 3 or not 1 <= h.components <= 4 or h.quant > 2:
+        reject('attributes: bad attribute header')
+    if h.quant != 0 and not 1 <= h.bits <= 24:
+        reject('attributes: bad quantization bits')
+    if h.quant == 2 and h.components != 3:
+        reject('attributes: octahedral needs 3 components')
+    if (h.kind == 1 and h.components != 3) or (h.kind == 3 and h.components != 2) or \
+            (h.kind == 2 and h.components < 3):
+        reject('attributes: components do not fit the kind')
+    h.origin = []
+    h.extent = 0.0
+    if h.quant == 1:
+        if end - p < 4 * h.components + 8:
+            reject('attributes: truncated grid')
+        h.origin = list(struct.unpack_from('<%df' % h.components, buf, p))
+        p += 4 * h.components
+        h.extent = struct.unpack_from('<d', buf, p)[0]
+        p += 8
+        if not all(math.isfinite(o) for o in h.origin):
+            reject('attributes: bad grid origin')
+        if not (math.isfinite(h.extent) and 0 <= h.extent <= 6.9e38):
+            reject('attributes: bad grid extent')
+    return h, p
+
+
+def sgn(x):
+    return 1.0 if x >= 0 else -1.0          # sgn 0 = +1 (also for -0.0)
+
+
+def octahedral_ints(x, y, z, bits):
+    """The encoder's octahedral mapping of direction (x, y, z) (binary64), §8.12."""
+    s = abs(x) + abs(y) + abs(z)
+    if not s > 0:
+        x, y, z = 0.0, 0.0, 1.0
+    else:
+        x, y, z = x / s, y / s, z / s
+    if z < 0:
+        x, y = (1 - abs(y)) * sgn(x), (1 - abs(x)) * sgn(y)
+    m = float((1 << bits) - 1)
+    u = int(math.floor((x * 0.5 + 0.5) * m + 0.5))
+    v = int(math.floor((y * 0.5 + 0.5) * m + 0.5))
+    top = (1 << bits) - 1
+    if v == 0 or v == top:
+        u = min(u, top - u)
+    if u == 0 or u == top:
+        v = min(v, top - v)
+    return [u, v]
+
+
+def octahedral_value(u, v, bits):
+    m = float((1 << bits) - 1)
+    x = u / m * 2 - 1
+    y = v / m * 2 - 1
+    z = 1 - abs(x) - abs(y)
+    if z < 0:
+        x, y = (1 - abs(y)) * sgn(x), (1 - abs(x)) * sgn(y)
+    n = math.sqrt(x * x + y * y + z * z)
+    return [f32(x / n), f32(y / n), f32(z / n)]
+
+
+def attribute_value(h, ints):
+    """The floats of one value from its integers (§8.12, "Integers of a value")."""
+    if h.quant == 2:
+        return octahedral_value(ints[0], ints[1], h.bits)
+    if h.quant == 0:
+        return [f32(float(x)) for x in ints]
+    step = h.extent / float((1 << h.bits) - 1) if h.extent > 0 else 0.0
+    out = []
+    for c in range(h.components):
+        x = float(h.origin[c]) + float(ints[c]) * step
+        out.append(f32(min(max(x, -FLT_MAX), FLT_MAX)))
+    return out
+
+
+def geometry_normals(faces, rank, q, bits):
+    """§8.12 "Geometry normals": per own rank the octahedral integers of the
+    summed fan cross products, or None where the sum is zero. Sums in face order,
+    a face's fan summed first, then added to each of its corners."""
+    n = len(q)
+    sx, sy, sz = [0.0] * n, [0.0] * n, [0.0] * n
+    for f in faces:
+        k = len(f)
+        if k < 3 or any(rank[c] == NONE for c in f):
+            continue
+        p0 = q[rank[f[0]]]
+        nx = ny = nz = 0.0
+        for i in range(1, k - 1):
+            p1, p2 = q[rank[f[i]]], q[rank[f[i + 1]]]
+            a0, a1, a2 = float(p1[0] - p0[0]), float(p1[1] - p0[1]), float(p1[2] - p0[2])
+            b0, b1, b2 = float(p2[0] - p0[0]), float(p2[1] - p0[1]), float(p2[2] - p0[2])
+            nx += a1 * b2 - a2 * b1
+            ny += a2 * b0 - a0 * b2
+            nz += a0 * b1 - a1 * b0
+        for c in f:
+            r = rank[c]
+            sx[r] += nx
+            sy[r] += ny
+            sz[r] += nz
+    out = [None] * n
+    for r in range(n):
+        if sx[r] != 0 or sy[r] != 0 or sz[r] != 0:
+            out[r] = octahedral_ints(sx[r], sy[r], sz[r], bits)
+    return out
+
+
+class AttrModels:
+    """The models of one attribute (§8.12), fresh per attribute."""
+
+    def __init__(self):
+        self.res = [[[SIntModel(4), SIntModel(4)] for _ in range(4)] for _ in range(3)]   # [cls][component][z]
+        self.symbol = [UIntModel(2) for _ in range(6)]
+        self.far = UIntModel(2)
+        self.unused = UIntModel(2)
+        self.imported = [UIntModel(2), UIntModel(2)]     # [the corner's vertex is a reference]
+        self.import_id = SIntModel(4)
+        self.last_zero = [1, 1, 1, 1]
+
+
+def faces_around(faces, n):
+    """§8.12 "Faces around a vertex": per part vertex the (face, position) pairs
+    of its corners, in face order, then position order."""
+    out = [[] for _ in range(n)]
+    for f, fa in enumerate(faces):
+        for i, v in enumerate(fa):
+            out[v].append((f, i))
+    return out
+
+
+def uv_place(pw, pa, pb, ua, ub, pc, uc, sigma):
+    """§8.12 "Placement of w from (a, b)": binary64, in the order FORMAT.md gives
+    (the integer differences are exact, so subtracting as integers first is the
+    same as subtracting their binary64 values)."""
+    ex, ey, ez = float(pb[0] - pa[0]), float(pb[1] - pa[1]), float(pb[2] - pa[2])
+    l2 = ex * ex + ey * ey + ez * ez
+    dx, dy = float(ub[0] - ua[0]), float(ub[1] - ua[1])
+    if l2 == 0:
+        return float(ua[0]), float(ua[1])
+    wx, wy, wz = float(pw[0] - pa[0]), float(pw[1] - pa[1]), float(pw[2] - pa[2])
+    t = (wx * ex + wy * ey + wz * ez) / l2
+    px, py, pz = wx - t * ex, wy - t * ey, wz - t * ez
+    hw = math.sqrt(px * px + py * py + pz * pz)
+    if pc is not None:
+        cx, cy, cz = float(pc[0] - pa[0]), float(pc[1] - pa[1]), float(pc[2] - pa[2])
+        tc = (cx * ex + cy * ey + cz * ez) / l2
+        qx, qy, qz = cx - tc * ex, cy - tc * ey, cz - tc * ez
+        hc = math.sqrt(qx * qx + qy * qy + qz * qz)
+        if hc > 0:
+            mx = (float(uc[0] - ua[0]) - tc * dx) / hc
+            my = (float(uc[1] - ua[1]) - tc * dy) / hc
+            return ua[0] + t * dx - hw * mx, ua[1] + t * dy - hw * my
+    h = hw / math.sqrt(l2) * sigma
+    return ua[0] + t * dx - h * dy, ua[1] + t * dy + h * dx
+
+
+def uv_orientation(uv):
+    """The sign of the texture-space area (shoelace, exact integers) of a face's values."""
+    k = len(uv)
+    area = 0
+    for i in range(k):
+        a, b = uv[i], uv[(i + 1) % k]
+        area += a[0] * b[1] - b[0] * a[1]
+    area = (area + (1 << 63)) % (1 << 64) - (1 << 63)    # int64, wrapping as attributes.cpp's sum does
+    return (area > 0) - (area < 0)
+
+
+def round_to_grid(x, bits):
+    r = math.floor(x + 0.5)
+    top = (1 << bits) - 1
+    return 0 if r < 0 else top if r > top else int(r)
+
+
+class AttrWalk:
+    """What the prediction of a value may look at: the attribute (header,
+    predictor byte), the part (faces with part-local ids, rank: own rank per part
+    vertex or NONE, q: own grid indices), the geometry normals (quant 2 only),
+    the faces around each vertex and sigma (predictor 2), the values so far and,
+    while coding a value, where it is."""
+
+    def __init__(self, h, predictor, faces, rank, q, around):
+        self.h, self.predictor, self.faces, self.rank, self.q = h, predictor, faces, rank, q
+        self.gnormal = geometry_normals(faces, rank, q, h.bits) if h.quant == 2 else None
+        self.around = around            # predictor 2: faces_around()
+        self.sigma = 1                  # predictor 2: the texture orientation so far
+        self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
+        self.values = []                # integers of the values decoded so far (corner domain: the value list)
+        self.alias = []                 # corner domain: per value, the earlier segment's value id it stands for, or None
+        self.face_offsets = [0]         # corner domain: first corner of each face, and
+        for f in faces:
+            self.face_offsets.append(self.face_offsets[-1] + len(f))
+        self.index = [None] * self.face_offsets[-1]     # each corner's value id once known
+        self.visit = []                 # corner domain: the current face's visiting order
+        self.cand = None                # corner domain: candidate value ids per part vertex
+
+    def uv_triangles(self, f, i, known, across, sx=0.0, sy=0.0):
+        """§8.12 "Prediction at position i of face f": adds its placements to the
+        running sum (sx, sy), side after side (the vertex domain carries one sum
+        over all faces around the vertex, as attributes.cpp does: summing per
+        face first could round differently). Returns (sx, sy, count)."""
+        fa = self.faces[f]
+        k = len(fa)
+        rank, q = self.rank, self.q
+        w = fa[i]
+        count = 0
+        if k < 3 or rank[w] == NONE:
+            return sx, sy, 0
+        for side in range(2 if k > 3 else 1):
+            ia, ib = ((i + 1) % k, (i + 2) % k) if side == 0 else ((i + k - 2) % k, (i + k - 1) % k)
+            a, b = fa[ia], fa[ib]
+            if a == w or b == w or a == b or rank[a] == NONE or rank[b] == NONE:
+                continue
+            ua, ub = known(ia), known(ib)
+            if ua is None or ub is None:
+                continue
+            pc = uc = None
+            for F, ja in self.around[a]:
+                kf = len(self.faces[F])
+                if F == f or kf < 3:
+                    continue
+                fc = self.faces[F]
+                if fc[(ja + 1) % kf] == b:
+                    jb, jc = (ja + 1) % kf, (ja + 2) % kf
+                elif fc[(ja + kf - 1) % kf] == b:
+                    jb, jc = (ja + kf - 1) % kf, (ja + kf - 2) % kf
+                else:
+                    continue
+                cv = fc[jc]
+                if cv == w or cv == a or cv == b or rank[cv] == NONE:
+                    continue
+                uc = across(F, ja, jb, jc, ia, ib)
+                if uc is not None:
+                    pc = q[rank[cv]]
+                    break
+            x, y = uv_place(q[rank[w]], q[rank[a]], q[rank[b]], ua, ub, pc, uc, self.sigma)
+            sx += x
+            sy += y
+            count += 1
+        return sx, sy, count
+
+    def update_sigma(self, uv):
+        o = uv_orientation(uv)
+        if o != 0:
+            self.sigma = o
+
+
+def corner_visit_order(walk, g):
+    """The order in which the corners of face g are visited (positions in the
+    face), §8.12: with predictor 2, first the positions whose vertex has
+    candidates when the face is reached, then the others; else face order."""
+    fa = walk.faces[g]
+    if walk.predictor == 2:
+        cand = walk.cand
+        order = [i for i in range(len(fa)) if cand[fa[i]]] + [i for i in range(len(fa)) if not cand[fa[i]]]
+    else:
+        order = list(range(len(fa)))
+    walk.visit = order
+    return order
+
+
+def predict_value(walk, item):
+    """The prediction of one value and its class (§8.12). item: ('vertex', own
+    rank, part vertex), ('face', part face), ('corner', corner index k, part
+    vertex w, face g, position i in the face) for a new corner value (walk.index
+    holds the value ids of the corners visited so far), or ('unused',) for a
+    value no corner uses. Returns (integers, cls)."""
+    h = walk.h
+    if item[0] == 'vertex':
+        r, v = item[1], item[2]
+        if walk.predictor == 1 and walk.gnormal[r] is not None:
+            return list(walk.gnormal[r]) + walk.prev[2:], 0
+        if walk.predictor == 2:
+            rank, vals = walk.rank, walk.values
+            sx = sy = 0.0
+            count = 0
+            for f, i in walk.around[v]:
+                fa = walk.faces[f]
+
+                def known(j, fa=fa):
+                    rj = rank[fa[j]]
+                    return vals[rj] if rj < r else None
+
+                def across(F, ja, jb, jc, ia, ib):
+                    rc = rank[walk.faces[F][jc]]
+                    return vals[rc] if rc < r else None
+                sx, sy, n = walk.uv_triangles(f, i, known, across, sx, sy)
+                count += n
+            if count > 0:
+                return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
+            return list(walk.prev), 0
+        return list(walk.prev), 0
+    if item[0] == 'corner' and h.quant == 2:
+        r = walk.rank[item[2]]
+        if r != NONE and walk.gnormal[r] is not None:
+            return list(walk.gnormal[r]), 0
+    if item[0] == 'corner' and walk.predictor == 2:
+        g, i = item[3], item[4]
+        off, index, vals = walk.face_offsets, walk.index, walk.values
+
+        def known(j):
+            x = index[off[g] + j]
+            return None if x is None else vals[x]
+
+        def across(F, ja, jb, jc, ia, ib):
+            if F >= g or index[off[F] + ja] != index[off[g] + ia] or index[off[F] + jb] != index[off[g] + ib]:
+                return None
+            return vals[index[off[F] + jc]]
+        sx, sy, count = walk.uv_triangles(g, i, known, across)
+        if count > 0:
+            return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
+        for j in walk.visit:
+            x = index[off[g] + j]
+            if x is not None:
+                return list(vals[x]), 0
+    return list(walk.prev), 0
+
+
+def decode_value(d, m, walk, item, segmented=False):
+    """One value: per integer c a residual from res[cls][c][previous residual of c
+    was 0]. A new corner value of a segment first says whether it stands for an
+    earlier segment's value (and which)."""
+    h = walk.h
+    pred, cls = predict_value(walk, item)
+    if segmented:
+        g = m.imported[1 if walk.rank[item[2]] == NONE else 0].decode(d)
+        if g > 1:
+            reject('attributes: corner values of %r are invalid' % h.name)
+        if g == 1:
+            gid = m.last_import + m.import_id.decode(d)
+            if not 0 <= gid < 0xFFFFFFFF:
+                reject('attributes: corner values of %r are invalid' % h.name)
+            m.last_import = gid
+            walk.alias.append(gid)
+        else:
+            walk.alias.append(None)
+    elif item[0] in ('corner', 'unused'):
+        walk.alias.append(None)
+    x = []
+    for c in range(h.ints()):
+        r = m.res[cls][c][m.last_zero[c]].decode(d)
+        v = pred[c] + r
+        if not h.in_range(v):
+            reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
+        x.append(v)
+        m.last_zero[c] = 1 if r == 0 else 0
+    walk.prev = x
+    walk.values.append(x)
+    return x
+
+
+def predictor_allowed(h, pr):
+    if pr == 0:
+        return True
+    if pr == 1:
+        return h.domain == 0 and h.quant == 2
+    if pr == 2:
+        return h.domain != 1 and h.quant == 1 and h.components == 2
+    return False
+
+
+def decode_attributes(payload, faces, glob, q, segmented=False):
+    """§8.12 for one part. faces: the part's faces (part-local ids); glob: per part
+    vertex NONE (own) or a reference; q: the own vertices' grid indices;
+    segmented: a segment of a segmented file (new corner values may stand for an
+    earlier segment's). Returns per attribute a dict: header, predictor, ints
+    (integers of each value), values (floats of each value), indices (corner
+    domain: per corner, else None), alias (corner domain: per value the earlier
+    segment's value id it stands for, or None)."""
+    if len(payload) == 0:
+        return []
+    A, p = read_varint(payload, 0, len(payload))
+    if A > MAX_ATTRIBUTES:
+        reject('attributes: bad attribute count')
+    headers = []
+    for _ in range(A):
+        h, p = read_attribute_header(payload, p)
+        headers.append(h)
+    predictors = []
+    for h in headers:
+        if p >= len(payload):
+            reject('attributes: bad predictor')
+        pr = payload[p]
+        p += 1
+        if not predictor_allowed(h, pr):
+            reject('attributes: bad predictor')
+        predictors.append(pr)
+    coded = payload[p:]
+    rank = [NONE] * len(glob)
+    own_vertex = []
+    for v in range(len(glob)):
+        if glob[v] == NONE:
+            rank[v] = len(own_vertex)
+            own_vertex.append(v)
+    own = len(own_vertex)
+    around = faces_around(faces, len(glob)) if 2 in predictors else None
+    d = RangeDecoder(coded)
+    out = []
+    for h, pr in zip(headers, predictors):
+        m = AttrModels()
+        m.last_import = 0
+        walk = AttrWalk(h, pr, faces, rank, q, around)
+        indices = alias = None
+        if h.domain == 0:                                    # vertex: own vertices in output order
+            for r in range(own):
+                x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
+                if pr == 2:                                  # faces this vertex completes: sigma
+                    for f, _ in around[own_vertex[r]]:
+                        fa = faces[f]
+                        if len(fa) >= 3 and all(rank[c] <= r for c in fa):
+                            walk.update_sigma([walk.values[rank[c]] for c in fa])
+        elif h.domain == 1:                                  # face: the part's faces in output order
+            for f in range(len(faces)):
+                decode_value(d, m, walk, ('face', f))
+        else:                                                # corner
+            cand = walk.cand = [[] for _ in range(len(glob))]
+            indices = walk.index
+            alias = walk.alias
+            for g, f in enumerate(faces):
+                for i in corner_visit_order(walk, g):
+                    k = walk.face_offsets[g] + i
+                    w = f[i]
+                    nc = len(cand[w])
+                    s = m.symbol[min(nc, 5)].decode(d)
+                    have = len(walk.values)
+                    if s < nc:
+                        vid = cand[w][s]
+                    elif s == nc:
+                        vid = have
+                        decode_value(d, m, walk, ('corner', k, w, g, i), segmented)
+                    elif s == nc + 1:
+                        back = m.far.decode(d)
+                        if back >= have:
+                            reject('attributes: corner values of %r are invalid' % h.name)
+                        vid = have - 1 - back
+                    else:
+                        reject('attributes: corner values of %r are invalid' % h.name)
+                    indices[k] = vid
+                    if s >= nc and nc < 4 and vid not in cand[w]:
+                        cand[w].append(vid)
+                if pr == 2 and len(f) >= 3:
+                    o = walk.face_offsets[g]
+                    walk.update_sigma([walk.values[indices[o + i]] for i in range(len(f))])
+            U = m.unused.decode(d)
+            if U == INVALID or U > 730 * (len(coded) + 8):
+                reject('attributes: corner values of %r are invalid' % h.name)
+            for _ in range(U):
+                decode_value(d, m, walk, ('unused',))
+        if d.truncated():
+            reject('attributes: stream is truncated')
+        out.append({'header': h, 'predictor': pr, 'ints': walk.values, 'indices': indices, 'alias': alias,
+                    'values': [attribute_value(h, x) for x in walk.values]})
+    return out
+
+
+def join_attributes(parts):
+    """§8.12 "Joining parts": parts = per part the list decode_attributes gave
+    (dicts: header, ints, values, indices, alias). Vertex and face values are
+    concatenated; corner value lists too, except the values that stand for an
+    earlier segment's value (alias): those are dropped and their corners use
+    that value; each part's other values take the next ids."""
+    joined = None
+    for part in parts:
+        if joined is None:
+            for a in part:
+                if a['alias'] is not None and any(x is not None for x in a['alias']):
+                    reject('the first segment names values of segments before it')
+            joined = [dict(a, ints=list(a['ints']), values=list(a['values']), alias=None,
+                           indices=None if a['indices'] is None else list(a['indices'])) for a in part]
+            continue
+        if len(part) != len(joined) or any(j['header'].description() != a['header'].description()
+                                           for j, a in zip(joined, part)):
+            reject('the segments disagree on the attributes they carry')
+        for j, a in zip(joined, part):
+            if a['indices'] is None:
+                j['ints'].extend(a['ints'])
+                j['values'].extend(a['values'])
+                continue
+            base = len(j['values'])
+            ids = []
+            for x, (ints, val, al) in enumerate(zip(a['ints'], a['values'], a['alias'])):
+                if al is None:
+                    ids.append(len(j['values']))
+                    j['ints'].append(ints)
+                    j['values'].append(val)
+                elif al < base:
+                    ids.append(al)
+                else:
+                    reject('attributes: %r: a value names value %d of the segments before, which hold %d'
+                           % (a['header'].name, al, base))
+            j['indices'].extend(ids[i] for i in a['indices'])
+    return joined or []
+
+
+# ---------------------------------------------------------------- §4.6 metadata
+
+def read_metadata(payload):
+    """§4.6 layout checks. Returns the entries as (key, value) byte strings."""
+    n = len(payload)
+    count, p = read_varint(payload, 0, n)
+    if count > (n - p) // 3:
+        reject('metadata: bad entry count')
+    entries = []
+    for i in range(count):
+        if p >= n:
+            reject('metadata: entry %d is truncated' % i)
+        kl = payload[p]
+        p += 1
+        if kl == 0 or kl > n - p:
+            reject('metadata: entry %d is truncated or has an empty key' % i)
+        key = bytes(payload[p:p + kl])
+        p += kl
+        vl, p = read_varint(payload, p, n)
+        if vl > n - p:
+            reject('metadata: entry %d is truncated' % i)
+        entries.append((key, bytes(payload[p:p + vl])))
+        p += vl
+    if p != n:
+        reject('metadata: %d bytes after the last entry' % (n - p))
+    if len(set(k for k, _ in entries)) != len(entries):
+        reject('metadata: a key appears twice')
+    return entries
+
 # ---------------------------------------------------------------- §5 dequantization, §9 payload
 
 def f32(x):
@@ -1175,11 +1751,11 @@ def f32(x):
 
 
 def decode_part(streams, counts, bits, earlier, trace):
-    """Steps 26-30 for the whole mesh or one segment (§4.5, §8.11). Returns
+    """Steps 26-31 for the whole mesh or one segment (§4.5, §8.11, §8.12). Returns
     faces (part-local ids), q (per own vertex), glob (per part vertex: the
-    output id of a reference, NONE for an own vertex), info."""
+    output id of a reference, NONE for an own vertex), info, attributes (§8.12)."""
     vc, fc, cc, rc = counts
-    s3, s4, s5, sr, s6 = streams
+    s3, s4, s5, sr, s6, sa = streams
     if not (vc < 0x3FFFFFFF and cc < 0x3FFFFFFF and fc <= cc):
         reject('counts')                                             # step 26
     if rc > vc:
@@ -1236,7 +1812,8 @@ def decode_part(streams, counts, bits, earlier, trace):
         layout = own
     q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 30
     info.update(ginfo)
-    return faces, q, glob, info
+    attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 31
+    return faces, q, glob, info, attrs
 
 
 def decode(data, trace=None):
@@ -1248,7 +1825,7 @@ def decode(data, trace=None):
                 reject('connectivity section missing')               # step 27
         if 6 not in sections:
             reject('geometry section missing')                       # step 28
-        parts = [((sections[3], sections[4], sections[5], None, sections[6]), (vc, fc, cc, 0))]
+        parts = [((sections[3], sections[4], sections[5], None, sections[6], sections.get(8, b'')), (vc, fc, cc, 0))]
     else:                                                            # §4.5
         parts = []
         for body in sections[7]:
@@ -1264,7 +1841,7 @@ def decode(data, trace=None):
                     reject('segment stream length')
                 streams.append(body[p:p + n])
                 p += n
-            # the rest is the segment's attribute stream (§8.12), not decoded here
+            streams.append(body[p:])       # the rest: the segment's attribute payload (§8.12)
             if counts[3] > counts[0]:
                 reject('segment references')
             parts.append((tuple(streams), counts))
@@ -1275,8 +1852,10 @@ def decode(data, trace=None):
             reject('segment sums')
     faces, q = [], []
     info = None
+    part_attrs = []
     for streams, counts in parts:
-        pf, pq, glob, pinfo = decode_part(streams, counts, h['bits'], len(q), trace)
+        pf, pq, glob, pinfo, pattrs = decode_part(streams, counts, h['bits'], len(q), trace)
+        part_attrs.append(pattrs)
         base = len(q)
         out_id = []
         own = 0
@@ -1294,6 +1873,9 @@ def decode(data, trace=None):
             for k in ('components', 'jump_edges', 'virtual', 'stitches', 'side_faces', 'polygons'):
                 info[k] += pinfo[k]
     info['segments'] = len(parts)
+    attrs = join_attributes(part_attrs)                              # step 31, §8.12
+    info['metadata'] = read_metadata(sections[9]) if sections.get(9) is not None else None   # step 32, §4.6
+    info['metadata_skipped'] = 9 in sections and sections[9] is None  # zstd-coded, no zstandard module
     step = h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
     positions = []
     for v in range(vc):
@@ -1303,7 +1885,7 @@ def decode(data, trace=None):
             x = min(max(x, -FLT_MAX), FLT_MAX)
             pt.append(f32(x))
         positions.append(pt)
-    return h, faces, q, positions, info
+    return h, faces, q, positions, info, attrs
 
 
 # ---------------------------------------------------------------- comparison with `tsm decode` output
@@ -1376,6 +1958,219 @@ def bits32(x):
     return struct.unpack('<I', struct.pack('<f', x))[0]
 
 
+# ---------------------------------------------------------------- output as `tsm decode` writes it
+
+class CannotWrite(Exception):
+    pass
+
+
+PLY_TYPE = {0: (b'float', '<f'), 1: (b'uchar', '<B'), 2: (b'ushort', '<H'), 3: (b'int', '<i')}
+TYPE_RANGE = {1: (0, 255), 2: (0, 65535), 3: (-2147483648, 2147483647)}
+
+
+def ply_scalar(h, x):
+    return x if h.type == 0 else int(x)
+
+
+def ply_bytes(positions, faces, attrs):
+    """The binary PLY `tsm decode FILE.tsm -o OUT.ply` writes (io_ply.cpp,
+    write_ply): positions as float x y z, faces as 'list uchar uint
+    vertex_indices' ('list uint uint' when a face has more than 255 corners),
+    then the attributes: vertex and face ones as scalar properties of their
+    element (the first normal / colour / texcoord of a domain as nx ny nz /
+    red green blue [alpha] / s t, others NAME or NAME_0 .. NAME_k-1), corner
+    ones as face list properties after the face scalars ('texcoord', 'normal',
+    'color' for the first of each kind, else the name) holding each corner's
+    value; property types uchar / ushort / int / float by attribute type."""
+    vnames = [b'x', b'y', b'z']
+    fnames = [b'vertex_indices']
+    first_done = set()
+    vprops, fprops, cprops = [], [], []          # header lines
+    vcols, fcols, clists = [], [], []            # (attribute, component) / (attribute, wide)
+    for k, a in enumerate(attrs):
+        h = a['header']
+        if h.type != 0:
+            lo, hi = TYPE_RANGE[h.type]
+            for i, val in enumerate(a['values']):
+                for x in val:
+                    if not (lo <= x <= hi) or x != math.floor(x):
+                        raise CannotWrite('attribute %d (%r): value %s does not fit type %s'
+                                          % (k, h.name, x, PLY_TYPE[h.type][0].decode()))
+        conventional = h.kind != 0 and (h.domain, h.kind) not in first_done
+        if conventional:
+            first_done.add((h.domain, h.kind))
+        if h.domain == 2:
+            names = [h.name if not conventional else {3: b'texcoord', 1: b'normal', 2: b'color'}[h.kind]]
+        elif conventional and h.kind == 1:
+            names = [b'nx', b'ny', b'nz']
+        elif conventional and h.kind == 2:
+            names = [b'red', b'green', b'blue'] + ([b'alpha'] if h.components == 4 else [])
+        elif conventional and h.kind == 3:
+            names = [b's', b't']
+        elif h.components == 1:
+            names = [h.name]
+        else:
+            names = [h.name + b'_' + str(c).encode() for c in range(h.components)]
+        used = vnames if h.domain == 0 else fnames
+        for n in names:
+            if not n or any(c <= 0x20 or c >= 0x7f for c in n):
+                raise CannotWrite('attribute %d (%r): not a PLY property name' % (k, h.name))
+            if n in used:
+                raise CannotWrite('attribute %d (%r): property %r taken' % (k, h.name, n))
+            used.append(n)
+        tname = PLY_TYPE[h.type][0]
+        if h.domain == 2:
+            wide = max([len(f) * h.components for f in faces] + [0]) > 255
+            clists.append((a, wide))
+            cprops.append(b'property list ' + (b'uint ' if wide else b'uchar ') + tname + b' ' + names[0] + b'\n')
+        else:
+            for c in range(h.components):
+                (vcols if h.domain == 0 else fcols).append((a, c))
+                (vprops if h.domain == 0 else fprops).append(b'property ' + tname + b' ' + names[c] + b'\n')
+    wide_count = max([len(f) for f in faces] + [0]) > 255
+    out = [b'ply\nformat binary_little_endian 1.0\ncomment written by tsm\n',
+           b'element vertex %d\n' % len(positions), b'property float x\nproperty float y\nproperty float z\n']
+    out += vprops
+    out.append(b'element face %d\n' % len(faces))
+    out.append(b'property list uint uint vertex_indices\n' if wide_count
+               else b'property list uchar uint vertex_indices\n')
+    out += fprops + cprops
+    out.append(b'end_header\n')
+    vfmt = '<3f' + ''.join(PLY_TYPE[a['header'].type][1][1] for a, _ in vcols)
+    for v, pt in enumerate(positions):
+        out.append(struct.pack(vfmt, *pt, *[ply_scalar(a['header'], a['values'][v][c]) for a, c in vcols]))
+    corner = 0
+    for fi, f in enumerate(faces):
+        n = len(f)
+        out.append(struct.pack('<I' if wide_count else '<B', n))
+        out.append(struct.pack('<%dI' % n, *f))
+        for a, c in fcols:
+            out.append(struct.pack(PLY_TYPE[a['header'].type][1], ply_scalar(a['header'], a['values'][fi][c])))
+        for a, wide in clists:
+            h = a['header']
+            out.append(struct.pack('<I' if wide else '<B', n * h.components))
+            t = PLY_TYPE[h.type][1][1]
+            vals = []
+            for j in range(n):
+                vals.extend(ply_scalar(h, x) for x in a['values'][a['indices'][corner + j]])
+            out.append(struct.pack('<%d%s' % (len(vals), t), *vals))
+        corner += n
+    return b''.join(out)
+
+
+def parse_f32(s):
+    """The binary32 nearest to decimal text s (ties to even), as std::from_chars
+    gives it: float() then f32 could round twice, so check the neighbours exactly."""
+    x = f32(float(s))
+    if not math.isfinite(x) or x == 0:
+        return x                     # keeps the sign of a zero
+    from fractions import Fraction
+    exact = Fraction(s)
+    u = bits32(x)
+    key = u if u < 0x80000000 else -(u & 0x7FFFFFFF)
+    best = None
+    for k in (key - 1, key, key + 1):
+        b = k if k >= 0 else (0x80000000 | -k)
+        if b & 0x7F800000 == 0x7F800000:
+            continue
+        y = struct.unpack('<f', struct.pack('<I', b))[0]
+        dist = abs(Fraction(y) - exact)
+        cand = (dist, b & 1, y)
+        if best is None or cand < best:
+            best = cand
+    return best[2]
+
+
+def compare_obj(path, positions, faces, attrs):
+    """Compares with `tsm decode FILE.tsm -o OUT.obj` (io_obj.cpp, write_obj): the
+    first texcoord attribute (or a 3-component generic 'texcoord3') as the vt
+    list, the first normal as the vn list, with the value list and the index of
+    every corner (a vertex-domain one indexed by the vertex, a face-domain one by
+    the face), the first vertex colour as v x y z r g b (u8 / u16 scaled to 0..1).
+    Every float is compared by its bits. Returns a list of differences."""
+    tex = nrm = col = None
+    for a in attrs:
+        if tex is None and a['header'].kind == 3:
+            tex = a
+    for a in attrs:
+        h = a['header']
+        if tex is None and h.kind == 0 and h.name == b'texcoord3' and h.components == 3:
+            tex = a
+    for a in attrs:
+        h = a['header']
+        if nrm is None and h.kind == 1:
+            nrm = a
+        if col is None and h.kind == 2 and h.domain == 0:
+            col = a
+    V, VT, VN, F = [], [], [], []
+    for line in open(path, 'rb').read().decode('ascii').splitlines():
+        w = line.split()
+        if not w or w[0].startswith('#'):
+            continue
+        if w[0] in ('v', 'vt', 'vn'):
+            {'v': V, 'vt': VT, 'vn': VN}[w[0]].append([parse_f32(t) for t in w[1:]])
+        elif w[0] == 'f':
+            F.append([[int(x) if x else None for x in t.split('/')] for t in w[1:]])
+    diffs = []
+    scale = 1.0
+    if col is not None and col['header'].type in (1, 2):
+        scale = 255.0 if col['header'].type == 1 else 65535.0
+    exp_v = []
+    for v, pt in enumerate(positions):
+        row = list(pt)
+        if col is not None:
+            row += [x if scale == 1.0 else f32(x / scale) for x in col['values'][v][:3]]
+        exp_v.append(row)
+
+    def same_list(name, got, want):
+        if len(got) != len(want):
+            diffs.append('%s: %d entries vs %d' % (name, len(want), len(got)))
+            return
+        for i, (g, e) in enumerate(zip(got, want)):
+            if [bits32(x) for x in g] != [bits32(x) for x in e]:
+                diffs.append('%s %d: %s vs %s' % (name, i, e, g))
+                return
+    same_list('v', V, exp_v)
+    same_list('vt', VT, tex['values'] if tex else [])
+    same_list('vn', VN, nrm['values'] if nrm else [])
+
+    def ref(a, c, f, v):
+        d = a['header'].domain
+        return v + 1 if d == 0 else f + 1 if d == 1 else a['indices'][c] + 1
+    exp_f = []
+    c = 0
+    for fi, f in enumerate(faces):
+        row = []
+        for v in f:
+            t = [v + 1]
+            if tex or nrm:
+                t.append(ref(tex, c, fi, v) if tex else None)
+                if nrm:
+                    t.append(ref(nrm, c, fi, v))
+            row.append(t)
+            c += 1
+        exp_f.append(row)
+    if F != exp_f:
+        bad = next(i for i in range(min(len(F), len(exp_f)) + 1) if i >= min(len(F), len(exp_f)) or F[i] != exp_f[i])
+        diffs.append('f: %d faces vs %d, first difference at face %d' % (len(exp_f), len(F), bad))
+    return diffs
+
+
+def dump_attributes(attrs):
+    for k, a in enumerate(attrs):
+        h = a['header']
+        print('  attribute %d: %r kind %s domain %s type %s components %d quant %d bits %d%s predictor %d, '
+              '%d values%s' % (k, h.name, KIND_NAMES[h.kind], DOMAIN_NAMES[h.domain], TYPE_NAMES[h.type],
+                               h.components, h.quant, h.bits,
+                               (' origin %s extent %r' % (h.origin, h.extent)) if h.quant == 1 else '',
+                               a.get('predictor', 0), len(a['values']),
+                               ', %d corners' % len(a['indices']) if a['indices'] is not None else ''))
+        for i, (x, val) in enumerate(zip(a['ints'], a['values'])):
+            print('    value %d: ints %s = %s' % (i, x, ' '.join(float(y).hex() for y in val)))
+        if a['indices'] is not None:
+            print('    indices: %s' % ' '.join(map(str, a['indices'])))
+
+
 def main(argv):
     if len(argv) < 2:
         print(__doc__)
@@ -1383,7 +2178,7 @@ def main(argv):
     path = argv[1]
     trace = [] if '--trace' in argv else None
     try:
-        h, faces, q, positions, info = decode(open(path, 'rb').read(), trace)
+        h, faces, q, positions, info, attrs = decode(open(path, 'rb').read(), trace)
     except Corrupt as e:
         print('%s: corrupt_data: %s' % (path, e))
         return 2
@@ -1392,13 +2187,20 @@ def main(argv):
         return 2
     print('%s: %d vertices, %d faces, q=%d; predictor %s%s, lattice planes %s (%d coordinates on planes), '
           '%d vertices on no triangle (%d anchored), geometry overrun %d; '
-          'components %d, jump edges %d, virtual %d, stitches %d, side faces %d, polygons %d, segments %d' % (
+          'components %d, jump edges %d, virtual %d, stitches %d, side faces %d, polygons %d, segments %d; '
+          'attributes %s; metadata %s' % (
               path, len(q), len(faces), h['bits'], info['predictor'],
               (' K=%d lambda=%s' % (info['K'], info['lambda'])) if info['predictor'] == 'ancestors'
               else ' alpha=%s' % info['alpha'],
               info['lattice_planes'], info['on_plane'], info['no_triangle'], info['anchored'], info['overrun'],
               info['components'], info['jump_edges'], info['virtual'],
-              info['stitches'], info['side_faces'], info['polygons'], info['segments']))
+              info['stitches'], info['side_faces'], info['polygons'], info['segments'],
+              ', '.join('%s (%s %s)' % (a['header'].name.decode('utf-8', 'replace'), DOMAIN_NAMES[a['header'].domain],
+                                        KIND_NAMES[a['header'].kind]) for a in attrs) or 'none',
+              'zstd-coded, not checked (no zstandard module)' if info['metadata_skipped'] else
+              'none' if info['metadata'] is None else
+              '%d entries (%s)' % (len(info['metadata']), ', '.join('%r: %d bytes' % (k, len(v))
+                                                                     for k, v in info['metadata']))))
     if trace is not None:
         for line in trace:
             print('  ' + line)
@@ -1407,26 +2209,52 @@ def main(argv):
             print('  face %d: %s' % (i, f))
         for v in range(len(q)):
             print('  vertex %d: q=%s pos=%s' % (v, q[v], ['%.9g' % x for x in positions[v]]))
+    if '--dump-attributes' in argv or '--dump' in argv:
+        dump_attributes(attrs)
+    status = 0
+    ply = None
+    if '--write-ply' in argv or '--compare' in argv:
+        try:
+            ply = ply_bytes(positions, faces, attrs)
+        except CannotWrite as e:
+            print('cannot write PLY: %s' % e)
+            return 1
+    if '--write-ply' in argv:
+        open(argv[argv.index('--write-ply') + 1], 'wb').write(ply)
     if '--compare' in argv:
         ref = argv[argv.index('--compare') + 1]
-        verts, rfaces = read_ply(ref)
-        ok = True
-        if len(verts) != len(positions):
-            print('vertex count differs: %d vs %d' % (len(positions), len(verts)))
-            ok = False
+        data = open(ref, 'rb').read()
+        if b'format ascii' in data[:data.find(b'end_header')]:
+            # ASCII PLY: positions and faces only (the attributes are compared on binary PLY)
+            verts, rfaces = read_ply(ref)
+            ok = len(verts) == len(positions) and all(
+                [bits32(x) for x in verts[v]] == [bits32(x) for x in positions[v]] for v in range(len(verts))) \
+                and [list(f) for f in rfaces] == faces
+            what = 'ASCII PLY, positions and faces'
         else:
-            bad = [v for v in range(len(verts))
-                   if [bits32(x) for x in verts[v]] != [bits32(x) for x in positions[v]]]
-            if bad:
-                print('%d vertices differ, first %d: %s vs %s' % (len(bad), bad[0], positions[bad[0]], verts[bad[0]]))
-                ok = False
-        if [list(f) for f in rfaces] != faces:
-            print('faces differ (%d vs %d faces)' % (len(faces), len(rfaces)))
-            ok = False
-        print('compare with %s: %s (%d vertices, %d faces)' % (ref, 'IDENTICAL' if ok else 'DIFFERENT',
-                                                              len(verts), len(rfaces)))
-        return 0 if ok else 1
-    return 0
+            ok = data == ply
+            what = 'binary PLY, byte for byte'
+            if not ok:
+                hd = ply.find(b'end_header')
+                if data[:data.find(b'end_header')] != ply[:hd]:
+                    print('headers differ:\n--- reference_decoder.py\n%s--- %s\n%s' % (
+                        ply[:hd].decode('ascii', 'replace'), ref,
+                        data[:data.find(b'end_header')].decode('ascii', 'replace')))
+                else:
+                    k = next((i for i in range(min(len(data), len(ply))) if data[i] != ply[i]), min(len(data), len(ply)))
+                    print('first differing byte at offset %d (body offset %d); sizes %d vs %d' % (
+                        k, k - hd - len(b'end_header\n'), len(ply), len(data)))
+        print('compare with %s (%s): %s (%d vertices, %d faces, %d attributes)' % (
+            ref, what, 'IDENTICAL' if ok else 'DIFFERENT', len(positions), len(faces), len(attrs)))
+        status = status or (0 if ok else 1)
+    if '--compare-obj' in argv:
+        ref = argv[argv.index('--compare-obj') + 1]
+        diffs = compare_obj(ref, positions, faces, attrs)
+        for d in diffs:
+            print('  ' + d)
+        print('compare with %s (OBJ: v, vt, vn lists and f indices): %s' % (ref, 'DIFFERENT' if diffs else 'IDENTICAL'))
+        status = status or (1 if diffs else 0)
+    return status
 
 
 if __name__ == '__main__':

@@ -12,10 +12,26 @@
                 vertex lies on a grid edge, so many coordinates share voxel planes
                 (the geometry lattice), plus an isolated vertex
 
+  attributes.obj  mixed(12, 20) with vertex colours, corner `vt u v w` (a
+                3-component generic 'texcoord3') and corner `vn` with seams,
+                shared and unused values
+  attributes.ply  mixed(12, 20) with vertex, face and corner attributes of
+                every kind and type
+  uv_vertex.ply   curved surfaces with per-vertex texture coordinates (s t) in
+                smooth charts, one mirrored: predictor 2 in the vertex domain
+  uv_corner.obj   a UV sphere, a torus and a box with corner texture
+                coordinates (vt u v) in charts with seams, some mirrored:
+                predictor 2 in the corner domain (segmented: values shared
+                across segment borders)
+
 Usage: test_meshes.py DIR
+       test_meshes.py --add-metadata SRC.tsm DST.tsm KEY=VALUE ...
+       test_meshes.py --add-metadata SRC.tsm DST.tsm --raw HEX   (a malformed payload)
+         (with --zstd: the section zstd-coded, by the zstd command)
 """
 import math
 import os
+import struct
 import sys
 
 
@@ -143,13 +159,357 @@ def lattice():
     return V, F
 
 
+
+def unit(x, y, z):
+    n = math.sqrt(x * x + y * y + z * z)
+    return (x / n, y / n, z / n) if n > 0 else (0.0, 0.0, 1.0)
+
+
+def face_normal(V, fa):
+    (ax, ay, az), (bx, by, bz), (cx, cy, cz) = V[fa[0]], V[fa[1]], V[fa[-1]]
+    u, w = (bx - ax, by - ay, bz - az), (cx - ax, cy - ay, cz - az)
+    return unit(u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0])
+
+
+def attr_obj(path, V, F):
+    """mixed() with v colours (a vertex colour), `vt u v w` with w != 0 (a
+    3-component generic corner attribute 'texcoord3', grid-quantized) and `vn`
+    (a corner normal, octahedral): values shared by the corners of a vertex,
+    seams (several values at a vertex, more than 4 at the poles), values shared
+    by far-apart corners (the hexagon, the torus quads' face normals) and
+    values no corner uses."""
+    VT, VN = [], []
+
+    def vt(u, v, w=0.5):
+        VT.append((u, v, w))
+        return len(VT)
+
+    def vn(x, y, z):
+        VN.append(unit(x, y, z))
+        return len(VN)
+    vt(0.9, 0.9)                                           # unused
+    vn(1, 1, 1)                                            # unused
+    base_t = [vt(0.5 + 0.3 * x, 0.5 + 0.3 * y, 0.25 + 0.1 * z) for x, y, z in V]
+    base_n = [vn(*p) for p in V]
+    seam_t = {}
+    hex_t = vt(0.1, 0.2, 0.3)
+    pole_t = [vt(0.05 * k, 1.0, 0.75) for k in range(7)]
+    vt(0.7, 0.1, 0.9)                                      # unused
+    vn(0, 0, -1)                                           # unused
+    face_n = {}
+    lines = []
+    for i, (x, y, z) in enumerate(V):
+        lines.append('v %.6f %.6f %.6f %.4f %.4f %.4f\n' % (x, y, z, (x + 3) / 6, (y + 3) / 6, (z + 2) / 4))
+    for fi, fa in enumerate(F):
+        corners = []
+        for k, c in enumerate(fa):
+            if len(fa) == 6:
+                t = hex_t                                  # one value, six vertices
+            elif c == 0:
+                t = pole_t[fi % 7]                         # 7 values at the north pole
+            elif fi % 9 == 0:
+                if c not in seam_t:
+                    x, y, z = V[c]
+                    seam_t[c] = vt(0.4 - 0.2 * x, 0.6 + 0.2 * y, 0.5)
+                t = seam_t[c]                              # a seam: a second value at c
+            else:
+                t = base_t[c]
+            if len(fa) == 4:
+                if fi not in face_n:
+                    face_n[fi] = vn(*face_normal(V, fa))
+                n = face_n[fi]                             # flat quads: a crease at every edge
+            else:
+                n = base_n[c]
+            corners.append('%d/%d/%d' % (c + 1, t, n))
+        lines.append('f ' + ' '.join(corners) + '\n')
+    with open(path, 'w') as f:
+        f.write('# test mesh for reference_decoder.py: corner and vertex attributes\n')
+        f.writelines(lines[:len(V)])
+        f.writelines('vt %.6f %.6f %.6f\n' % t for t in VT)
+        f.writelines('vn %.6f %.6f %.6f\n' % n for n in VN)
+        f.writelines(lines[len(V):])
+
+
+def attr_ply(path, V, F):
+    """mixed() as ASCII PLY with attributes of every domain and type: vertex
+    normal (nx ny nz), colour (uchar RGBA), generic float, a 3-component
+    generic (w_0 w_1 w_2), ushort and int generics; face colour (uchar RGB),
+    face normal (nx ny nz), float and int generics; per-corner lists: a normal, a float, a ushort pair."""
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\ncomment test mesh for reference_decoder.py\n')
+        f.write('element vertex %d\n' % len(V))
+        f.write(''.join('property float %s\n' % n for n in ('x', 'y', 'z', 'nx', 'ny', 'nz')))
+        f.write(''.join('property uchar %s\n' % n for n in ('red', 'green', 'blue', 'alpha')))
+        f.write('property float temperature\nproperty float w_0\nproperty float w_1\nproperty float w_2\n')
+        f.write('property ushort label\nproperty int id32\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\n' % len(F))
+        f.write('property float quality\nproperty int group\n')
+        f.write(''.join('property uchar %s\n' % n for n in ('red', 'green', 'blue')))
+        f.write(''.join('property float %s\n' % n for n in ('nx', 'ny', 'nz')))
+        f.write('property list uchar float normal\nproperty list uchar float shade\n')
+        f.write('property list uchar ushort pair\nend_header\n')
+        for i, (x, y, z) in enumerate(V):
+            nx, ny, nz = unit(x, y, z)
+            f.write('%.6f %.6f %.6f %.6f %.6f %.6f %d %d %d %d %.5f %.4f %.4f %.4f %d %d\n' % (
+                x, y, z, nx, ny, nz, int(127 + 120 * nx), int(127 + 120 * ny), int(127 + 120 * nz), 255 - i % 3,
+                20 + 5 * z + 0.01 * i, x * y, y * z, z * x, i // 7, (i * 7919) % 2001 - 1000))
+        for fi, fa in enumerate(F):
+            fn = face_normal(V, fa) if len(set(fa)) >= 3 else (0.0, 0.0, 1.0)
+            rec = ['%d' % len(fa)] + ['%d' % c for c in fa]
+            rec += ['%.3f' % (0.5 + 0.5 * fn[2]), '%d' % (fi // 10 - 5),
+                    '%d %d %d' % (fi % 256, (3 * fi) % 256, 200), '%.6f %.6f %.6f' % fn]
+            rec.append('%d ' % (3 * len(fa)) + ' '.join('%.6f %.6f %.6f' % (fn if fi % 3 else unit(*V[c]))
+                                                         for c in fa))
+            rec.append('%d ' % len(fa) + ' '.join('%.4f' % (0.25 * k + 0.01 * fi) for k in range(len(fa))))
+            rec.append('%d ' % (2 * len(fa)) + ' '.join('%d %d' % (c % 100, fi % 50) for c in fa))
+            f.write(' '.join(rec) + '\n')
+
+
+
+def uv_surfaces():
+    """Curved surfaces with smooth texture charts (for the texture placement
+    predictor 2 of §8.12): a wavy open cylinder (triangles and some quads), a
+    mirrored copy (the other texture orientation, sigma -1), a sphere cap and an
+    isolated vertex. Returns V, F, UV (per vertex), chart (per vertex)."""
+    V, F, UV = [], [], []
+
+    def v(p, uv):
+        V.append(p)
+        UV.append(uv)
+        return len(V) - 1
+    for mirror in (0, 1):
+        N, M = 36, 14
+        g = {}
+        for i in range(N + 1):
+            th = 1.5 * math.pi * i / N
+            for j in range(M + 1):
+                z = 2.0 * j / M
+                r = 1 + 0.12 * math.sin(3 * th) * math.cos(1.7 * z)
+                s = 0.05 + 0.9 * i / N + 0.02 * math.sin(2.3 * z)
+                t = 0.05 + 0.45 * j / M + 0.01 * math.cos(2 * th)
+                if mirror:
+                    s = 1 - s
+                    t += 0.5
+                g[i, j] = v((r * math.cos(th) + 3 * mirror, r * math.sin(th), z), (s, t))
+        for i in range(N):
+            for j in range(M):
+                a, b, c, d = g[i, j], g[i + 1, j], g[i + 1, j + 1], g[i, j + 1]
+                if (i + 2 * j) % 7 == 0:
+                    F.append([a, b, c, d])                 # a quad: both sides of a polygon
+                elif (i + j) % 2:
+                    F += [[a, b, c], [a, c, d]]
+                else:
+                    F += [[a, b, d], [b, c, d]]
+    n_, m_ = 8, 16                                         # a sphere cap
+    top = v((0, 0, 4), (0.5, 0.5))
+    ring = {}
+    for i in range(1, n_ + 1):
+        th = 0.6 * math.pi * i / n_
+        for j in range(m_):
+            ph = 2 * math.pi * j / m_
+            rr = 0.45 * i / n_
+            ring[i, j] = v((math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), 3 + math.cos(th)),
+                           (0.5 + rr * math.cos(ph), 0.5 + rr * math.sin(ph)))
+    for j in range(m_):
+        F.append([top, ring[1, j], ring[1, (j + 1) % m_]])
+    for i in range(1, n_):
+        for j in range(m_):
+            F += [[ring[i, j], ring[i + 1, j], ring[i + 1, (j + 1) % m_]],
+                  [ring[i, j], ring[i + 1, (j + 1) % m_], ring[i, (j + 1) % m_]]]
+    v((5, 5, 5), (0.3, 0.7))                               # an isolated vertex
+    return V, F, UV
+
+
+def uv_vertex_ply(path):
+    """uv_surfaces() as ASCII PLY with per-vertex texture coordinates (s t):
+    a vertex-domain texcoord (predictor 2 in the vertex domain)."""
+    V, F, UV = uv_surfaces()
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
+        f.write('property float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
+        for (x, y, z), (s, t) in zip(V, UV):
+            f.write('%.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, s, t))
+        for fa in F:
+            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+
+
+def uv_corner_obj(path):
+    """A UV sphere with a latitude-longitude chart (a seam along one meridian,
+    one value per face at the poles), a torus of quads and triangles (seams
+    both ways), a box with one chart per side (four of them in the other
+    texture orientation) and a jittered height field (two charts, texture
+    coordinates its x, y, one mirrored), as OBJ with corner texture
+    coordinates `vt u v` shared by the corners of a vertex within a chart:
+    predictor 2 in the corner domain; segmented, many values are shared
+    across segment borders (§8.12 imported values)."""
+    V, F, VT = [], [], {}
+    lines = []
+
+    def v(x, y, z):
+        V.append((x, y, z))
+        return len(V) - 1
+
+    def vt(key, u, w):
+        if key not in VT:
+            VT[key] = (len(VT) + 1, u, w)
+        return VT[key][0]
+
+    def face(cs):                                          # cs: (vertex, vt index)
+        F.append(cs)
+    n_, m_ = 14, 24
+    top, bot = v(0, 0, 1), v(0, 0, -1)
+    ring = {}
+    for i in range(1, n_):
+        th = math.pi * i / n_
+        for j in range(m_):
+            ph = 2 * math.pi * j / m_
+            ring[i, j] = v(math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th))
+
+    def st(i, j):                                          # sphere chart: column m_ is the seam's copy
+        return vt(('s', i, j), 0.5 * j / m_, 0.5 * (1 - i / n_))
+    for j in range(m_):
+        face([(top, vt(('top', j), 0.5 * (j + 0.5) / m_, 0.5)), (ring[1, j], st(1, j)),
+              (ring[1, (j + 1) % m_], st(1, j + 1))])
+        face([(ring[n_ - 1, j], st(n_ - 1, j)), (bot, vt(('bot', j), 0.5 * (j + 0.5) / m_, 0.0)),
+              (ring[n_ - 1, (j + 1) % m_], st(n_ - 1, j + 1))])
+    for i in range(1, n_ - 1):
+        for j in range(m_):
+            a, b = (ring[i, j], st(i, j)), (ring[i + 1, j], st(i + 1, j))
+            c, d = (ring[i + 1, (j + 1) % m_], st(i + 1, j + 1)), (ring[i, (j + 1) % m_], st(i, j + 1))
+            if (i * 3 + j) % 5 == 0:
+                face([a, b, c, d])
+            else:
+                face([a, b, c])
+                face([a, c, d])
+    N, M, R, r = 16, 8, 0.9, 0.3                           # a torus
+    idx = {}
+    for i in range(N):
+        for j in range(M):
+            al, be = 2 * math.pi * i / N, 2 * math.pi * j / M
+            idx[i, j] = v(3 + (R + r * math.cos(be)) * math.cos(al), (R + r * math.cos(be)) * math.sin(al),
+                          r * math.sin(be))
+
+    def tt(i, j):
+        return vt(('t', i, j), 0.5 + 0.45 * i / N, 0.05 + 0.4 * j / M)
+    for i in range(N):
+        for j in range(M):
+            q = [(idx[i, j], tt(i, j)), (idx[(i + 1) % N, j], tt(i + 1, j)),
+                 (idx[(i + 1) % N, (j + 1) % M], tt(i + 1, j + 1)), (idx[i, (j + 1) % M], tt(i, j + 1))]
+            if (i + j) % 3 == 0:
+                face(q)
+            else:
+                face(q[:3])
+                face([q[0], q[2], q[3]])
+    K = 4                                                  # a box, 4 x 4 cells per side
+    bv = {}
+
+    def bvert(p):
+        if p not in bv:
+            bv[p] = v(-3 + 0.5 * p[0] / K, 0.5 * p[1] / K, 0.5 * p[2] / K)
+        return bv[p]
+    for side in range(6):
+        ax, sgn_ = side // 2, side % 2
+        u_ax, w_ax = [a for a in range(3) if a != ax]
+        for a in range(K):
+            for b in range(K):
+                corners = []
+                for da, db in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    p = [0, 0, 0]
+                    p[ax] = K * sgn_
+                    p[u_ax], p[w_ax] = a + da, b + db
+                    uu = (a + da) / K if side % 3 else 1 - (a + da) / K      # mirrored on sides 0 and 3
+                    corners.append((bvert(tuple(p)),
+                                    vt(('b', side, a + da, b + db), 0.5 + 0.08 * side + 0.07 * uu,
+                                       0.55 + 0.3 * (b + db) / K)))
+                if sgn_:
+                    corners.reverse()                      # outward orientation
+                if (a + b + side) % 2:
+                    face(corners)
+                else:
+                    face(corners[:3])
+                    face([corners[0], corners[2], corners[3]])
+    G = 24                                                 # a jittered height field, two charts
+    hv, rnd = {}, 12345
+    for i in range(G + 1):
+        for j in range(G + 1):
+            rnd = (rnd * 1103515245 + 12345) % 2 ** 31
+            jx, jy = (rnd % 1000) / 1000 - 0.5, (rnd // 1000 % 1000) / 1000 - 0.5
+            x, y = (i + 0.35 * jx * (0 < i < G)) / G, (j + 0.35 * jy * (0 < j < G)) / G
+            hv[i, j] = (v(x * 2, 3 + y * 2, 0.3 * math.sin(3 * x) * math.cos(2 * y)), x, y)
+
+    def ht(i, j, chart):
+        _, x, y = hv[i, j]
+        return vt(('h', chart, i, j), 0.02 + 0.45 * x if chart == 0 else 0.98 - 0.45 * x, 0.5 + 0.45 * y)
+    for i in range(G):
+        for j in range(G):
+            chart = int(i >= G // 2)
+            q = [(hv[a, b][0], ht(a, b, chart)) for a, b in ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1))]
+            if (i * 7 + j) % 4:
+                face([q[0], q[1], q[3]] if (i + j) % 2 else q[:3])
+                face([q[1], q[2], q[3]] if (i + j) % 2 else [q[0], q[2], q[3]])
+            else:
+                face(q)
+    with open(path, 'w') as f:
+        f.write('# test mesh for reference_decoder.py: corner texture coordinates (predictor 2)\n')
+        f.writelines('v %.6f %.6f %.6f\n' % p for p in V)
+        f.writelines('vt %.6f %.6f\n' % (u, w) for _, u, w in sorted(VT.values()))
+        f.writelines('f ' + ' '.join('%d/%d' % (c + 1, t) for c, t in fa) + '\n' for fa in F)
+
+
+def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
+    """Copies the .tsm file src to dst with a metadata section (id 9, §4.6)
+    inserted after the header checksum, as the reference encoder places it.
+    entries: (key, value) byte strings; raw_payload: the payload as given (for
+    malformed sections); zstd: store it zstd-coded (codec 1, by the zstd
+    command), else raw."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from reference_decoder import xxh32, read_varint
+
+    def varint(n):
+        out = bytearray()
+        while True:
+            if n < 0x80:
+                out.append(n)
+                return bytes(out)
+            out.append(0x80 | (n & 0x7F))
+            n >>= 7
+    data = open(src, 'rb').read()
+    hlen, p = read_varint(data, 8, len(data))
+    at = p + hlen + 4
+    if raw_payload is None:
+        raw_payload = varint(len(entries)) + b''.join(
+            bytes([len(k)]) + k + varint(len(v)) + v for k, v in entries)
+    stored = raw_payload
+    if zstd:
+        import subprocess
+        stored = subprocess.run(['zstd', '-q', '-c', '-19'], input=raw_payload, capture_output=True,
+                                check=True).stdout
+    section = (struct.pack('<HB', 9, 1 if zstd else 0) + varint(len(stored)) + varint(len(raw_payload))
+               + struct.pack('<I', xxh32(stored)) + stored)
+    open(dst, 'wb').write(data[:at] + section + data[at:])
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == '--add-metadata':
+        # --add-metadata SRC DST KEY=VALUE ...   or   --add-metadata SRC DST --raw HEX
+        args = sys.argv[4:]
+        zstd = '--zstd' in args
+        args = [a for a in args if a != '--zstd']
+        if args and args[0] == '--raw':
+            add_metadata(sys.argv[2], sys.argv[3], None, bytes.fromhex(args[1]), zstd)
+        else:
+            add_metadata(sys.argv[2], sys.argv[3], [tuple(a.encode().split(b'=', 1)) for a in args], None, zstd)
+        return
     out = sys.argv[1] if len(sys.argv) > 1 else '.'
     os.makedirs(out, exist_ok=True)
     write_obj(os.path.join(out, 'triangle.obj'), [(0, 0, 0), (2, 0, 0), (0, 1, 0.5)], [[0, 1, 2]])
     write_obj(os.path.join(out, 'mixed.obj'), *mixed())
     write_obj(os.path.join(out, 'mixed_small.obj'), *mixed(6, 10))
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
+    attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
+    attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
+    uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
+    uv_corner_obj(os.path.join(out, 'uv_corner.obj'))
 
 
 if __name__ == '__main__':
