@@ -271,3 +271,27 @@ TEST(Connectivity, PolygonDiagonalNeverInTheVertexTree) {
   m.add_face(f4, 3);
   expect_round_trip(m, "pentagon reached through its diagonal", 8, false);
 }
+
+// Found by fuzz_roundtrip (crash-749cac2e, segment 3 of 16 with segments of
+// at most 14 faces), minimized: 8 faces on 5 vertices, a quad (3, 1, 0, 4)
+// among repeated triangles on the edges 0-1 and 0-4. Cut open, the quad's
+// corner 3 is one ring from the root 0 only through the quad's diagonal 3-0,
+// and its two sides 3-1 and 3-4 were both left out by the spiral tree's path
+// rule (their other ends already had two same-ring tree edges). Those left-
+// out edges were tried only after the edges to virtual vertices, so corner 3
+// joined the tree through the virtual vertex closing the hole along its two
+// sides: the encoder wrote a virtual vertex with a child, which the decoder
+// refuses (FORMAT.md §8.7: "a virtual vertex has children"). Left-out
+// same-ring edges now come before any edge to a virtual vertex. (The old
+// encoder's output for this mesh is tests/regressions/
+// encoder-virtual-vertex-with-children.bin, which decoders must refuse.)
+TEST(Connectivity, VirtualVertexNeverInsideTheVertexTree) {
+  Mesh m;
+  for (uint32_t i = 0; i < 5; ++i)
+    m.add_vertex(static_cast<float>(i % 7), static_cast<float>(i * 3 % 11), static_cast<float>(i * 5 % 13));
+  const uint32_t tris[][3] = {{4, 0, 2}, {2, 0, 1}, {2, 0, 4}, {4, 0, 1}, {2, 1, 0}, {4, 1, 0}, {4, 0, 1}};
+  for (const auto& t : tris) m.add_triangle(t[0], t[1], t[2]);
+  const uint32_t quad[] = {3, 1, 0, 4};
+  m.add_face(quad, 4);
+  expect_round_trip(m, "quad corner reached only through its diagonal or a virtual vertex", 14, false);
+}

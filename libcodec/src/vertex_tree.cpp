@@ -3,8 +3,9 @@
 // the edges with the root's reference edge first, then the same-ring edges,
 // inner rings before outer, each vertex taking at most two of them (so a
 // ring becomes paths, not branching trees), then the ring-to-ring edges,
-// those that join path ends first, then edges to virtual vertices (which so
-// become leaves), polygon diagonals last (so they are never cut). Rings are
+// those that join path ends first, then the same-ring edges the path rule
+// left out, then edges to virtual vertices (which so become leaves), polygon
+// diagonals last (so they are never cut). Rings are
 // paths joined by single edges: a spiral with few, long runs. The tree is linearized in pre-order with the children of a node in
 // clockwise order starting from the edge to its parent.
 #include <algorithm>
@@ -172,20 +173,26 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     if (ex != ey) return ex < ey;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
   });
+  // Before any edge to a virtual vertex or polygon diagonal: the same-ring
+  // edges the path rule left out. The real vertices of a component are
+  // connected without those two kinds of edges (a polygon's corners by its
+  // sides, a hole's by its border), so with them the real vertices form one
+  // tree first: a virtual vertex then joins it by a single edge, as a leaf
+  // (the decoder refuses a virtual vertex with children, FORMAT.md §8.7),
+  // and a diagonal never joins it (it would be cut and split its polygon).
   bool retried = false;
+  auto retry_skipped = [&] {
+    retried = true;
+    for (uint32_t h : skipped)
+      if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
+  };
   for (; i < edges.size(); ++i) {
     const Edge& e = edges[i];
-    if (!retried && (e.key >> 60) >= 4) {
-      // Before any polygon diagonal: the same-ring edges the path rule left
-      // out, so that a diagonal joins the tree only when nothing else can
-      // (a diagonal in the tree would be cut and split its polygon).
-      retried = true;
-      for (uint32_t h : skipped)
-        if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
-    }
+    if (!retried && (e.key >> 60) >= 3) retry_skipped();
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
   }
+  if (!retried) retry_skipped();
 
   // Pre-order, children clockwise from the parent edge (from the reference
   // half-edge at a root, which itself comes first).
