@@ -34,7 +34,10 @@ corpus=${CORPUS:-$here/../../shared/corpus}
 dec=$here/reference_decoder.py
 failed=""
 cases=0
-python3 "$here/test_meshes.py" "$work" || exit 1
+# Debian's python3 (where setup.sh installs python3-zstandard) when present,
+# else whatever python3 is first on PATH; PYTHON overrides.
+PY=${PYTHON:-$( [ -x /usr/bin/python3 ] && echo /usr/bin/python3 || echo python3 )}
+"$PY" "$here/test_meshes.py" "$work" || exit 1
 
 result() {  # name status
   cases=$((cases + 1))
@@ -45,7 +48,7 @@ encode() {  # name mesh q level [segment_faces]
 }
 check() {  # name mesh q level [segment_faces]: positions, faces and attributes through PLY
   if encode "$@" && "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet; then
-    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
+    "$PY" "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
     st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
   else
     echo "$1: tsm failed"; result "$1" 1
@@ -54,7 +57,7 @@ check() {  # name mesh q level [segment_faces]: positions, faces and attributes 
 acheck() {  # the same, and the corner value lists through OBJ
   if encode "$@" && "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet &&
      "$tsm" decode "$work/$1.tsm" -o "$work/$1.obj" -f --quiet; then
-    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" --compare-obj "$work/$1.obj" > "$work/$1.txt"
+    "$PY" "$dec" "$work/$1.tsm" --compare "$work/$1.ply" --compare-obj "$work/$1.obj" > "$work/$1.txt"
     st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
   else
     echo "$1: tsm failed"; result "$1" 1
@@ -62,14 +65,14 @@ acheck() {  # the same, and the corner value lists through OBJ
 }
 compare_file() {  # name: an existing $work/name.tsm
   if "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet; then
-    python3 "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
+    "$PY" "$dec" "$work/$1.tsm" --compare "$work/$1.ply" > "$work/$1.txt"
     st=$?; result "$1" $st; if [ $st -eq 0 ]; then sed 1d "$work/$1.txt"; else cat "$work/$1.txt"; fi
   else
     echo "$1: tsm decode failed"; result "$1" 1
   fi
 }
 refused() {  # name: both decoders must refuse $work/name.tsm (corrupt_data)
-  out=$(python3 "$dec" "$work/$1.tsm")
+  out=$("$PY" "$dec" "$work/$1.tsm")
   py=$?
   if "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet 2>/dev/null; then cpp=0; else cpp=$?; fi
   if [ $py -eq 2 ] && [ $cpp -ne 0 ]; then
@@ -114,7 +117,7 @@ corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000
 
 # ---- metadata (§4.6)
-meta="python3 $here/test_meshes.py --add-metadata"
+meta="$PY $here/test_meshes.py --add-metadata"
 $meta "$work/attributes_ply_l0.tsm" "$work/metadata.tsm" gltf='{"asset":{"version":"2.0"}}' note=hello empty= &&
   compare_file metadata
 $meta "$work/attributes_ply_segments.tsm" "$work/metadata_segments.tsm" k=v && compare_file metadata_segments

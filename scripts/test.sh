@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite: install, build release and ASan+UBSan, run both, then
+# the format spec's independent Python decoder against the C++ one, then
 # a short smoke run of every libFuzzer target (fuzz/run.sh; clang + libFuzzer
 # are required: without them this fails, it never skips), then the browser
 # test (web/test.sh: emscripten and Chromium from Debian; when they cannot be
@@ -16,6 +17,8 @@ for preset in release asan; do
   echo "== $preset tests"
   ctest --preset "$preset" -j "$jobs"
 done
+echo "== format spec: the independent Python decoder (format-spec/reference_decoder.py) against tsm decode"
+bash format-spec/check_decoder.sh build/release/cli/tsm
 fuzz_seconds=${TSM_FUZZ_SMOKE_SECONDS:-20}
 echo "== fuzz smoke run (${fuzz_seconds} s per target)"
 FUZZ_JOBS=$jobs bash fuzz/run.sh "$fuzz_seconds"
