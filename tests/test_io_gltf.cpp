@@ -364,7 +364,7 @@ TEST(GltfRead, StripsAndFansFollowTheSpecWinding) {
   EXPECT_EQ(info.skipped_elements, 7u);
 }
 
-TEST(GltfRead, SceneMeshesConcatenatedTransformsIgnoredAndDroppedContentNoted) {
+TEST(GltfRead, SceneMeshesConcatenatedTransformsIgnoredAndOtherContentKept) {
   // Mesh 0 (twice, one with a translation), mesh 1 (with a NORMAL and a u8
   // colour), mesh 2 outside the scene; a material, texture, image, sampler.
   Bin b;
@@ -398,7 +398,7 @@ TEST(GltfRead, SceneMeshesConcatenatedTransformsIgnoredAndDroppedContentNoted) {
   ASSERT_TRUE(s.ok()) << s.to_string();
   EXPECT_EQ(m.positions, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 5, 5, 6, 5, 5, 5, 6, 5}));
   EXPECT_EQ(tsm_test::faces_of(m), (tsm_test::Faces{{0, 1, 2}, {3, 4, 5}}));
-  ASSERT_EQ(m.attributes.size(), 2u);
+  ASSERT_EQ(m.attributes.size(), 3u);
   EXPECT_EQ(m.attributes[0].name, "normal");
   EXPECT_EQ(m.attributes[0].values, (std::vector<float>{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
   EXPECT_EQ(m.attributes[1].name, "color");
@@ -406,13 +406,23 @@ TEST(GltfRead, SceneMeshesConcatenatedTransformsIgnoredAndDroppedContentNoted) {
   EXPECT_EQ(m.attributes[1].values,
             (std::vector<float>{255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 255, 1, 2, 3, 4, 5, 6, 7, 8, 9,
                                 10, 11, 12}));
+  // Two vertex groups: the pass-through tag says which vertex is whose
+  // (test_gltf_passthrough.cpp tests the rest of the pass-through).
+  EXPECT_EQ(m.attributes[2].name, "_gltf_group");
+  EXPECT_EQ(m.attributes[2].values, (std::vector<float>{0, 0, 0, 1, 1, 1}));
   EXPECT_TRUE(m.valid());
   for (const char* part : {"read scene 1 of 2", "node transforms not applied", "1 mesh(es) used by several nodes read once",
-                           "1 mesh(es) not in the scene not read", "2 primitives of 2 mesh(es) concatenated",
+                           "1 mesh(es) not in the scene kept as stored", "2 primitives of 2 mesh(es) concatenated",
                            "NORMAL missing in 1 of 2 vertex group(s): filled with zeros",
-                           "COLOR_0 missing in 1 of 2 vertex group(s): filled with opaque white",
-                           "1 material, 1 texture, 1 image, 1 sampler not kept"})
+                           "COLOR_0 missing in 1 of 2 vertex group(s): filled with opaque white"})
     EXPECT_TRUE(contains(info.notes, part));
+  // The material, texture, image and sampler are kept (Mesh::metadata "gltf").
+  EXPECT_FALSE(contains(info.notes, "not kept")) << info.notes;
+  ASSERT_NE(m.find_metadata("gltf"), nullptr);
+  std::string out;
+  ASSERT_TRUE(tsm::write_gltf(m, WriteOptions(), out, false).ok());
+  for (const char* part : {"\"materials\"", "\"baseColorTexture\"", "\"skin.png\"", "\"samplers\""})
+    EXPECT_TRUE(contains(out, part));
 }
 
 TEST(GltfRead, InterleavedStrideSparseAndQuantizedAttributes) {

@@ -1,16 +1,17 @@
 // glTF 2.0 reader and writer (file-format stage, not part of the compression
 // method): .gltf (JSON with data-URI or external buffers) and .glb (binary
 // container) to a tsm::Mesh and back, through Debian's tinygltf (JSON and
-// container parsing, JSON writing) with nlohmann-json. Images are never
-// decoded (no stb): tinygltf is built here without image loading, and image
-// bytes are dropped.
+// container parsing) with nlohmann-json (the pass-through document). Images
+// are never decoded (no stb): tinygltf is built here without image loading;
+// their bytes travel untouched in the pass-through entry (below).
 //
-// Reading
+// Reading: the geometry
 //   - The meshes instanced by the nodes of the default scene (`scene`, else
 //     scene 0; every mesh when the file has no scene), each mesh once however
 //     many nodes use it, in the order the node tree (depth first) meets them.
-//     Node transforms are NOT applied: positions are kept as stored. Several
-//     meshes / primitives are concatenated into one tsm::Mesh (noted).
+//     Node transforms are NOT applied: positions are kept as stored (the
+//     transforms stay in the document). Several meshes / primitives are
+//     concatenated into one tsm::Mesh (noted).
 //   - Triangles (mode 4) as stored, degenerate ones included; strips (5) and
 //     fans (6) become triangles with the winding the spec gives, dropping the
 //     degenerate triangles strips use for stitching (noted). Points and lines
@@ -25,13 +26,69 @@
 //     (float -> f32, unsigned byte / short -> u8 / u16 integers, byte / short
 //     -> i32 integers). Normalized or integer normals and texture
 //     coordinates (KHR_mesh_quantization) become floats as the spec decodes
-//     them. Primitives sharing the same vertex accessors share vertices.
-//     When primitives disagree on attributes, missing values are filled
-//     (zeros; colours opaque white) and differing types widened (noted).
+//     them. Morph targets: each displacement (POSITION / NORMAL / TANGENT of
+//     target t) -> the float vertex attribute "_gltf_target<t>_<SEMANTIC>".
+//     Primitives with the same vertex accessors (attributes and targets)
+//     share vertices: they form one "vertex group". When groups disagree on
+//     attributes, missing values are filled (zeros; colours opaque white) and
+//     differing types widened (noted).
 //   - Indices of any unsigned type; none: 0..n-1.
-//   - Everything else (materials, textures, images, samplers, animations,
-//     skins, cameras, morph targets, extensions) is dropped and listed in
-//     ReadInfo::notes.
+//
+// Reading: everything else (the pass-through entry)
+//   The reader adds Mesh::metadata "gltf", which the codec stores and gives
+//   back unchanged, holding the whole document but the geometry it turned
+//   into mesh data. Its value (version 1, all integers little endian):
+//       "tsmG"  u32 version = 1  u32 J  J bytes of JSON  BIN (the rest)
+//   The JSON (compact, member order of the input, deterministic) is
+//       {"tsm_gltf": 1,
+//        "vertex_groups": [vertex count of group 0, ...],
+//        "face_sets": [[group, triangle count], ...],
+//        "accessors": [fill, ...],
+//        "document": the glTF JSON}
+//   A face set is the triangles of one primitive (a primitive repeating
+//   another one's data shares its face set). The mesh holds group 0's
+//   vertices, then group 1's, ..., and face set 0's triangles, then 1's, ...;
+//   the codec reorders both, so two tags travel as integer attributes: the
+//   vertex attribute "_gltf_group" (u16; i32 past 65536 groups) when there
+//   are two groups or more, and the face attribute "_gltf_primitive" (the
+//   face set) when a group has two face sets or more. Without a tag the
+//   answer is unique (group 0; the only face set of the face's group).
+//   A fill names an accessor of the document the writer fills from the mesh:
+//       {"accessor": i, "group": g, "semantic": "POSITION"}
+//       {"accessor": i, "group": g, "semantic": "NORMAL", "attribute": "normal",
+//        "components": 3}                      (a vertex attribute)
+//       {"accessor": i, "group": g, "semantic": "POSITION", "target": t,
+//        "attribute": "_gltf_target<t>_POSITION", "components": 3}
+//       {"accessor": i, "face_set": k}         (indices)
+//   The document is the input JSON (nlohmann ordered_json, so numbers,
+//   strings, member order, extensions and extras are as given) where:
+//     - accessors keep their indices, so every reference to an accessor
+//       (animations, skins, EXT_mesh_gpu_instancing, extensions tsm does
+//       not know) stays valid. A geometry accessor only the primitives read
+//       use becomes a placeholder (name, extras, extensions kept; data
+//       fields removed) that the writer fills; a second use of it (another
+//       vertex group, a strip's indices) gets a new accessor after the last.
+//       Accessors anything else uses (meshes outside the scene, animation,
+//       skin, instancing data, unused ones) keep their bytes.
+//     - the primitives read name their fills: attributes and targets the
+//       reader kept (ones it did not, e.g. NORMAL as VEC4, are left out of
+//       the primitive, noted), indices, mode 4 for triangles, strips and
+//       fans, mode 0 (points, no indices) for points and lines primitives
+//       and triangle primitives without a triangle; a
+//       KHR_draco_mesh_compression extension is removed (its data is the
+//       mesh's now; Draco-only primitives are refused as before).
+//     - the buffer views still used (by kept accessors, sparse data,
+//       images, Draco data of meshes outside the scene) are copied, in their
+//       order and each at its old offset modulo 4, into one buffer (BIN),
+//       and renumbered; the others are gone. All buffers become that one
+//       buffer (external .bin files and data URIs included); images as data
+//       URIs or external URIs keep their URI.
+//     - extensionsUsed loses EXT_meshopt_compression (its fallback views are
+//       kept uncompressed) and KHR_draco_mesh_compression when no primitive
+//       uses it any more.
+//   Meshes outside the default scene are not mesh data: they are kept with
+//   their bytes in BIN, not compressed by the codec. A mesh used by several
+//   nodes stays one mesh (nodes are untouched).
 //
 // Not read: Draco (KHR_draco_mesh_compression) and meshopt
 // (EXT_meshopt_compression) compressed data, refused with ErrorCode::
@@ -43,20 +100,40 @@
 // JSON nesting depth is bounded (tinygltf walks `extras` recursively), and
 // every accessor (dense and sparse) is checked against its buffer view and
 // buffer before a byte is read: types, strides, offsets, counts, sparse
-// indices, vertex indices. What the primitives produce is bounded by a small
+// indices, vertex indices; every buffer view copied to the pass-through
+// entry likewise. What the primitives produce is bounded by a small
 // multiple of the input's bytes (accessors reused by many primitives cannot
 // blow up memory), and by ReadOptions::max_vertices / max_faces. External
 // buffer files are read only from ReadOptions::external_files_dir (set by
 // read_mesh to the file's folder), only regular files, never otherwise.
 //
-// Writing: one mesh, one primitive, one buffer (GLB: the BIN chunk; .gltf: a
-// base64 data URI). Triangles only: a mesh with other faces is refused
-// (write PLY or OBJ to keep polygons) rather than silently triangulated. A
-// mesh with vertices but no faces is written as a points primitive (which
-// reads back as the same vertices). POSITION with min / max, NORMAL,
-// TEXCOORD_0.. (numbered in order), COLOR_0.. (u8 / u16 colours as
-// normalized unsigned byte / short, padded to 4-byte elements), other
-// vertex attributes as custom `_name` semantics (names that are glTF
+// Writing with a "gltf" entry (a mesh read from glTF, or decoded from a .tsm
+// made from one): the entry's document with the mesh's geometry put back.
+// The vertices of each group in mesh order make its accessors (POSITION
+// with min / max, morph target POSITION too; u8 / u16 integer attributes
+// as unsigned byte / short, normalized for COLOR_n and WEIGHTS_n; the rest
+// float), the triangles of each face set in mesh order its indices (uint16
+// when the group has at most 65535 vertices, else uint32), appended to the
+// entry's BIN as new buffer views; the tags are not written. GLB: the
+// buffer is the BIN chunk; .gltf: a base64 data URI. The entry is checked
+// before use and never trusted: a wrong magic, version or length, JSON that
+// does not parse or nests too deep, a fill naming no accessor or one twice,
+// counts or tags that do not match the mesh (vertex and triangle counts
+// per group and face set, a triangle using another group's vertex, an
+// attribute missing) give ErrorCode::corrupt_data (the entry is damaged) or
+// invalid_argument (the mesh is not the one the entry describes), never a
+// crash; nothing is allocated beyond the mesh's and the entry's own sizes.
+// Polygons, corner attributes, face attributes other than the tag and
+// non-finite positions are refused as below.
+//
+// Writing without one: one mesh, one primitive, one buffer (GLB: the BIN
+// chunk; .gltf: a base64 data URI). Triangles only: a mesh with other faces
+// is refused (write PLY or OBJ to keep polygons) rather than silently
+// triangulated. A mesh with vertices but no faces is written as a points
+// primitive (which reads back as the same vertices). POSITION with min /
+// max, NORMAL, TEXCOORD_0.. (numbered in order), COLOR_0.. (u8 / u16
+// colours as normalized unsigned byte / short, padded to 4-byte elements),
+// other vertex attributes as custom `_name` semantics (names that are glTF
 // semantics already, or start with '_', are kept; f32 and i32 as float, u8 /
 // u16 as unsigned byte / short, normalized for WEIGHTS_n only). The empty
 // mesh is written as a file without scene or mesh (glTF has no empty
@@ -65,6 +142,13 @@
 // splitting vertices, which tsm does not do silently: they are refused (PLY
 // or OBJ keep them), as are non-finite positions (POSITION min / max must be
 // numbers).
+//
+// Limits of the pass-through: primitives with different vertex accessors
+// that share some of them (the same POSITION, another NORMAL) are separate
+// groups, so their shared accessors are written twice; lines come back as
+// points; buffer views named only inside unknown extensions are not kept
+// (accessors are, by index); a mesh edited between reading and writing must
+// keep the tags and the per-group counts, or the writer refuses it.
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -113,6 +197,14 @@ constexpr uint32_t kChunkJson = 0x4E4F534A;
 constexpr uint32_t kChunkBin = 0x004E4942;
 constexpr size_t kMaxJsonDepth = 128;
 constexpr uint64_t kMaxIndex = std::numeric_limits<uint32_t>::max();
+
+// The pass-through entry (Mesh::metadata "gltf"): see the top of the file.
+using ojson = nlohmann::ordered_json;
+const char* const kPassKey = "gltf";
+const char kPassMagic[4] = {'t', 's', 'm', 'G'};
+constexpr uint32_t kPassVersion = 1;
+const char* const kGroupTag = "_gltf_group";
+const char* const kPrimitiveTag = "_gltf_primitive";
 
 size_t component_size(int ct) {
   switch (ct) {
@@ -383,8 +475,11 @@ long semantic_index(const std::string& s, const char* prefix) {
 
 // One attribute of one vertex group, as read.
 struct RawAttribute {
-  std::string slot;  // the tsm name ("normal", "texcoord0", "color", "TANGENT")
-  std::string semantic;
+  std::string slot;  // the tsm name ("normal", "texcoord0", "color", "TANGENT", "_gltf_target0_POSITION")
+  std::string semantic;  // the glTF semantic ("NORMAL"; for a morph target: "target 0 POSITION")
+  std::string gltf_semantic;  // the key in the primitive's attributes / target ("NORMAL", "POSITION")
+  int accessor = -1;
+  int target = -1;  // morph target number, -1 for a vertex attribute
   AttributeKind kind = AttributeKind::generic;
   AttributeType type = AttributeType::f32;
   uint32_t components = 1;
@@ -395,7 +490,28 @@ struct RawAttribute {
 struct VertexGroup {
   uint32_t base = 0;
   uint32_t count = 0;
+  int position_accessor = -1;
   std::vector<RawAttribute> attributes;
+};
+
+// The vertex accessors of a primitive: attributes and morph targets.
+using GroupKey = std::pair<std::map<std::string, int>, std::vector<std::map<std::string, int>>>;
+
+// A primitive turned into mesh data: its vertices are vertex group `group`,
+// its triangles face set `face_set` (-1: none, written back as points).
+struct PrimitiveRecord {
+  int mesh = 0;
+  size_t primitive = 0;
+  size_t group = 0;
+  int face_set = -1;
+};
+
+// The triangles of one primitive (a repeated primitive shares them).
+struct FaceSet {
+  size_t group = 0;
+  uint32_t first = 0;  // first face in the mesh
+  uint32_t count = 0;
+  int accessor = -1;  // the indices accessor it came from (-1: none, or a strip / fan)
 };
 
 // A checked accessor: every byte it names lies inside its buffer.
@@ -482,6 +598,7 @@ class GltfReader {
     if (json_depth(json, kMaxJsonDepth) > kMaxJsonDepth)
       return error("the JSON nests arrays and objects more than " + std::to_string(kMaxJsonDepth) +
                    " deep; refused (no glTF needs that)");
+    json_ = json;
 
     FsContext fs;
     fs.dir = options_.external_files_dir;
@@ -605,14 +722,15 @@ class GltfReader {
     }
     if (repeated > 0) note(std::to_string(repeated) + " repeated node reference(s) (not a tree) read once");
     if (transformed > 0)
-      note("node transforms not applied (" + std::to_string(transformed) + " node(s) have one): positions as stored");
+      note("node transforms not applied (" + std::to_string(transformed) +
+           " node(s) have one): positions as stored, the transforms kept in the document");
     size_t instanced = 0, unused = 0;
     for (size_t m = 0; m < nmeshes; ++m) {
       if (uses[m] > 1) ++instanced;
       if (uses[m] == 0) ++unused;
     }
     if (instanced > 0) note(std::to_string(instanced) + " mesh(es) used by several nodes read once");
-    if (unused > 0) note(std::to_string(unused) + " mesh(es) not in the scene not read");
+    if (unused > 0) note(std::to_string(unused) + " mesh(es) not in the scene kept as stored (not compressed)");
     return Status::Ok();
   }
 
@@ -787,6 +905,8 @@ class GltfReader {
                    " elements, but POSITION has " + std::to_string(vertex_count));
     RawAttribute r;
     r.semantic = semantic;
+    r.gltf_semantic = semantic;
+    r.accessor = accessor;
     r.components = v.components;
     const std::string shape = std::string(type_name(model_.accessors[static_cast<size_t>(accessor)].type)) + " of " +
                               component_name(v.component_type);
@@ -845,7 +965,38 @@ class GltfReader {
     return Status::Ok();
   }
 
-  Status read_group(const std::map<std::string, int>& attributes, const std::string& where, size_t& group_index) {
+  // A morph target's displacement (POSITION, NORMAL, TANGENT: VEC3 of
+  // float, or normalized byte / short) as the float vertex attribute
+  // "_gltf_target<t>_<SEMANTIC>".
+  Status read_target_attribute(size_t t, const std::string& semantic, int accessor, size_t vertex_count,
+                               const std::string& where, VertexGroup& g) {
+    const std::string what = where + " target " + std::to_string(t) + " " + semantic;
+    AccessorView v;
+    TSM_RETURN_IF_ERROR(view_accessor(accessor, what, v));
+    if (v.count != vertex_count)
+      return error(what + " (accessor " + std::to_string(accessor) + ") has " + std::to_string(v.count) +
+                   " elements, but POSITION has " + std::to_string(vertex_count));
+    const bool known = semantic == "POSITION" || semantic == "NORMAL" || semantic == "TANGENT";
+    const bool numeric = v.component_type == kFloat ||
+                         (v.normalized && (v.component_type == kByte || v.component_type == kShort));
+    if (!known || v.components != 3 || !numeric) {
+      note(what + " is not a VEC3 of float or normalized byte / short displacements: not kept");
+      return Status::Ok();
+    }
+    RawAttribute r;
+    r.slot = "_gltf_target" + std::to_string(t) + "_" + semantic;
+    r.semantic = "target " + std::to_string(t) + " " + semantic;
+    r.gltf_semantic = semantic;
+    r.accessor = accessor;
+    r.target = static_cast<int>(t);
+    r.components = 3;
+    TSM_RETURN_IF_ERROR(read_floats(v, v.normalized, what + " (accessor " + std::to_string(accessor) + ")", r.values));
+    g.attributes.push_back(std::move(r));
+    return Status::Ok();
+  }
+
+  Status read_group(const GroupKey& key, const std::string& where, size_t& group_index) {
+    const std::map<std::string, int>& attributes = key.first;
     const std::string what = where + " POSITION";
     AccessorView pv;
     TSM_RETURN_IF_ERROR(view_accessor(attributes.at("POSITION"), what, pv));
@@ -862,10 +1013,14 @@ class GltfReader {
     VertexGroup g;
     g.base = static_cast<uint32_t>(out_.vertex_count());
     g.count = static_cast<uint32_t>(pv.count);
+    g.position_accessor = attributes.at("POSITION");
     TSM_RETURN_IF_ERROR(read_floats(pv, pv.normalized, what + " (accessor " + std::to_string(attributes.at("POSITION")) + ")",
                                     out_.positions));
     for (const auto& [semantic, accessor] : attributes)
       if (semantic != "POSITION") TSM_RETURN_IF_ERROR(read_attribute(semantic, accessor, pv.count, where, g));
+    for (size_t t = 0; t < key.second.size(); ++t)
+      for (const auto& [semantic, accessor] : key.second[t])
+        TSM_RETURN_IF_ERROR(read_target_attribute(t, semantic, accessor, pv.count, where, g));
     group_index = groups_.size();
     groups_.push_back(std::move(g));
     return Status::Ok();
@@ -879,7 +1034,6 @@ class GltfReader {
     where += " primitive " + std::to_string(prim_index);
     if (p.mode < 0 || p.mode > 6)
       return error(where + ": unknown primitive mode " + std::to_string(p.mode) + " (glTF has 0..6)");
-    if (!p.targets.empty()) ++morphed_;
     auto pos = p.attributes.find("POSITION");
     if (pos == p.attributes.end()) {
       note(where + " has no POSITION: skipped");
@@ -896,18 +1050,27 @@ class GltfReader {
                                                   "uncompressed copy, and tsm does not decode Draco");
       note(where + ": read the uncompressed copy of a Draco-compressed primitive");
     }
-    if (!seen_primitives_.insert(std::make_tuple(p.attributes, p.indices, p.mode)).second) {
+    const GroupKey key(p.attributes, p.targets);
+    PrimitiveRecord record;
+    record.mesh = mesh_index;
+    record.primitive = prim_index;
+    auto seen = seen_primitives_.find(std::make_tuple(key, p.indices, p.mode));
+    if (seen != seen_primitives_.end()) {  // the same data again: the same vertices and faces
       ++repeated_primitives_;
+      record.group = seen->second.first;
+      record.face_set = seen->second.second;
+      records_.push_back(record);
       return Status::Ok();
     }
     size_t gi = 0;
-    auto found = group_of_.find(p.attributes);
+    auto found = group_of_.find(key);
     if (found != group_of_.end()) {
       gi = found->second;
     } else {
-      TSM_RETURN_IF_ERROR(read_group(p.attributes, where, gi));
-      group_of_[p.attributes] = gi;
+      TSM_RETURN_IF_ERROR(read_group(key, where, gi));
+      group_of_[key] = gi;
     }
+    record.group = gi;
     const uint32_t base = groups_[gi].base;
     const uint32_t n = groups_[gi].count;
 
@@ -937,6 +1100,9 @@ class GltfReader {
       if (elements > 0)
         note(where + ": " + std::to_string(elements) + " " + kModes[p.mode] +
              (p.mode == 0 ? "" : " segment(s)") + " skipped (their vertices are kept)");
+      if (p.mode != TINYGLTF_MODE_POINTS) ++lines_as_points_;
+      seen_primitives_[std::make_tuple(key, p.indices, p.mode)] = {gi, -1};
+      records_.push_back(record);
       return Status::Ok();
     }
     size_t tris = 0;
@@ -975,6 +1141,20 @@ class GltfReader {
       out_.add_triangle(base + a, base + b, base + c);
     }
     if (dropped > 0) note(where + ": " + std::to_string(dropped) + " degenerate strip/fan triangle(s) dropped");
+    const uint32_t first = static_cast<uint32_t>(out_.face_count() - (tris - dropped));
+    if (tris > dropped) {
+      FaceSet fs;
+      fs.group = gi;
+      fs.first = first;
+      fs.count = static_cast<uint32_t>(tris - dropped);
+      fs.accessor = p.mode == TINYGLTF_MODE_TRIANGLES ? p.indices : -1;
+      record.face_set = static_cast<int>(face_sets_.size());
+      face_sets_.push_back(fs);
+    } else {
+      ++empty_triangles_;
+    }
+    seen_primitives_[std::make_tuple(key, p.indices, p.mode)] = {gi, record.face_set};
+    records_.push_back(record);
     return Status::Ok();
   }
 
@@ -1106,28 +1286,324 @@ class GltfReader {
       note(std::to_string(repeated_primitives_) + " primitive(s) repeating another one read once");
     TSM_RETURN_IF_ERROR(merge_attributes());
 
-    // What is not kept.
-    std::string dropped;
-    auto count = [&](size_t n, const char* what) {
-      if (n == 0) return;
-      if (!dropped.empty()) dropped += ", ";
-      dropped += std::to_string(n) + " " + what;
-    };
-    count(model_.materials.size(), model_.materials.size() == 1 ? "material" : "materials");
-    count(model_.textures.size(), model_.textures.size() == 1 ? "texture" : "textures");
-    count(model_.images.size(), model_.images.size() == 1 ? "image" : "images");
-    count(model_.samplers.size(), model_.samplers.size() == 1 ? "sampler" : "samplers");
-    count(model_.animations.size(), model_.animations.size() == 1 ? "animation" : "animations");
-    count(model_.skins.size(), model_.skins.size() == 1 ? "skin" : "skins");
-    count(model_.cameras.size(), model_.cameras.size() == 1 ? "camera" : "cameras");
-    count(model_.lights.size(), model_.lights.size() == 1 ? "light" : "lights");
-    count(morphed_, morphed_ == 1 ? "primitive's morph targets" : "primitives' morph targets");
-    if (!dropped.empty()) note(dropped + " not kept");
-    if (!model_.extensionsUsed.empty()) {
-      std::string ext;
-      for (const std::string& e : model_.extensionsUsed) ext += (ext.empty() ? "" : ", ") + e;
-      note("extensions not kept: " + ext);
+    if (lines_as_points_ > 0)
+      note(std::to_string(lines_as_points_) + " line primitive(s) kept as points primitives (their vertices)");
+    if (empty_triangles_ > 0)
+      note(std::to_string(empty_triangles_) + " triangle primitive(s) without a triangle kept as points primitives");
+    return build_passthrough();
+  }
+
+  // ----- pass-through: the document without the geometry -----
+
+  // The JSON array `key` of `doc`, which must have the `n` elements tinygltf
+  // read (absent when n is 0).
+  Status json_array(ojson& doc, const char* key, size_t n, ojson*& arr) const {
+    arr = nullptr;
+    auto it = doc.find(key);
+    if (it == doc.end()) {
+      if (n == 0) return Status::Ok();
+    } else if (it->is_array() && it->size() == n) {
+      arr = &*it;
+      return Status::Ok();
     }
+    return error(std::string("the JSON's '") + key + "' does not match what tinygltf read (" + std::to_string(n) +
+                 " elements)");
+  }
+
+  Status build_passthrough() {
+    ojson doc;
+    try {
+      doc = ojson::parse(json_.begin(), json_.end());
+    } catch (const std::exception& e) {
+      return error(std::string("invalid JSON: ") + clean_message(e.what()));
+    }
+    if (!doc.is_object()) return error("the glTF JSON is not an object");
+    const size_t na = model_.accessors.size(), nviews = model_.bufferViews.size();
+    ojson *accessors, *views, *images, *meshes;
+    TSM_RETURN_IF_ERROR(json_array(doc, "accessors", na, accessors));
+    TSM_RETURN_IF_ERROR(json_array(doc, "bufferViews", nviews, views));
+    TSM_RETURN_IF_ERROR(json_array(doc, "images", model_.images.size(), images));
+    TSM_RETURN_IF_ERROR(json_array(doc, "meshes", model_.meshes.size(), meshes));
+    for (size_t m = 0; m < model_.meshes.size(); ++m) {
+      ojson* prims;
+      TSM_RETURN_IF_ERROR(json_array((*meshes)[m], "primitives", model_.meshes[m].primitives.size(), prims));
+    }
+
+    // Accessors something other than the primitives read uses keep their bytes.
+    std::set<std::pair<int, size_t>> read_primitives;
+    for (const PrimitiveRecord& r : records_) read_primitives.insert({r.mesh, r.primitive});
+    std::vector<char> other_use(na, 0);
+    auto mark = [&](int a) {
+      if (a >= 0 && static_cast<size_t>(a) < na) other_use[static_cast<size_t>(a)] = 1;
+    };
+    for (size_t m = 0; m < model_.meshes.size(); ++m)
+      for (size_t p = 0; p < model_.meshes[m].primitives.size(); ++p) {
+        if (read_primitives.count({static_cast<int>(m), p})) continue;
+        const tinygltf::Primitive& prim = model_.meshes[m].primitives[p];
+        for (const auto& kv : prim.attributes) mark(kv.second);
+        mark(prim.indices);
+        for (const auto& target : prim.targets)
+          for (const auto& kv : target) mark(kv.second);
+      }
+    for (const tinygltf::Animation& a : model_.animations)
+      for (const tinygltf::AnimationSampler& s : a.samplers) {
+        mark(s.input);
+        mark(s.output);
+      }
+    for (const tinygltf::Skin& s : model_.skins) mark(s.inverseBindMatrices);
+    if (auto nodes = doc.find("nodes"); nodes != doc.end() && nodes->is_array())
+      for (const ojson& node : *nodes) {
+        const ojson* at = &node;
+        for (const char* key : {"extensions", "EXT_mesh_gpu_instancing", "attributes"}) {
+          if (!at->is_object() || !at->contains(key)) {
+            at = nullptr;
+            break;
+          }
+          at = &(*at)[key];
+        }
+        if (at && at->is_object())
+          for (const auto& kv : at->items())
+            if (kv.value().is_number_unsigned() && kv.value().get<uint64_t>() < na) mark(kv.value().get<int>());
+      }
+
+    // Accessor slots of the geometry: an accessor only the primitives read
+    // use keeps its index (the first role to claim it); other roles get new
+    // accessors after the last one.
+    std::vector<char> claimed(na, 0);
+    std::vector<ojson> appended;
+    size_t next = na;
+    auto placeholder = [&](int orig) {
+      ojson a = ojson::object();
+      if (orig >= 0 && static_cast<size_t>(orig) < na && (*accessors)[static_cast<size_t>(orig)].is_object()) {
+        a = (*accessors)[static_cast<size_t>(orig)];
+        for (const char* k : {"bufferView", "byteOffset", "componentType", "normalized", "count", "type", "max", "min",
+                              "sparse"})
+          a.erase(k);
+      }
+      return a;
+    };
+    auto slot_for = [&](int orig) -> size_t {
+      if (orig >= 0 && static_cast<size_t>(orig) < na && !other_use[static_cast<size_t>(orig)] &&
+          !claimed[static_cast<size_t>(orig)]) {
+        claimed[static_cast<size_t>(orig)] = 1;
+        (*accessors)[static_cast<size_t>(orig)] = placeholder(orig);
+        return static_cast<size_t>(orig);
+      }
+      appended.push_back(placeholder(orig));
+      return next++;
+    };
+    ojson fills = ojson::array();
+    std::vector<std::map<std::string, size_t>> attribute_slot(groups_.size());
+    std::vector<std::vector<std::map<std::string, size_t>>> target_slot(groups_.size());
+    for (size_t g = 0; g < groups_.size(); ++g) {
+      const VertexGroup& group = groups_[g];
+      size_t slot = slot_for(group.position_accessor);
+      attribute_slot[g]["POSITION"] = slot;
+      fills.push_back({{"accessor", slot}, {"group", g}, {"semantic", "POSITION"}});
+      for (const RawAttribute& r : group.attributes) {
+        slot = slot_for(r.accessor);
+        ojson f = {{"accessor", slot}, {"group", g}, {"semantic", r.gltf_semantic}};
+        if (r.target >= 0) {
+          const size_t t = static_cast<size_t>(r.target);
+          if (target_slot[g].size() <= t) target_slot[g].resize(t + 1);
+          target_slot[g][t][r.gltf_semantic] = slot;
+          f["target"] = t;
+        } else {
+          attribute_slot[g][r.gltf_semantic] = slot;
+        }
+        f["attribute"] = r.slot;
+        f["components"] = r.components;
+        fills.push_back(std::move(f));
+      }
+    }
+    std::vector<size_t> face_set_slot(face_sets_.size());
+    for (size_t k = 0; k < face_sets_.size(); ++k) {
+      face_set_slot[k] = slot_for(face_sets_[k].accessor);
+      fills.push_back({{"accessor", face_set_slot[k]}, {"face_set", k}});
+    }
+
+    // The primitives read name their new accessors.
+    for (const PrimitiveRecord& r : records_) {
+      ojson& prim = (*meshes)[static_cast<size_t>(r.mesh)]["primitives"][r.primitive];
+      if (!prim.is_object()) return error("the JSON's primitives do not match what tinygltf read");
+      ojson attributes = ojson::object();
+      if (prim.contains("attributes") && prim["attributes"].is_object())
+        for (const auto& kv : prim["attributes"].items())
+          if (auto it = attribute_slot[r.group].find(kv.key()); it != attribute_slot[r.group].end())
+            attributes[kv.key()] = it->second;
+      prim["attributes"] = std::move(attributes);
+      if (prim.contains("targets") && prim["targets"].is_array()) {
+        ojson& targets = prim["targets"];
+        for (size_t t = 0; t < targets.size(); ++t) {
+          ojson kept = ojson::object();
+          if (targets[t].is_object() && t < target_slot[r.group].size())
+            for (const auto& kv : targets[t].items())
+              if (auto it = target_slot[r.group][t].find(kv.key()); it != target_slot[r.group][t].end())
+                kept[kv.key()] = it->second;
+          targets[t] = std::move(kept);
+        }
+      }
+      if (r.face_set >= 0) {
+        prim["indices"] = face_set_slot[static_cast<size_t>(r.face_set)];
+        if (prim.contains("mode")) prim["mode"] = TINYGLTF_MODE_TRIANGLES;
+      } else {
+        prim.erase("indices");
+        prim["mode"] = TINYGLTF_MODE_POINTS;
+      }
+      if (prim.contains("extensions") && prim["extensions"].is_object()) {
+        prim["extensions"].erase("KHR_draco_mesh_compression");  // its data is the mesh's now
+        if (prim["extensions"].empty()) prim.erase("extensions");
+      }
+    }
+
+    // Buffer views the kept content uses, copied into one buffer (each at
+    // its old offset modulo 4, so that accessors stay aligned).
+    std::vector<char> needed(nviews, 0);
+    auto need = [&](int v) {
+      if (v >= 0 && static_cast<size_t>(v) < nviews) needed[static_cast<size_t>(v)] = 1;
+    };
+    for (size_t i = 0; i < na; ++i) {
+      if (claimed[i]) continue;
+      const tinygltf::Accessor& a = model_.accessors[i];
+      need(a.bufferView);
+      if (a.sparse.isSparse) {
+        need(a.sparse.indices.bufferView);
+        need(a.sparse.values.bufferView);
+      }
+    }
+    for (const tinygltf::Image& image : model_.images) need(image.bufferView);
+    // Draco data of primitives not read (meshes outside the scene).
+    std::vector<ojson*> draco;
+    if (meshes)
+      for (size_t m = 0; m < meshes->size(); ++m)
+        for (ojson& prim : (*meshes)[m]["primitives"]) {
+          if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
+          ojson& ext = prim["extensions"];
+          if (!ext.contains("KHR_draco_mesh_compression")) continue;
+          ojson& d = ext["KHR_draco_mesh_compression"];
+          if (d.is_object() && d.contains("bufferView") && d["bufferView"].is_number_unsigned() &&
+              d["bufferView"].get<uint64_t>() < nviews) {
+            need(d["bufferView"].get<int>());
+            draco.push_back(&d);
+          }
+        }
+    std::string bin;
+    std::vector<size_t> new_view(nviews, 0);
+    ojson kept_views = ojson::array();
+    for (size_t v = 0; v < nviews; ++v) {
+      if (!needed[v]) continue;
+      const tinygltf::BufferView& bv = model_.bufferViews[v];
+      const tinygltf::BufferView* view;
+      const tinygltf::Buffer* buffer;
+      TSM_RETURN_IF_ERROR(check_view(static_cast<int>(v), "buffer view " + std::to_string(v), view, buffer));
+      while (bin.size() % 4 != bv.byteOffset % 4) bin.push_back('\0');
+      ojson j = (*views)[v].is_object() ? (*views)[v] : ojson::object();
+      j["buffer"] = 0;
+      j["byteOffset"] = bin.size();
+      if (j.contains("extensions") && j["extensions"].is_object()) {
+        j["extensions"].erase("EXT_meshopt_compression");  // the view holds the uncompressed fallback
+        if (j["extensions"].empty()) j.erase("extensions");
+      }
+      bin.append(reinterpret_cast<const char*>(buffer->data.data()) + bv.byteOffset, bv.byteLength);
+      new_view[v] = kept_views.size();
+      kept_views.push_back(std::move(j));
+    }
+    while (bin.size() % 4) bin.push_back('\0');
+    auto renumber = [&](ojson& obj, int old) {
+      if (old >= 0 && static_cast<size_t>(old) < nviews && obj.is_object())
+        obj["bufferView"] = new_view[static_cast<size_t>(old)];
+    };
+    for (size_t i = 0; i < na; ++i) {
+      if (claimed[i]) continue;
+      const tinygltf::Accessor& a = model_.accessors[i];
+      ojson& j = (*accessors)[i];
+      renumber(j, a.bufferView);
+      if (a.sparse.isSparse && j.is_object() && j.contains("sparse") && j["sparse"].is_object()) {
+        ojson& sp = j["sparse"];
+        if (sp.contains("indices")) renumber(sp["indices"], a.sparse.indices.bufferView);
+        if (sp.contains("values")) renumber(sp["values"], a.sparse.values.bufferView);
+      }
+    }
+    for (size_t i = 0; i < model_.images.size(); ++i) renumber((*images)[i], model_.images[i].bufferView);
+    for (ojson* d : draco) renumber(*d, (*d)["bufferView"].get<int>());
+
+    if (accessors) {
+      for (ojson& a : appended) accessors->push_back(std::move(a));
+    } else if (!appended.empty()) {
+      doc["accessors"] = ojson(std::move(appended));
+    }
+    if (kept_views.empty()) {
+      doc.erase("bufferViews");
+    } else {
+      doc["bufferViews"] = std::move(kept_views);
+    }
+    if (bin.empty()) {
+      doc.erase("buffers");
+    } else {
+      doc["buffers"] = ojson::array({ojson{{"byteLength", bin.size()}}});
+    }
+    // Extensions whose data is gone.
+    if (doc.contains("extensionsUsed") && doc["extensionsUsed"].is_array()) {
+      bool draco_left = !draco.empty();
+      ojson used = ojson::array();
+      for (const ojson& e : doc["extensionsUsed"])
+        if (!(e == "EXT_meshopt_compression" || (e == "KHR_draco_mesh_compression" && !draco_left))) used.push_back(e);
+      if (used.empty()) {
+        doc.erase("extensionsUsed");
+      } else {
+        doc["extensionsUsed"] = std::move(used);
+      }
+    }
+
+    // Which vertex group each vertex, which primitive each face belongs to.
+    const auto tag_type = [&](size_t n, AttributeType& type) -> Status {
+      if (n > (size_t{1} << 24)) return limit(std::to_string(n) + " vertex groups or primitives; tsm keeps at most 2^24");
+      type = n <= 65536 ? AttributeType::u16 : AttributeType::i32;
+      return Status::Ok();
+    };
+    if (groups_.size() > 1) {
+      Attribute a;
+      a.name = kGroupTag;
+      TSM_RETURN_IF_ERROR(tag_type(groups_.size(), a.type));
+      a.values.resize(out_.vertex_count());
+      for (size_t g = 0; g < groups_.size(); ++g)
+        std::fill_n(a.values.begin() + groups_[g].base, groups_[g].count, static_cast<float>(g));
+      out_.attributes.push_back(std::move(a));
+    }
+    std::vector<size_t> sets_of_group(groups_.size(), 0);
+    bool shared = false;
+    for (const FaceSet& fs : face_sets_) shared |= ++sets_of_group[fs.group] > 1;
+    if (shared) {
+      Attribute a;
+      a.name = kPrimitiveTag;
+      a.domain = AttributeDomain::face;
+      TSM_RETURN_IF_ERROR(tag_type(face_sets_.size(), a.type));
+      a.values.resize(out_.face_count());
+      for (size_t k = 0; k < face_sets_.size(); ++k)
+        std::fill_n(a.values.begin() + face_sets_[k].first, face_sets_[k].count, static_cast<float>(k));
+      out_.attributes.push_back(std::move(a));
+    }
+
+    ojson w = ojson::object();
+    w["tsm_gltf"] = 1;
+    ojson counts = ojson::array();
+    for (const VertexGroup& g : groups_) counts.push_back(g.count);
+    w["vertex_groups"] = std::move(counts);
+    ojson sets = ojson::array();
+    for (const FaceSet& fs : face_sets_) sets.push_back(ojson::array({fs.group, fs.count}));
+    w["face_sets"] = std::move(sets);
+    w["accessors"] = std::move(fills);
+    w["document"] = std::move(doc);
+    const std::string text = w.dump();
+    if (text.size() + bin.size() > std::numeric_limits<uint32_t>::max() - 16u)
+      return limit("the glTF content besides the geometry takes 4 GiB or more; refused");
+    std::string value(kPassMagic, 4);
+    value.resize(12);
+    store_u32(reinterpret_cast<unsigned char*>(&value[4]), kPassVersion);
+    store_u32(reinterpret_cast<unsigned char*>(&value[8]), static_cast<uint32_t>(text.size()));
+    value += text;
+    value += bin;
+    out_.metadata.push_back({kPassKey, std::move(value)});
     return Status::Ok();
   }
 
@@ -1141,10 +1617,14 @@ class GltfReader {
   size_t input_bytes_ = 0;
   uint64_t produced_ = 0;
   std::vector<VertexGroup> groups_;
-  std::map<std::map<std::string, int>, size_t> group_of_;
-  std::set<std::tuple<std::map<std::string, int>, int, int>> seen_primitives_;
+  std::map<GroupKey, size_t> group_of_;
+  std::map<std::tuple<GroupKey, int, int>, std::pair<size_t, int>> seen_primitives_;  // -> group, face set
+  std::vector<PrimitiveRecord> records_;
+  std::vector<FaceSet> face_sets_;
+  std::string_view json_;  // the glTF JSON (GLB: its JSON chunk)
   size_t repeated_primitives_ = 0;
-  size_t morphed_ = 0;
+  size_t lines_as_points_ = 0;
+  size_t empty_triangles_ = 0;
   size_t skipped_ = 0;
   std::string notes_;
   size_t note_count_ = 0;
@@ -1161,6 +1641,43 @@ const char* type_text(AttributeType t) {
     case AttributeType::i32: return "i32";
   }
   return "?";
+}
+
+// What every glTF this writer makes needs: triangles, vertex attributes
+// only (the pass-through writer takes its own face tag), finite positions.
+Status check_writable(const Mesh& mesh, bool passthrough) {
+  std::string why;
+  if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write glTF: the mesh is invalid: " + why);
+  size_t other = 0, first = 0;
+  for (size_t f = mesh.face_count(); f-- > 0;)
+    if (mesh.face_size(f) != 3) {
+      ++other;
+      first = f;
+    }
+  if (other > 0)
+    return Status(ErrorCode::unsupported,
+                  "cannot write glTF: it stores triangles only, and " + std::to_string(other) + " of the mesh's " +
+                      std::to_string(mesh.face_count()) + " faces are not triangles (face " + std::to_string(first) +
+                      " has " + std::to_string(mesh.face_size(first)) +
+                      " corners); write PLY or OBJ to keep polygons, or triangulate the mesh first");
+  for (const Attribute& a : mesh.attributes) {
+    if (a.domain == AttributeDomain::corner)
+      return Status(ErrorCode::unsupported,
+                    "cannot write glTF: attribute " + shown_name(a.name) +
+                        " is per face corner (seams), and glTF has per-vertex attributes only; tsm does not split "
+                        "vertices silently: write PLY or OBJ to keep it");
+    if (a.domain == AttributeDomain::face && !(passthrough && a.name == kPrimitiveTag))
+      return Status(ErrorCode::unsupported,
+                    "cannot write glTF: attribute " + shown_name(a.name) +
+                        " is per face, and glTF has per-vertex attributes only; tsm does not split vertices "
+                        "silently: write PLY or OBJ to keep it");
+  }
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      return Status(ErrorCode::unsupported, "cannot write glTF: vertex " + std::to_string(i / 3) +
+                                                " has a non-finite coordinate, and glTF needs the POSITION bounds "
+                                                "(min / max) as finite numbers");
+  return Status::Ok();
 }
 
 class GltfWriter {
@@ -1203,40 +1720,7 @@ class GltfWriter {
   }
 
  private:
-  Status check() const {
-    std::string why;
-    if (!mesh_.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write glTF: the mesh is invalid: " + why);
-    size_t other = 0, first = 0;
-    for (size_t f = mesh_.face_count(); f-- > 0;)
-      if (mesh_.face_size(f) != 3) {
-        ++other;
-        first = f;
-      }
-    if (other > 0)
-      return Status(ErrorCode::unsupported,
-                    "cannot write glTF: it stores triangles only, and " + std::to_string(other) + " of the mesh's " +
-                        std::to_string(mesh_.face_count()) + " faces are not triangles (face " + std::to_string(first) +
-                        " has " + std::to_string(mesh_.face_size(first)) +
-                        " corners); write PLY or OBJ to keep polygons, or triangulate the mesh first");
-    for (const Attribute& a : mesh_.attributes) {
-      if (a.domain == AttributeDomain::corner)
-        return Status(ErrorCode::unsupported,
-                      "cannot write glTF: attribute " + shown_name(a.name) +
-                          " is per face corner (seams), and glTF has per-vertex attributes only; tsm does not split "
-                          "vertices silently: write PLY or OBJ to keep it");
-      if (a.domain == AttributeDomain::face)
-        return Status(ErrorCode::unsupported,
-                      "cannot write glTF: attribute " + shown_name(a.name) +
-                          " is per face, and glTF has per-vertex attributes only; tsm does not split vertices "
-                          "silently: write PLY or OBJ to keep it");
-    }
-    for (size_t i = 0; i < mesh_.positions.size(); ++i)
-      if (!std::isfinite(mesh_.positions[i]))
-        return Status(ErrorCode::unsupported, "cannot write glTF: vertex " + std::to_string(i / 3) +
-                                                  " has a non-finite coordinate, and glTF needs the POSITION bounds "
-                                                  "(min / max) as finite numbers");
-    return Status::Ok();
-  }
+  Status check() const { return check_writable(mesh_, false); }
 
   // Appends a buffer view of `elements` elements of `elem` bytes each,
   // filled by put(i, dst); returns its index. Vertex data gets a stride
@@ -1400,6 +1884,390 @@ class GltfWriter {
   std::vector<unsigned char> data_;
 };
 
+// ---------------------------------------------------------------------------
+// The pass-through writer: the document of the "gltf" metadata entry with the
+// geometry of the mesh put back into its accessors.
+
+std::string base64_encode(std::string_view in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  size_t i = 0;
+  const auto* u = reinterpret_cast<const unsigned char*>(in.data());
+  for (; i + 2 < in.size(); i += 3) {
+    const uint32_t v = static_cast<uint32_t>(u[i]) << 16 | static_cast<uint32_t>(u[i + 1]) << 8 | u[i + 2];
+    for (int sh = 18; sh >= 0; sh -= 6) out += k[(v >> sh) & 63];
+  }
+  if (i < in.size()) {
+    uint32_t v = static_cast<uint32_t>(u[i]) << 16;
+    if (i + 1 < in.size()) v |= static_cast<uint32_t>(u[i + 1]) << 8;
+    out += k[(v >> 18) & 63];
+    out += k[(v >> 12) & 63];
+    out += i + 1 < in.size() ? k[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+class PassThroughWriter {
+ public:
+  PassThroughWriter(const Mesh& mesh, const std::string& value) : mesh_(mesh), value_(value) {}
+
+  Status run(bool binary, std::string& out) {
+    TSM_RETURN_IF_ERROR(parse());
+    TSM_RETURN_IF_ERROR(check_writable(mesh_, true));
+    TSM_RETURN_IF_ERROR(assign_vertices());
+    TSM_RETURN_IF_ERROR(assign_faces());
+    TSM_RETURN_IF_ERROR(fill_accessors());
+    return serialize(binary, out);
+  }
+
+ private:
+  static Status damaged(const std::string& what) {
+    return Status(ErrorCode::corrupt_data,
+                  "cannot write glTF: the mesh's glTF pass-through data (metadata 'gltf') is damaged: " + what);
+  }
+  static Status mismatch(const std::string& what) {
+    return Status(ErrorCode::invalid_argument,
+                  "cannot write glTF: the mesh does not match its glTF pass-through data (metadata 'gltf'): " + what);
+  }
+
+  // An unsigned integer member below `bound`.
+  static bool get_index(const ojson& obj, const char* key, uint64_t bound, uint64_t& v) {
+    if (!obj.is_object()) return false;
+    auto it = obj.find(key);
+    if (it == obj.end() || !it->is_number_unsigned()) return false;
+    v = it->get<uint64_t>();
+    return v < bound;
+  }
+
+  Status parse() {
+    const auto* u = reinterpret_cast<const unsigned char*>(value_.data());
+    if (value_.size() < 12 || std::memcmp(value_.data(), kPassMagic, 4) != 0)
+      return damaged("it does not start with 'tsmG' and its 12-byte header");
+    const uint32_t version = load_u32(u + 4);
+    if (version != kPassVersion)
+      return damaged("version " + std::to_string(version) + "; this tsm reads version " + std::to_string(kPassVersion));
+    const uint32_t json_length = load_u32(u + 8);
+    if (json_length > value_.size() - 12)
+      return damaged("its JSON (" + std::to_string(json_length) + " bytes) runs past its end (" +
+                     std::to_string(value_.size()) + " bytes)");
+    const std::string_view text(value_.data() + 12, json_length);
+    bin_ = std::string_view(value_).substr(12 + static_cast<size_t>(json_length));
+    if (bin_.size() % 4 != 0) return damaged("its binary part is not a multiple of 4 bytes");
+    if (json_depth(text, kMaxJsonDepth + 2) > kMaxJsonDepth + 2) return damaged("its JSON nests too deep");
+    try {
+      wrapper_ = ojson::parse(text.begin(), text.end());
+    } catch (const std::exception& e) {
+      return damaged(std::string("its JSON does not parse: ") + clean_message(e.what()));
+    }
+    if (!wrapper_.is_object() || wrapper_.value("tsm_gltf", ojson()) != 1)
+      return damaged("its JSON is not a version 1 description");
+    for (const char* key : {"vertex_groups", "face_sets", "accessors"})
+      if (!wrapper_.contains(key) || !wrapper_[key].is_array()) return damaged(std::string("no '") + key + "' list");
+    if (!wrapper_.contains("document") || !wrapper_["document"].is_object()) return damaged("no glTF document");
+    for (const ojson& c : wrapper_["vertex_groups"]) {
+      if (!c.is_number_unsigned() || c.get<uint64_t>() > kMaxIndex) return damaged("a vertex group's size is not a count");
+      groups_.push_back(c.get<uint64_t>());
+    }
+    for (const ojson& fs : wrapper_["face_sets"]) {
+      if (!fs.is_array() || fs.size() != 2 || !fs[0].is_number_unsigned() || fs[0].get<uint64_t>() >= groups_.size() ||
+          !fs[1].is_number_unsigned() || fs[1].get<uint64_t>() > kMaxIndex)
+        return damaged("a face set is not [vertex group, face count]");
+      sets_.emplace_back(static_cast<size_t>(fs[0].get<uint64_t>()), fs[1].get<uint64_t>());
+    }
+    return Status::Ok();
+  }
+
+  // An attribute of the mesh by name in `domain` with one component (a tag).
+  const Attribute* tag(const char* name, AttributeDomain domain) const {
+    for (const Attribute& a : mesh_.attributes)
+      if (a.name == name && a.domain == domain && a.components == 1) return &a;
+    return nullptr;
+  }
+
+  static bool tag_value(const Attribute& a, size_t i, size_t bound, size_t& v) {
+    const float x = a.values[i];
+    if (!(x >= 0 && x < static_cast<float>(bound) && x == std::floor(x))) return false;
+    v = static_cast<size_t>(x);
+    return v < bound;
+  }
+
+  Status assign_vertices() {
+    const size_t nv = mesh_.vertex_count();
+    uint64_t total = 0;
+    for (uint64_t c : groups_) total += c;
+    if (total != nv)
+      return mismatch("it describes " + std::to_string(total) + " vertices, and the mesh has " + std::to_string(nv));
+    group_of_.assign(nv, 0);
+    local_.assign(nv, 0);
+    if (groups_.size() > 1) {
+      const Attribute* t = tag(kGroupTag, AttributeDomain::vertex);
+      if (!t)
+        return mismatch(std::string("no vertex attribute '") + kGroupTag + "' tells its " +
+                        std::to_string(groups_.size()) + " vertex groups apart");
+      for (size_t v = 0; v < nv; ++v) {
+        size_t g;
+        if (!tag_value(*t, v, groups_.size(), g))
+          return mismatch(std::string("vertex ") + std::to_string(v) + ": '" + kGroupTag + "' is " +
+                          float_text(t->values[v]) + ", not a vertex group (0.." + std::to_string(groups_.size() - 1) +
+                          ")");
+        group_of_[v] = static_cast<uint32_t>(g);
+      }
+    }
+    members_.assign(groups_.size(), {});
+    for (size_t v = 0; v < nv; ++v) {
+      std::vector<uint32_t>& m = members_[group_of_[v]];
+      local_[v] = static_cast<uint32_t>(m.size());
+      m.push_back(static_cast<uint32_t>(v));
+    }
+    for (size_t g = 0; g < groups_.size(); ++g)
+      if (members_[g].size() != groups_[g])
+        return mismatch("vertex group " + std::to_string(g) + " has " + std::to_string(members_[g].size()) +
+                        " vertices; it had " + std::to_string(groups_[g]));
+    return Status::Ok();
+  }
+
+  Status assign_faces() {
+    const size_t nf = mesh_.face_count();
+    uint64_t total = 0;
+    for (const auto& fs : sets_) total += fs.second;
+    if (total != nf)
+      return mismatch("it describes " + std::to_string(total) + " triangles, and the mesh has " + std::to_string(nf));
+    faces_.assign(sets_.size(), {});
+    const Attribute* t = tag(kPrimitiveTag, AttributeDomain::face);
+    // Without the tag, a vertex group has at most one face set.
+    std::vector<long> only(groups_.size(), -1);
+    for (size_t k = 0; k < sets_.size(); ++k) only[sets_[k].first] = only[sets_[k].first] == -1 ? static_cast<long>(k) : -2;
+    for (size_t f = 0; f < nf; ++f) {
+      const uint32_t* c = mesh_.face(f);
+      size_t k;
+      if (t) {
+        if (!tag_value(*t, f, sets_.size(), k))
+          return mismatch(std::string("face ") + std::to_string(f) + ": '" + kPrimitiveTag + "' is " +
+                          float_text(t->values[f]) + ", not a primitive (0.." + std::to_string(sets_.size()) + ")");
+      } else {
+        const long o = only[group_of_[c[0]]];
+        if (o < 0)
+          return mismatch(std::string("face ") + std::to_string(f) + " is in vertex group " +
+                          std::to_string(group_of_[c[0]]) + ", which has " + (o == -1 ? "no" : "several") +
+                          " triangle primitives, and no face attribute '" + kPrimitiveTag + "' says which");
+        k = static_cast<size_t>(o);
+      }
+      for (int i = 0; i < 3; ++i)
+        if (group_of_[c[i]] != sets_[k].first)
+          return mismatch("face " + std::to_string(f) + " of primitive " + std::to_string(k) + " uses vertex " +
+                          std::to_string(c[i]) + " of vertex group " + std::to_string(group_of_[c[i]]) +
+                          ", and that primitive's vertices are group " + std::to_string(sets_[k].first));
+      faces_[k].push_back(static_cast<uint32_t>(f));
+    }
+    for (size_t k = 0; k < sets_.size(); ++k)
+      if (faces_[k].size() != sets_[k].second)
+        return mismatch("primitive " + std::to_string(k) + " has " + std::to_string(faces_[k].size()) +
+                        " triangles; it had " + std::to_string(sets_[k].second));
+    return Status::Ok();
+  }
+
+  // Appends a buffer view of `elements` elements of `elem` bytes (vertex
+  // data: a stride that is a multiple of 4), filled by put(i, dst).
+  template <typename Put>
+  size_t add_view(size_t elements, size_t elem, int target, Put put) {
+    const size_t stride = target == TINYGLTF_TARGET_ARRAY_BUFFER ? (elem + 3) & ~size_t{3} : elem;
+    while (data_.size() % 4) data_.push_back(0);
+    const size_t at = data_.size();
+    data_.resize(at + elements * stride, 0);
+    for (size_t i = 0; i < elements; ++i) put(i, reinterpret_cast<unsigned char*>(&data_[at + i * stride]));
+    ojson view = {{"buffer", 0}, {"byteOffset", at}, {"byteLength", elements * stride}};
+    if (target == TINYGLTF_TARGET_ARRAY_BUFFER && stride != elem) view["byteStride"] = stride;
+    view["target"] = target;
+    views_->push_back(std::move(view));
+    return views_->size() - 1;
+  }
+
+  // The accessor `slot` with its data fields first, then what it kept (name, extras, ...).
+  static void set_accessor(ojson& slot, size_t view, int ct, bool normalized, size_t count, uint32_t comps,
+                           const std::vector<double>* lo, const std::vector<double>* hi) {
+    ojson a = {{"bufferView", view}, {"componentType", ct}};
+    if (normalized) a["normalized"] = true;
+    a["count"] = count;
+    a["type"] = type_name(type_for_components(comps));
+    if (lo && hi && count > 0) {
+      a["min"] = *lo;
+      a["max"] = *hi;
+    }
+    for (const auto& kv : slot.items())
+      if (!a.contains(kv.key())) a[kv.key()] = kv.value();
+    slot = std::move(a);
+  }
+
+  Status fill_accessors() {
+    ojson& doc = wrapper_["document"];
+    if (!doc.contains("bufferViews")) doc["bufferViews"] = ojson::array();
+    if (!doc["bufferViews"].is_array()) return damaged("the document's bufferViews are not a list");
+    views_ = &doc["bufferViews"];
+    const ojson& fills = wrapper_["accessors"];
+    if (!fills.empty() && (!doc.contains("accessors") || !doc["accessors"].is_array()))
+      return damaged("the document has no accessors list");
+    data_.assign(bin_.begin(), bin_.end());
+    std::vector<char> filled(fills.empty() ? 0 : doc["accessors"].size(), 0);
+    for (const ojson& e : fills) {
+      uint64_t slot;
+      if (!get_index(e, "accessor", filled.size(), slot) || filled[slot] || !doc["accessors"][slot].is_object())
+        return damaged("an entry names no accessor of the document, or one already filled");
+      filled[slot] = 1;
+      ojson& acc = doc["accessors"][slot];
+      uint64_t k;
+      if (e.contains("face_set")) {
+        if (!get_index(e, "face_set", sets_.size(), k)) return damaged("an entry names no face set");
+        const std::vector<uint32_t>& faces = faces_[k];
+        const bool small = groups_[sets_[k].first] <= 0xFFFF;
+        const size_t n = 3 * faces.size();
+        auto corner = [&](size_t i) { return local_[mesh_.face(faces[i / 3])[i % 3]]; };
+        const size_t view =
+            small ? add_view(n, 2, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                             [&](size_t i, unsigned char* d) { store_u16(d, static_cast<uint16_t>(corner(i))); })
+                  : add_view(n, 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                             [&](size_t i, unsigned char* d) { store_u32(d, corner(i)); });
+        set_accessor(acc, view, small ? kUShort : kUInt, false, n, 1, nullptr, nullptr);
+        continue;
+      }
+      if (!get_index(e, "group", groups_.size(), k)) return damaged("an entry names no vertex group");
+      const std::vector<uint32_t>& verts = members_[k];
+      if (!e.contains("semantic") || !e["semantic"].is_string()) return damaged("an entry has no semantic");
+      const std::string semantic = e["semantic"].get<std::string>();
+      const float* src;
+      uint32_t comps, stride;
+      const Attribute* a = nullptr;
+      if (!e.contains("attribute")) {
+        if (semantic != "POSITION") return damaged("an entry without a mesh attribute is not POSITION");
+        src = mesh_.positions.data();
+        comps = stride = 3;
+      } else {
+        if (!e["attribute"].is_string()) return damaged("an entry's attribute is not a name");
+        const std::string name = e["attribute"].get<std::string>();
+        for (const Attribute& x : mesh_.attributes)
+          if (x.name == name && x.domain == AttributeDomain::vertex) a = &x;
+        if (!a) return mismatch("the mesh has no vertex attribute " + shown_name(name) + " for " + semantic);
+        uint64_t c;
+        if (!get_index(e, "components", 5, c) || c == 0) return damaged("an entry's component count is not 1..4");
+        if (c > a->components)
+          return mismatch("attribute " + shown_name(name) + " has " + std::to_string(a->components) +
+                          " components; " + semantic + " had " + std::to_string(c));
+        src = a->values.data();
+        comps = static_cast<uint32_t>(c);
+        stride = a->components;
+      }
+      // Component type: integers stay integers (colours and weights
+      // normalized), everything else is float.
+      int ct = kFloat;
+      bool normalized = false;
+      const bool target = e.contains("target");
+      if (a && !target && (a->type == AttributeType::u8 || a->type == AttributeType::u16) &&
+          (a->kind == AttributeKind::color || a->kind == AttributeKind::generic)) {
+        ct = a->type == AttributeType::u8 ? kUByte : kUShort;
+        normalized = semantic.compare(0, 6, "COLOR_") == 0 || semantic_index(semantic, "WEIGHTS_") >= 0;
+        const float top = a->type == AttributeType::u8 ? 255.0f : 65535.0f;
+        for (uint32_t v : verts)
+          for (uint32_t c = 0; c < comps; ++c) {
+            const float x = src[static_cast<size_t>(v) * stride + c];
+            if (!(x >= 0 && x <= top && x == std::floor(x)))
+              return Status(ErrorCode::invalid_argument,
+                            "cannot write glTF: attribute " + shown_name(a->name) + " has type " + type_text(a->type) +
+                                " but value " + float_text(x) + " (vertex " + std::to_string(v) +
+                                ") is not an integer in 0.." + float_text(top));
+          }
+      }
+      const size_t csize = component_size(ct);
+      const size_t view = add_view(verts.size(), csize * comps, TINYGLTF_TARGET_ARRAY_BUFFER,
+                                   [&](size_t i, unsigned char* d) {
+                                     const float* p = src + static_cast<size_t>(verts[i]) * stride;
+                                     for (uint32_t c = 0; c < comps; ++c) {
+                                       if (ct == kFloat) {
+                                         store_f32(d + 4 * c, p[c]);
+                                       } else if (ct == kUByte) {
+                                         d[c] = static_cast<unsigned char>(p[c]);
+                                       } else {
+                                         store_u16(d + 2 * c, static_cast<uint16_t>(p[c]));
+                                       }
+                                     }
+                                   });
+      std::vector<double> lo, hi;
+      if (semantic == "POSITION") {  // required for POSITION and morph target POSITION
+        lo.assign(comps, 0.0);
+        hi.assign(comps, 0.0);
+        for (uint32_t c = 0; c < comps; ++c) {
+          float l = std::numeric_limits<float>::infinity(), h = -l;
+          for (uint32_t v : verts) {
+            l = std::min(l, src[static_cast<size_t>(v) * stride + c]);
+            h = std::max(h, src[static_cast<size_t>(v) * stride + c]);
+          }
+          if (!std::isfinite(l) || !std::isfinite(h)) l = h = 0;  // a target with non-finite values: no bound
+          lo[c] = l;
+          hi[c] = h;
+        }
+      }
+      set_accessor(acc, view, ct, normalized, verts.size(), comps, lo.empty() ? nullptr : &lo,
+                   hi.empty() ? nullptr : &hi);
+    }
+    if (views_->empty()) doc.erase("bufferViews");
+    return Status::Ok();
+  }
+
+  Status serialize(bool binary, std::string& out) {
+    ojson& doc = wrapper_["document"];
+    while (data_.size() % 4) data_.push_back(0);
+    if (data_.size() > std::numeric_limits<uint32_t>::max() - (1u << 24))
+      return Status(ErrorCode::limit_exceeded, "cannot write glTF: the document needs " + std::to_string(data_.size()) +
+                                                   " bytes of buffer; a glTF buffer holds less than 4 GiB");
+    if (data_.empty()) {
+      doc.erase("buffers");
+    } else {
+      ojson buffer = {{"byteLength", data_.size()}};
+      if (!binary) buffer["uri"] = "data:application/octet-stream;base64," + base64_encode(data_);
+      doc["buffers"] = ojson::array({std::move(buffer)});
+    }
+    if (!binary) {
+      out = doc.dump(2);
+      out += '\n';
+      return Status::Ok();
+    }
+    std::string json = doc.dump();
+    while (json.size() % 4) json += ' ';
+    const uint64_t total = 12 + 8 + json.size() + (data_.empty() ? 0 : 8 + data_.size());
+    if (total > std::numeric_limits<uint32_t>::max())
+      return Status(ErrorCode::limit_exceeded, "cannot write glTF: the GLB would take 4 GiB or more");
+    std::string glb(20, '\0');
+    auto* h = reinterpret_cast<unsigned char*>(&glb[0]);
+    store_u32(h, kGlbMagic);
+    store_u32(h + 4, 2);
+    store_u32(h + 8, static_cast<uint32_t>(total));
+    store_u32(h + 12, static_cast<uint32_t>(json.size()));
+    store_u32(h + 16, kChunkJson);
+    glb += json;
+    if (!data_.empty()) {
+      unsigned char c[8];
+      store_u32(c, static_cast<uint32_t>(data_.size()));
+      store_u32(c + 4, kChunkBin);
+      glb.append(reinterpret_cast<const char*>(c), 8);
+      glb += data_;
+    }
+    out = std::move(glb);
+    return Status::Ok();
+  }
+
+  const Mesh& mesh_;
+  const std::string& value_;
+  ojson wrapper_;
+  std::string_view bin_;
+  std::vector<uint64_t> groups_;                    // vertex count of each group
+  std::vector<std::pair<size_t, uint64_t>> sets_;   // group and triangle count of each face set
+  std::vector<uint32_t> group_of_, local_;          // per mesh vertex
+  std::vector<std::vector<uint32_t>> members_;      // mesh vertices of each group, in mesh order
+  std::vector<std::vector<uint32_t>> faces_;        // mesh faces of each face set, in mesh order
+  ojson* views_ = nullptr;
+  std::string data_;
+};
+
 }  // namespace
 
 Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options,
@@ -1411,10 +2279,20 @@ Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& ou
   (void)options;
   out.clear();
   try {
+    if (const MetadataEntry* pass = mesh.find_metadata(kPassKey)) {
+      Status s = PassThroughWriter(mesh, pass->value).run(binary, out);
+      if (!s.ok()) out.clear();
+      return s;
+    }
     return GltfWriter(mesh).run(binary, out);
   } catch (const std::bad_alloc&) {
     out.clear();
     return Status(ErrorCode::limit_exceeded, "cannot write glTF: out of memory");
+  } catch (const std::exception& e) {  // a JSON value of an unexpected type in the metadata
+    out.clear();
+    return Status(ErrorCode::corrupt_data,
+                  std::string("cannot write glTF: the mesh's glTF pass-through data (metadata 'gltf') is damaged: ") +
+                      clean_message(e.what()));
   }
 }
 

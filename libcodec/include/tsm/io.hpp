@@ -69,9 +69,13 @@ Status read_off(std::string_view bytes, const std::string& name, Mesh& out,
 // glTF 2.0, .gltf or .glb (told apart by content): the triangles of the
 // meshes of the default scene, concatenated, with their vertex attributes
 // (NORMAL -> "normal", TEXCOORD_n -> "texcoord<n>", COLOR_0 -> "color",
-// others under their glTF name); node transforms are not applied; what is
-// not kept (materials, textures, ...) is listed in ReadInfo::notes. See
-// io_gltf.cpp.
+// others under their glTF name); node transforms are not applied. The rest
+// of the document (scenes, nodes, materials, textures, images, cameras,
+// skins, animations, extensions, extras, meshes outside the scene) goes into
+// Mesh::metadata "gltf", and which primitive each vertex and face came from
+// into the integer attributes "_gltf_group" / "_gltf_primitive" (only when
+// there are several), so that write_gltf gives the document back around the
+// codec's geometry. See io_gltf.cpp.
 Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out,
                  const ReadOptions& options, ReadInfo* info);
 
@@ -84,9 +88,12 @@ Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions&
 // Serializers (to memory).
 Status write_ply(const Mesh& mesh, const WriteOptions& options, std::string& out);
 Status write_obj(const Mesh& mesh, std::string& out);
-// glTF 2.0: binary (.glb) or JSON with the buffer as a data URI (.gltf). One
-// triangle primitive (a points primitive when there are no faces) with
-// POSITION, NORMAL, TEXCOORD_n, COLOR_n (u8 / u16 colours as normalized
+// glTF 2.0: binary (.glb) or JSON with the buffer as a data URI (.gltf).
+// With a "gltf" metadata entry (from read_gltf), the document it holds with
+// each primitive's geometry taken from the mesh (a damaged entry is
+// corrupt_data, one that does not fit the mesh invalid_argument). Without
+// one: one triangle primitive (a points primitive when there are no faces)
+// with POSITION, NORMAL, TEXCOORD_n, COLOR_n (u8 / u16 colours as normalized
 // unsigned byte / short) and other vertex attributes as "_name". Refuses
 // (ErrorCode::unsupported) faces that are not triangles, face and corner
 // attributes (glTF would need split vertices: write PLY or OBJ) and
