@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
       "for several files, the worst of them. `tsm COMMAND --help` shows each command's options.");
 
   EncodeArgs ea;
-  CLI::App* enc = app.add_subcommand("encode", "Compress meshes (PLY, OBJ, STL, OFF) into .tsm files");
+  CLI::App* enc = app.add_subcommand("encode", "Compress meshes (PLY, OBJ, STL, OFF, glTF/GLB) into .tsm files");
   enc->add_option("inputs", ea.inputs, "Mesh files to compress; - reads one mesh from stdin")
       ->required()->check(kFileOrStdin);
   enc->add_option("-o,--output", ea.output,
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
       "the others; failures are listed at the end and the exit code is the worst one (3 bad input, 4 I/O).");
 
   DecodeArgs da;
-  CLI::App* dec = app.add_subcommand("decode", "Decompress .tsm files into PLY or OBJ");
+  CLI::App* dec = app.add_subcommand("decode", "Decompress .tsm files into PLY, OBJ or glTF/GLB");
   dec->add_option("inputs", da.inputs, ".tsm files; - reads one from stdin")->required()->check(kFileOrStdin);
   dec->add_option("-o,--output", da.output,
                   "Output: a .ply/.obj file (one input), a folder (DIR/, or several inputs: DIR/NAME.ply), or - for "
