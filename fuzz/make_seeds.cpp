@@ -302,6 +302,43 @@ void corpus_seeds(const fs::path& corpus, const fs::path& decode_dir, const fs::
   }
 }
 
+// A sphere with spherical texture coordinates per vertex or per corner (a
+// seam where u wraps; values shared by the corners of a vertex otherwise),
+// a face attribute, and metadata: seeds for the attribute decoder's
+// predictors, values of earlier segments and the metadata section.
+tsm::Mesh with_attributes(bool per_corner) {
+  tsm::Mesh m = tsm_test::icosphere(2);
+  tsm::Attribute t, f;
+  t.name = "texcoord";
+  t.kind = tsm::AttributeKind::texcoord;
+  t.components = 2;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    const float* p = &m.positions[3 * v];
+    t.values.push_back(0.5f + std::atan2(p[1], p[0]) / 6.2831853f);
+    t.values.push_back(0.5f + 0.5f * p[2]);
+  }
+  if (per_corner) {
+    t.domain = tsm::AttributeDomain::corner;
+    const size_t base = t.value_count();
+    for (size_t k = 0; k < m.corner_count(); ++k) {
+      const uint32_t v = m.indices[k];
+      const bool seam = t.values[2 * v] < 0.1f;
+      t.indices.push_back(seam ? static_cast<uint32_t>(base + k) : v);
+    }
+    for (size_t k = 0; k < m.corner_count(); ++k) {
+      t.values.push_back(t.values[2 * m.indices[k]] + 1.0f);
+      t.values.push_back(t.values[2 * m.indices[k] + 1]);
+    }
+  }
+  f.name = "material";
+  f.domain = tsm::AttributeDomain::face;
+  f.type = tsm::AttributeType::u16;
+  for (size_t k = 0; k < m.face_count(); ++k) f.values.push_back(static_cast<float>(k % 3));
+  m.attributes = {t, f};
+  m.metadata = {{"gltf", "{\"materials\":[{},{},{}]}"}, {"note", std::string(100, 'n')}};
+  return m;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -340,6 +377,11 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 12, 6, 40);
   encode_seed(decode_dir, "grid_holes", tsm_test::grid_with_holes(10, 2), 10, 0, 25);
   encode_seed(decode_dir, "spheres", tsm_test::copies(tsm_test::icosphere(1), 3), 8, 6, 30);
+  // Attributes (predictor 2 per vertex and per corner, values of earlier
+  // segments) and metadata.
+  encode_seed(decode_dir, "uv_vertex", with_attributes(false), 12, 6);
+  encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6);
+  encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6, 60);
   handwritten(read_dir);
   corpus_seeds(TSM_CORPUS_DIR, decode_dir, read_dir);
   std::printf("fuzz_seeds: %d seed files in %s\n", written, out.string().c_str());
