@@ -403,6 +403,16 @@ struct AttributeWalk {
     return count;
   }
 
+  // The mean of `count` placements summed in `sum` becomes the prediction
+  // (when there is one); returns the residuals' class.
+  int placed(const double sum[2], int count, int32_t* pred) const {
+    if (count > 0) {
+      pred[0] = round_to_grid(sum[0] / count, h.bits);
+      pred[1] = round_to_grid(sum[1] / count, h.bits);
+    }
+    return std::min(count, 2);
+  }
+
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
   bool vertices(int predictor, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
@@ -436,11 +446,7 @@ struct AttributeWalk {
               },
               sum);
         }
-        if (count > 0) {
-          pred[0] = round_to_grid(sum[0] / count, h.bits);
-          pred[1] = round_to_grid(sum[1] / count, h.bits);
-        }
-        cls = std::min(count, 2);
+        cls = placed(sum, count, pred);
       }
       if (!vc.value(h, pred, &x[n * static_cast<size_t>(r)], cls)) return false;
       std::copy(&x[n * static_cast<size_t>(r)], &x[n * static_cast<size_t>(r)] + n, prev);
@@ -558,11 +564,8 @@ struct AttributeWalk {
                   return &values[n * static_cast<size_t>(index[off[F] + pc])];
                 },
                 sum);
-            cls = std::min(count, 2);
-            if (count > 0) {
-              pred[0] = round_to_grid(sum[0] / count, h.bits);
-              pred[1] = round_to_grid(sum[1] / count, h.bits);
-            } else {
+            cls = placed(sum, count, pred);
+            if (count == 0) {
               for (uint32_t j : visit)
                 if (done[j]) {
                   const int32_t* u = &values[n * static_cast<size_t>(index[faces.face_offsets[g] + j])];
@@ -830,13 +833,17 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   ByteWriter w(body);
   w.varint(headers.size());
   for (const AttributeHeader& h : headers) write_header(w, h);
-  // Per attribute: the predictor, the one that codes it smallest.
-  std::vector<int> predictor(headers.size(), 0);
+  // Per attribute: the predictor that codes it smallest (each tried alone),
+  // its byte in the header, then its values into the one stream.
+  Enc enc;
+  if (in.own_values) in.own_values->assign(headers.size(), {});
   for (size_t i = 0; i < headers.size(); ++i) {
     const AttributeHeader& h = headers[i];
     if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
     const unsigned choices = predictors_for(h);
+    int predictor = 0;
     size_t best = SIZE_MAX;
+    own_values = nullptr;
     for (int p = 0; p < 3 && choices != 1; ++p) {
       if (!(choices >> p & 1)) continue;
       Enc trial;
@@ -844,17 +851,12 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       const size_t size = trial.e.finish().size();
       if (size < best) {
         best = size;
-        predictor[i] = p;
+        predictor = p;
       }
     }
-    w.u8(static_cast<uint8_t>(predictor[i]));
-  }
-  Enc enc;
-  if (in.own_values) in.own_values->assign(headers.size(), {});
-  for (size_t i = 0; i < headers.size(); ++i) {
-    if (headers[i].quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, headers[i].bits, gnormal, ghas);
+    w.u8(static_cast<uint8_t>(predictor));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
-    if (!code(enc, i, predictor[i])) return Status(ErrorCode::internal, "attributes: values out of range");
+    if (!code(enc, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
   }
   out = body + enc.e.finish();
   return Status::Ok();

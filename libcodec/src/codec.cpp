@@ -318,6 +318,23 @@ struct EncodedPart {
   Status status;
 };
 
+// The attribute payload of a part from what encode_part kept (`imported`,
+// `own_values`: see AttributeInput; null for a whole mesh).
+Status encode_part_attributes(const Mesh& part, const std::vector<AttributeHeader>& headers,
+                              const std::vector<std::vector<uint32_t>>* imported,
+                              std::vector<std::vector<uint32_t>>* own_values, EncodedPart& p) {
+  AttributeInput ai;
+  ai.part = &part;
+  ai.order = &p.order;
+  ai.is_ref = &p.ref_out;
+  ai.faces = &p.faces;
+  ai.q = &p.q;
+  ai.segmented = imported != nullptr;
+  ai.imported = imported;
+  ai.own_values = own_values;
+  return encode_attributes(headers, ai, p.attributes);
+}
+
 // qin: grid indices per part input vertex; is_ref: per part input vertex,
 // 1 when an earlier segment holds it (empty: none).
 Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
@@ -381,19 +398,12 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
     out.ref_out.resize(mark.size());
     for (size_t v = 0; v < mark.size(); ++v) out.ref_out[v] = mark[v] != kNone;
     out.q = std::move(q);
-    if (is_ref.empty()) {  // a whole mesh: now
-      AttributeInput ai;
-      ai.part = &mesh;
-      ai.order = &ce.vertex_order;
-      ai.is_ref = &out.ref_out;
-      ai.faces = &out.faces;
-      ai.q = &out.q;
-      TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, out.attributes));
-    }
   }
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
+  if (!headers.empty() && is_ref.empty())  // a whole mesh: its attributes now
+    TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, out));
   return Status::Ok();
 }
 
@@ -517,16 +527,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       for (size_t i = 0; i < headers.size(); ++i)
         if (!value_id[i].empty())
           for (uint32_t x : p.value_origin[i]) imported[i].push_back(value_id[i][x]);
-      AttributeInput ai;
-      ai.part = &p.part;
-      ai.order = &p.order;
-      ai.is_ref = &p.ref_out;
-      ai.faces = &p.faces;
-      ai.q = &p.q;
-      ai.segmented = true;
-      ai.imported = &imported;
-      ai.own_values = &own_values;
-      TSM_RETURN_IF_ERROR(encode_attributes(headers, ai, p.attributes));
+      TSM_RETURN_IF_ERROR(encode_part_attributes(p.part, headers, &imported, &own_values, p));
       for (size_t i = 0; i < headers.size(); ++i)
         if (!value_id[i].empty())
           for (uint32_t local : own_values[i]) value_id[i][p.value_origin[i][local]] = value_count[i]++;
