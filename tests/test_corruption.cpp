@@ -114,6 +114,7 @@ namespace {
 
 using tsm::ErrorCode;
 using tsm::Mesh;
+using tsm_test::random_bytes;
 
 // The memory a decoder may hold for an input of n bytes. Every decoded
 // element has to be paid for with coded bits; the range coder's cheapest
@@ -217,13 +218,6 @@ Mesh point_set(int n) {
   return m;
 }
 
-std::string random_bytes_fixed(size_t n) {
-  std::mt19937 rng(5);
-  std::string s(n, '\0');
-  for (char& c : s) c = static_cast<char>(rng() & 0xff);
-  return s;
-}
-
 // Small files of different kinds (a few hundred bytes to a few kilobytes).
 std::vector<std::string> small_files() {
   Mesh cube = tsm_test::cube_quads();
@@ -256,7 +250,8 @@ std::vector<std::string> damage_files() {
   out.push_back(encode_ok(tsm_test::icosphere(2), 12, tsm::kDefaultLevel, 40));  // 8 segments
   out.push_back(encode_ok(tsm_test::copies(tsm_test::cube_quads(), 4), 9, tsm::kDefaultLevel, 5));
   Mesh with_metadata = tsm_test::icosphere(2);
-  with_metadata.metadata = {{"notes", "a few words of text, and more of them"}, {"blob", random_bytes_fixed(200)}};
+  std::mt19937 rng(5);
+  with_metadata.metadata = {{"notes", "a few words of text, and more of them"}, {"blob", random_bytes(rng, 200)}};
   out.push_back(encode_ok(with_metadata, 12, tsm::kDefaultLevel, 100));
   return out;
 }
@@ -282,12 +277,6 @@ std::string build(const Container& c) { return tsm_fuzz::build_container(c); }
 bool checksums_match(const std::string& file) {
   std::string fixed = file;
   return tsm_fuzz::fix_checksums(fixed) > 0 && fixed == file;
-}
-
-std::string random_bytes(std::mt19937& rng, size_t n) {
-  std::string s(n, '\0');
-  for (char& c : s) c = static_cast<char>(rng() & 0xff);
-  return s;
 }
 
 // A decode of damaged input must fail cleanly (corrupt_data; unsupported only

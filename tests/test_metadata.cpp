@@ -15,9 +15,7 @@ using tsm::Mesh;
 
 std::string some_bytes(size_t n, uint32_t seed) {
   std::mt19937 rng(seed);
-  std::string s(n, '\0');
-  for (char& c : s) c = static_cast<char>(rng() & 0xff);
-  return s;
+  return tsm_test::random_bytes(rng, n);
 }
 
 std::string encode_ok(const Mesh& m, uint32_t segment_faces = 0) {

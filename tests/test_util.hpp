@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,13 @@ inline float from_bits(uint32_t b) {
   float x;
   std::memcpy(&x, &b, 4);
   return x;
+}
+
+// n pseudo-random bytes from `rng`.
+inline std::string random_bytes(std::mt19937& rng, size_t n) {
+  std::string s(n, '\0');
+  for (char& c : s) c = static_cast<char>(rng() & 0xff);
+  return s;
 }
 
 // `part` occurs in `text` (an error message, a file), with both shown if not.
