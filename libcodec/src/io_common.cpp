@@ -95,6 +95,12 @@ MeshFormat sniff_format(std::string_view bytes) {
   return MeshFormat::unknown;
 }
 
+void ReadInfo::add_note(const std::string& note) {
+  if (note.empty()) return;
+  if (!notes.empty()) notes += "; ";
+  notes += note;
+}
+
 Status read_file(const std::string& path, std::string& out) {
   FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) return Status(ErrorCode::io_error, path + ": cannot open: " + errno_text());

@@ -554,10 +554,7 @@ class GltfReader {
       info_->format = binary_ ? MeshFormat::glb : MeshFormat::gltf;
       info_->binary = binary_;
       info_->skipped_elements += skipped_;
-      if (!notes_.empty()) {
-        if (!info_->notes.empty()) info_->notes += "; ";
-        info_->notes += notes_;
-      }
+      info_->add_note(notes_);
     }
     return Status::Ok();
   }

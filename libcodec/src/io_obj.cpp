@@ -579,11 +579,8 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
 
   if (info) {
     info->skipped_elements = lines_ + points_;
-    std::string notes;
-    auto add = [&](const std::string& s) {
-      if (!notes.empty()) notes += "; ";
-      notes += s;
-    };
+    info->notes.clear();
+    auto add = [&](const std::string& s) { info->add_note(s); };
     for (const std::string& n : attribute_notes) add(n);
     if (lines_ + points_ > 0) {
       std::string s = "skipped ";
@@ -596,7 +593,6 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
       add("skipped " + std::to_string(u.second) + " record" + (u.second == 1 ? "" : "s") +
           " with unknown keyword " + quote(u.first));
     if (unknown_other_) add("skipped " + std::to_string(unknown_other_) + " more records with other unknown keywords");
-    info->notes = notes;
   }
   return Status::Ok();
 }

@@ -328,10 +328,7 @@ class PlyReader {
     if (empty_faces_ > 0) note("skipped " + std::to_string(empty_faces_) + " face(s) with no corners");
     if (info_) {
       info_->skipped_elements += skipped_;
-      if (!notes_.empty()) {
-        if (!info_->notes.empty()) info_->notes += "; ";
-        info_->notes += notes_;
-      }
+      info_->add_note(notes_);
     }
     return Status::Ok();
   }

@@ -47,6 +47,8 @@ struct ReadInfo {
   bool binary = false;
   size_t skipped_elements = 0;    // lines, points and other non-face records
   std::string notes;              // warnings worth showing ("skipped 12 'l' lines")
+  // Appends to `notes`, "; " between notes (nothing when `note` is empty).
+  void add_note(const std::string& note);
 };
 
 // Reads a mesh; format from content first, extension second.
