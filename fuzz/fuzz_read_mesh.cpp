@@ -1,7 +1,9 @@
-// libFuzzer target: every mesh reader (PLY, OBJ, STL, OFF, and the sniffer)
-// on arbitrary bytes. An accepted mesh must be valid; it must survive the
-// writers exactly (binary PLY, ascii PLY and OBJ give back bit-identical
-// positions and identical faces, as io.hpp and io_obj.cpp promise); and,
+// libFuzzer target: every mesh reader (PLY, OBJ, STL, OFF, glTF / GLB with
+// its pass-through entry, and the sniffer) on arbitrary bytes. An accepted
+// mesh must be valid; it must survive the writers exactly (binary PLY, ascii
+// PLY and OBJ give back bit-identical positions and identical faces, as
+// io.hpp and io_obj.cpp promise; what the glTF writer accepts, .gltf and
+// .glb, its reader gives back with the same faces and positions); and,
 // when small, it must round-trip through the codec under the oracle
 // tsm::compare_meshes (readers make meshes with arbitrary float positions, a
 // good test of the geometry coder). Any violation aborts.
@@ -48,6 +50,16 @@ void check_writers(const tsm::Mesh& mesh, const char* format) {
     if (!s.ok()) fail(std::string(format) + ": the OBJ writer wrote what the reader refuses: " + s.to_string());
     if (!same(mesh, back)) fail(std::string(format) + ": OBJ write + read changed the mesh");
   }
+  for (bool binary : {false, true}) {
+    std::string gltf;
+    // Refusals are documented (polygons, face and corner attributes,
+    // non-finite positions, an entry that does not fit the mesh).
+    if (!tsm::write_gltf(mesh, tsm::WriteOptions{}, gltf, binary).ok()) continue;
+    tsm::Mesh back;
+    tsm::Status s = tsm::read_gltf(gltf, binary ? "fuzz.glb" : "fuzz.gltf", back, all, nullptr);
+    if (!s.ok()) fail(std::string(format) + ": the glTF writer wrote what the reader refuses: " + s.to_string());
+    if (!same(mesh, back)) fail(std::string(format) + ": glTF write + read changed the mesh");
+  }
 }
 
 void check_codec(const tsm::Mesh& mesh, const char* format) {
@@ -75,7 +87,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.max_faces = 1u << 20;
   (void)tsm::sniff_format(bytes);
   for (tsm::MeshFormat f : {tsm::MeshFormat::unknown, tsm::MeshFormat::ply, tsm::MeshFormat::obj, tsm::MeshFormat::stl,
-                            tsm::MeshFormat::off}) {
+                            tsm::MeshFormat::off, tsm::MeshFormat::gltf}) {
     tsm::Mesh mesh;
     tsm::ReadInfo info;
     tsm::Status s = tsm::read_mesh_from_memory(bytes, "fuzz", mesh, options, &info, f);

@@ -9,8 +9,11 @@
 //                                  set, ...) at a few quantizations and levels
 //        OUT_DIR/fuzz_read_mesh/   the same kind of meshes as small PLY
 //                                  (ascii, binary little and big endian), OBJ,
-//                                  STL (ascii, binary) and OFF texts, plus
-//                                  hand-written files with the awkward forms
+//                                  STL (ascii, binary), OFF, glTF and GLB,
+//                                  plus hand-written files with the awkward
+//                                  forms (a glTF document with two meshes,
+//                                  materials, nodes, an image and a morph
+//                                  target: the pass-through entry)
 //        OUT_DIR/fuzz_roundtrip/   those meshes in fuzz_roundtrip's input
 //                                  layout
 // and, when ../shared/corpus exists, its small files (read seeds, and encoded
@@ -243,6 +246,60 @@ void handwritten(const fs::path& dir) {
       "endsolid named thing\n");
 }
 
+std::string base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < in.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, in.size() - i);  // n bytes give n + 1 characters
+    uint32_t v = 0;
+    for (size_t j = 0; j < 3; ++j) v = v << 8 | (j < n ? static_cast<unsigned char>(in[i + j]) : 0u);
+    for (size_t j = 0; j < 4; ++j) out += j <= n ? k[(v >> (18 - 6 * j)) & 63] : '=';
+  }
+  return out;
+}
+
+// A .gltf document as exporters write it: two meshes (one with two
+// primitives sharing a POSITION accessor, one with a morph target), three
+// materials, a node tree with a transform, a camera, an image in a buffer
+// view, extras and an extension; read_gltf keeps all but the geometry in the
+// "gltf" metadata entry and the writer rebuilds it.
+std::string gltf_document() {
+  std::string bin;
+  auto f32 = [&](float f) { bin.append(reinterpret_cast<const char*>(&f), 4); };
+  auto u16 = [&](uint16_t v) { bin.append(reinterpret_cast<const char*>(&v), 2); };
+  const float quad[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (auto& p : quad) for (float c : p) f32(c);                  // 0: positions, 48 bytes
+  for (int i : {0, 1, 2, 0, 2, 3}) u16(static_cast<uint16_t>(i));  // 48: indices, 12 bytes
+  for (auto& p : quad) { f32(p[0]); f32(p[1]); f32(0.5f); }       // 60: second mesh, 48 bytes
+  for (int i = 0; i < 4; ++i) { f32(0); f32(0); f32(0.25f * static_cast<float>(i)); }  // 108: morph, 48 bytes
+  bin += "\x89PNG\r\n\x1a\n0000";                                 // 156: image, 12 bytes
+  return std::string(R"({"asset":{"version":"2.0","generator":"fuzz_seeds"},"scene":0,)") +
+         R"("scenes":[{"nodes":[0]}],"nodes":[{"children":[1,2],"translation":[1,2,3]},{"mesh":0},)" +
+         R"({"mesh":1,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1],"camera":0}],)" +
+         R"("cameras":[{"type":"perspective","perspective":{"yfov":1.0,"znear":0.1}}],)" +
+         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0},)" +
+         R"({"attributes":{"POSITION":0},"indices":2,"material":1}]},)" +
+         R"({"primitives":[{"attributes":{"POSITION":3},"indices":2,"targets":[{"POSITION":4}],"mode":4,"material":2}],)" +
+         R"("weights":[0.5]}],)" +
+         R"("materials":[{"name":"a"},{"name":"b","doubleSided":true},{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)" +
+         R"("textures":[{"source":0}],"images":[{"bufferView":3,"mimeType":"image/png"}],)" +
+         R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},)" +
+         R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"},)" +
+         R"({"bufferView":1,"byteOffset":6,"componentType":5123,"count":3,"type":"SCALAR"},)" +
+         R"({"bufferView":2,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0.5],"max":[1,1,0.5]},)" +
+         R"({"bufferView":2,"byteOffset":48,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[0,0,0.75]}],)" +
+         R"("bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12},)" +
+         R"({"buffer":0,"byteOffset":60,"byteLength":96},{"buffer":0,"byteOffset":156,"byteLength":12}],)" +
+         R"("buffers":[{"byteLength":168,"uri":"data:application/octet-stream;base64,)" + base64(bin) + R"("}],)" +
+         R"("extensionsUsed":["EXT_x"],"extensions":{"EXT_x":{"a":1}},"extras":{"k":[1,"two",null]}})";
+}
+
+void gltf_seeds(const fs::path& dir, const std::string& name, const tsm::Mesh& m) {
+  std::string s;
+  if (tsm::write_gltf(m, tsm::WriteOptions{}, s, false).ok()) put(dir, name + ".gltf", s);
+  if (tsm::write_gltf(m, tsm::WriteOptions{}, s, true).ok()) put(dir, name + ".glb", s);
+}
+
 void roundtrip_seed(const fs::path& dir, const Named& n) {
   const tsm::Mesh& m = n.mesh;
   if (m.vertex_count() == 0 || m.vertex_count() > 256) return;
@@ -368,6 +425,17 @@ int main(int argc, char** argv) {
       put(read_dir, n.name + "_ascii.stl", stl_ascii(n.mesh));
       put(read_dir, n.name + "_binary.stl", stl_binary(n.mesh));
     }
+    gltf_seeds(read_dir, n.name, n.mesh);
+  }
+  {
+    const std::string doc = gltf_document();
+    put(read_dir, "hand_document.gltf", doc);
+    tsm::Mesh m;
+    if (!tsm::read_gltf(doc, "hand_document.gltf", m, tsm::ReadOptions{}, nullptr).ok() || !m.find_metadata("gltf")) {
+      std::fprintf(stderr, "fuzz_seeds: the hand-written glTF document is not read with its pass-through entry\n");
+      return 1;
+    }
+    gltf_seeds(read_dir, "hand_document_written", m);  // the writer's form, .gltf and .glb
   }
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 0);
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 9);
