@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format version 2), written from
+"""An independent decoder for .tsm files (format version 3), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version != 2:
+    if version != 3:
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -255,18 +255,23 @@ class RangeDecoder:
             self.code = ((self.code << 8) | self.next_byte()) & 0xFFFFFFFF
 
     def bit(self, probs, i):
-        """probs: a list of probabilities, i: index of the one to use and adapt."""
-        p = probs[i]
-        bound = (self.range >> 12) * p
+        """probs: a list of models (p | n << 16: probability and update
+        count, §8.1), i: index of the one to use and adapt."""
+        p = probs[i] & 0xFFFF
+        n = probs[i] >> 16
+        s = SHIFT[n]
+        n = min(n + 1, 128)
+        bound = (self.range >> 15) * p
         if self.code < bound:
             self.range = bound
-            probs[i] = p + ((4096 - p) >> 5)
+            p = min(p + ((32768 - p) >> s), 32704)
             b = 0
         else:
             self.code -= bound
             self.range -= bound
-            probs[i] = p - (p >> 5)
+            p = max(p - (p >> s), 64)
             b = 1
+        probs[i] = p | (n << 16)
         self.normalize()
         return b
 
@@ -285,8 +290,12 @@ class RangeDecoder:
         return self.overrun > 8
 
 
+# shift(n) = min(7, floor(log2(n + 2))) for update counts n = 0 .. 128 (§8.1)
+SHIFT = [min(7, (n + 2).bit_length() - 1) for n in range(129)]
+
+
 def probs(n):
-    return [2048] * n
+    return [16384] * n           # p = 16384, count 0
 
 
 class BitTree:
@@ -449,7 +458,8 @@ def bounding_loop(lparent, jumps):
 # ---------------------------------------------------------------- §8.8 triangle tree walk (+ §8.10 step 1 marks)
 
 def triangle_walk(L, root, march, branch, loop, n, read_bit):
-    """read_bit(va, vb, prev) reads one marching bit with context bit[va][vb][prev]."""
+    """read_bit(va, vb, prev, vr, vl) reads one marching bit with context
+    bit[va][vb][prev][vr][vl] (vr, vl: loop visits of the candidates, 0..2)."""
     nr = len(march)
     if L < 4 or root >= L:
         reject('walk: L or root')
@@ -483,6 +493,9 @@ def triangle_walk(L, root, march, branch, loop, n, read_bit):
     slot = []
     marks = []      # per triangle: [mark edge0, edge1, edge2] (loop edge or None)
     val = [0] * n   # valences so far, per local vertex
+    visits = [0] * n  # loop positions per local vertex (its degree in the cut)
+    for p in range(L):
+        visits[loop[p]] += 1
 
     class Tris(list):
         def append(self, t):
@@ -504,7 +517,8 @@ def triangle_walk(L, root, march, branch, loop, n, read_bit):
             span = (a - b) % L
             if span < 3:
                 reject('walk: march step without room')
-            bit = read_bit(min(val[loop[a]], 7), min(val[loop[b]], 7), prev)
+            bit = read_bit(min(val[loop[a]], 7), min(val[loop[b]], 7), prev,
+                           min(visits[loop[fwd(b, 1)]], 3) - 1, min(visits[loop[bwd(a, 1)]], 3) - 1)
             prev = bit
             k = len(tris)
             if bit == 0:
@@ -557,11 +571,11 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     # §8.2 models
     v_length = [UIntModel(), UIntModel()]
     v_leaf = probs(2)
-    v_last = probs(1)
+    v_last = probs(2)             # last[child index 1, or 2 and more]
     t_root = UIntModel()
-    t_march = [UIntModel(), UIntModel()]
-    t_end = [probs(2), probs(2)]
-    t_bit = probs(8 * 8 * 3)       # bit[va][vb][prev] at (8 va + vb) 3 + prev
+    t_march = [[UIntModel(), UIntModel()], [UIntModel(), UIntModel()]]  # [previous end][this end]
+    t_end = [probs(2), probs(2)]   # [previous end][the end before it]
+    t_bit = probs(8 * 8 * 3 * 9)   # bit[va][vb][prev][vr][vl] at ((8 va + vb) 3 + prev) 9 + 3 vr + vl
     t_diag = probs(2)
     o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
     o_has_poly = probs(1)
@@ -599,15 +613,17 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             if not root_run:
                 if not stack:
                     reject('run without parent')
-                par = stack[-1]
-                if dv.bit(v_last, 0) == 1:
+                par = stack[-1][0]
+                idx = stack[-1][1]
+                stack[-1][1] += 1
+                if idx > 0 and dv.bit(v_last, 1 if idx > 1 else 0) == 1:
                     stack.pop()
             root_run = False
             for _ in range(ln + 1):
                 parent.append(par)
                 par = len(parent) - 1
             if leaf == 0:
-                stack.append(par)
+                stack.append([par, 0])              # branching vertex, child runs so far
             if leaf == 1 and not stack:
                 break
         n = len(parent) - start
@@ -617,7 +633,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             reject('two-vertex component')
         # -- jump edges (stream 5)
         nj = o_count.decode(do)
-        if nj > 730 * (len(s5) + 8) // 6 or nj % 2 or overrun():
+        if nj > 2837 * (len(s5) + 8) // 6 or nj % 2 or overrun():
             reject('jump count')
         jumps = []
         corner = 0
@@ -645,17 +661,18 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
         root = t_root.decode(dt)
         total = 0
         leaves = branches = 0
-        prev_end = 1
+        prev_end = prev_end2 = 1
         march, branch = [], []
         while True:
             if overrun():
                 reject('triangle tree truncated')
-            m = t_march[prev_end].decode(dt)
+            br = dt.bit(t_end[prev_end], prev_end2)
+            m = t_march[prev_end][br].decode(dt)
             if m == INVALID or total + m + 1 > L:
                 reject('march count')
-            br = dt.bit(t_end[prev_end], 1 if m == 0 else 0)
             march.append(m)
             branch.append(br)
+            prev_end2 = prev_end
             prev_end = br
             total += m + 1
             if br:
@@ -665,7 +682,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             if leaves == branches + 1:
                 break
         ltris, lpar, lslot, marks = triangle_walk(
-            L, root, march, branch, loop, n, lambda va, vb, prev: dt.bit(t_bit, (8 * va + vb) * 3 + prev))
+            L, root, march, branch, loop, n, lambda va, vb, prev, vr, vl: dt.bit(t_bit, ((8 * va + vb) * 3 + prev) * 9 + 3 * vr + vl))
         if overrun():
             reject('triangle tree truncated')
         T = L - 2
@@ -881,7 +898,7 @@ def decode_geometry(payload, layout, qbits, trace=None):
     if len(payload) < 1:
         reject('geometry: empty')
     predictor = payload[0]
-    if predictor > 2:
+    if predictor > 3:
         reject('geometry: predictor')
     pos = 1
     K = 0
@@ -946,12 +963,15 @@ def decode_geometry(payload, layout, qbits, trace=None):
         return j
 
     # §8.5.3
-    def code_vertex(v, pred, cls, activity):
+    def code_vertex(v, pred, cls, activity, spread=None):
         sm = 0
         top = 0
         n_on = 0
         for a in range(3):
-            ctx = activity if a == 0 else (activity + bit_length(top) + 1) // 2
+            if spread is not None:                           # predictor 3, 2+ parallelograms
+                ctx = bit_length(spread[a])
+            else:
+                ctx = activity if a == 0 else (activity + bit_length(top) + 1) // 2
             ctx = min(ctx, 13)
             p = min(max(pred[a], 0), qmax)
             coded = False
@@ -980,8 +1000,8 @@ def decode_geometry(payload, layout, qbits, trace=None):
         if trace is not None:
             trace.append('v%d pred=%s cls=%d act_in=%d -> q=%s act=%d' % (v, list(pred), cls, activity, q[v], act[v]))
 
-    def point(v, pred, cls, activity):
-        code_vertex(v, pred, cls, activity)
+    def point(v, pred, cls, activity, spread=None):
+        code_vertex(v, pred, cls, activity, spread)
         st['last'] = list(q[v])
         st['last_act'] = act[v]
 
@@ -1004,6 +1024,8 @@ def decode_geometry(payload, layout, qbits, trace=None):
     def predict(h0, multi):
         para = [0, 0, 0]
         nb = [0, 0, 0]
+        lo = [0, 0, 0]                 # per axis the smallest and largest single parallelogram
+        hi = [0, 0, 0]
         cnt = {'npara': 0, 'nnb': 0, 'actsum': 0}
 
         def neighbour(u):
@@ -1024,7 +1046,10 @@ def decode_geometry(payload, layout, qbits, trace=None):
             if o == NONE:
                 return
             for a in range(3):
-                para[a] += q[u][a] + q[w][a] - q[o][a]
+                x = q[u][a] + q[w][a] - q[o][a]
+                para[a] += x
+                lo[a] = min(lo[a], x) if cnt['npara'] else x
+                hi[a] = max(hi[a], x) if cnt['npara'] else x
             cnt['npara'] += 1
 
         if multi:
@@ -1050,7 +1075,8 @@ def decode_geometry(payload, layout, qbits, trace=None):
             pred = list(st['last'])
             cls = 0
         activity = (cnt['actsum'] + nnb // 2) // nnb if nnb > 0 else st['last_act']
-        return pred, cls, activity
+        spread = [hi[a] - lo[a] for a in range(3)] if predictor == 3 and npara >= 2 else None
+        return pred, cls, activity, spread
 
     # §8.5.7
     def on_no_triangle():
@@ -1084,7 +1110,7 @@ def decode_geometry(payload, layout, qbits, trace=None):
             if h0 % 4096 == 0 and d.truncated():
                 reject('geometry: truncated')
         on_no_triangle()
-    elif predictor == 1:                                     # §8.5.6
+    elif predictor in (1, 3):                                # §8.5.6
         first_he = [NONE] * vc
         for h in range(H - 1, -1, -1):
             v = ids[tri[h]]
@@ -1181,7 +1207,7 @@ def decode_geometry(payload, layout, qbits, trace=None):
                 reject('geometry: truncated')
     if d.truncated():                                        # §8.5.9
         reject('geometry: truncated')
-    ginfo = {'predictor': ['ancestors', 'parallelograms', 'gate'][predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
+    ginfo = {'predictor': ['ancestors', 'parallelograms', 'gate', 'spread'][predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
              'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun}
     ginfo.update(stats)
     return q, ginfo
@@ -1665,7 +1691,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                     o = walk.face_offsets[g]
                     walk.update_sigma([walk.values[indices[o + i]] for i in range(len(f))])
             U = m.unused.decode(d)
-            if U == INVALID or U > 730 * (len(coded) + 8):
+            if U == INVALID or U > 2837 * (len(coded) + 8):
                 reject('attributes: corner values of %r are invalid' % h.name)
             for _ in range(U):
                 decode_value(d, m, walk, ('unused',))
@@ -1760,7 +1786,7 @@ def decode_part(streams, counts, bits, earlier, trace):
         reject('counts')                                             # step 26
     if rc > vc:
         reject('references')
-    D = lambda b: 730 * (len(b) + 8)
+    D = lambda b: 2837 * (len(b) + 8)
     if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + D(s5) // 6:
         reject('stream budget')
     if sr is not None and vc > D(sr):

@@ -109,7 +109,8 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
     for (int bits : {4, 11, 20}) {
       Prepared p = prepare(m, bits);
       tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
-      for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::parallelograms, 0}, {Predictor::ancestors, 1},
+      for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::parallelograms, 0}, {Predictor::spread, 0},
+                             {Predictor::ancestors, 1},
                              {Predictor::ancestors, 3}, {Predictor::ancestors, 4}}) {
         for (bool use_lattice : {false, true}) {
           SCOPED_TRACE(name + " bits=" + std::to_string(bits) + " predictor=" + std::to_string(int(pred)) +

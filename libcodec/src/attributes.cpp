@@ -917,7 +917,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     } else {
       std::vector<uint32_t> none, aliases, in_of;
       std::vector<int32_t> no_ints;
-      const uint64_t budget = 730 * (static_cast<uint64_t>(coded.size()) + 8);
+      const uint64_t budget = max_decisions(coded.size());
       if (!walk.corners(predictor[i], in.segmented, nullptr, none, no_ints, 0, budget, x, a.indices, aliases, in_of))
         return corrupt("corner values of '" + h.name + "' are invalid");
       if (alias) {

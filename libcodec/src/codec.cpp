@@ -15,6 +15,7 @@
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
+#include "range_coder.hpp"
 #include "segments.hpp"
 #include "tsm/tsm.hpp"
 
@@ -46,15 +47,16 @@ struct PartStreams {
   std::string_view attributes;  // empty: none
 };
 
-// A modelled binary decision costs at least -log2(4065/4096) = 0.011 bits
-// (12-bit probabilities adapted by 1/32), so a stream of n bytes (plus the 8
-// zero bytes a decoder may read past its end) holds at most 730 (n + 8)
-// decisions. Every own vertex costs at least 3 in the geometry stream, every
-// vertex of a segment 1 in its references stream, every triangle of the cut
-// surface at least 1 in the triangle-tree stream (a marching bit or a run's
-// end), every side-face corner at least 6 in the topology stream: counts
-// beyond that are forged, refused before allocating.
-uint64_t decisions(std::string_view stream) { return 730 * (static_cast<uint64_t>(stream.size()) + 8); }
+// A modelled binary decision costs at least 0.00282 bits (range_coder.hpp:
+// probabilities stay within 64/32768 of certainty), so a stream of n bytes
+// (plus the 8 zero bytes a decoder may read past its end) holds at most
+// max_decisions(n) = 2837 (n + 8) decisions. Every own vertex costs at least
+// 3 in the geometry stream, every vertex of a segment 1 in its references
+// stream, every triangle of the cut surface at least 1 in the triangle-tree
+// stream (a marching bit or a run's end), every side-face corner at least 6
+// in the topology stream: counts beyond that are forged, refused before
+// allocating.
+uint64_t decisions(std::string_view stream) { return max_decisions(stream.size()); }
 
 Status check_budget(const PartCounts& c, const PartStreams& s) {
   if (c.vertex_count >= 0x3FFFFFFFu || c.corner_count >= 0x3FFFFFFFu || c.face_count > c.corner_count)
@@ -693,6 +695,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   const GeometryStats& gs = parts[0].gstats;
   info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
                             : gs.predictor == Predictor::gate    ? "gate"
+                            : gs.predictor == Predictor::spread  ? "spread"
                                                                  : "parallelograms";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];

@@ -1,9 +1,10 @@
 // Connectivity coding (seed 004 §3-4, design notes §3-5): runs the stages
 // (mesh_cut -> vertex_tree -> bounding_loop -> triangle_tree) and codes
 // their output with the adaptive range coder in three streams:
-//   vertex tree:   per component, the tree's runs (length, leaf bit, last bit)
-//   triangle tree: per component, root position, runs (march count, end
-//                  type), marching bits, polygon-edge flags
+//   vertex tree:   per component, the tree's runs (length, leaf bit, last bit
+//                  for runs after their branching node's first)
+//   triangle tree: per component, root position, runs (end type, march
+//                  count), marching bits, polygon-edge flags
 //   topology:      component count, jump edges, virtual vertices, stitches,
 //                  side faces (degenerate faces kept verbatim)
 // The decoder reverses it and reassembles the exact input faces.
@@ -20,13 +21,16 @@ namespace {
 struct VertexTreeModels {
   UIntModel length[2];  // by previous run's end (0 branch, 1 leaf)
   Prob leaf[2];
-  Prob last;
+  // By the run's index among its branching node's children: 1, or 2 and
+  // more. The first child (index 0) is never the last (a branching node has
+  // at least two), so its bit is not coded.
+  Prob last[2];
 };
 
 struct TriangleTreeModels {
   UIntModel root;
-  UIntModel march[2];  // by previous run's end type
-  Prob end[2][2];      // [previous end][march == 0]
+  UIntModel march[2][2];  // [previous run's end type][this run's end type]
+  Prob end[2][2];         // [previous run's end][the end of the run before it]
   Prob bit[kMarchContexts];  // see MarchBitSource
   Prob diagonal[2];    // by previous flag
 };
@@ -80,6 +84,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   dec_tri.reserve(m.triangle_count());
   for (uint32_t p = 0; p < f.order.size(); ++p)
     if (f.parent[p] != kNone) last_child[f.parent[p]] = p;
+  std::vector<uint32_t> kids_seen(f.order.size(), 0);  // runs started so far at each branching node
 
   int prev_leaf = 1;
   for (uint32_t c = 0; c < C; ++c) {
@@ -91,7 +96,10 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       const int leaf = f.child_count[j] == 0;
       vm.length[prev_leaf].encode(ev, j - i);
       ev.bit(vm.leaf[prev_leaf], leaf);
-      if (i != start) ev.bit(vm.last, last_child[f.parent[i]] == i);
+      if (i != start) {
+        const uint32_t idx = kids_seen[f.parent[i]]++;
+        if (idx > 0) ev.bit(vm.last[idx > 1], last_child[f.parent[i]] == i);
+      }
       prev_leaf = leaf;
       ++st.vertex_runs;
       i = j + 1;
@@ -129,10 +137,11 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
         if (m.tri[3 * t + j] == first) rot[t] = j;
     }
     tm.root.encode(et, tr.root);
-    int prev_end = 1;
+    int prev_end = 1, prev_end2 = 1;
     for (size_t r = 0; r < tr.march.size(); ++r) {
-      tm.march[prev_end].encode(et, tr.march[r]);
-      et.bit(tm.end[prev_end][tr.march[r] == 0], tr.branch[r]);
+      et.bit(tm.end[prev_end][prev_end2], tr.branch[r]);
+      tm.march[prev_end][tr.branch[r]].encode(et, tr.march[r]);
+      prev_end2 = prev_end;
       prev_end = tr.branch[r];
     }
     {  // Marching bits, coded during the same walk the decoder makes.
@@ -262,7 +271,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   // Pre-order vertices: real + duplicates + virtual; the latter two are at
   // most one per corner each.
   const uint64_t max_positions = vertex_count + 2 * corner_count;
-  const uint64_t max_jumps = 730 * (static_cast<uint64_t>(in.topology.size()) + 8) / 6;
+  const uint64_t max_jumps = max_decisions(in.topology.size()) / 6;
   const uint32_t C = om.count.decode(dop);
   const bool polygons = dop.bit(om.has_polygons);
   if (C > max_positions) return corrupt("more components than vertices");
@@ -276,7 +285,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   std::vector<uint32_t>& twin = layout.twin;  // per decoded half-edge
   twin.clear();
   std::vector<uint8_t> tslot;
-  std::vector<uint32_t> stack;
+  std::vector<std::pair<uint32_t, uint32_t>> stack;  // branching node, runs started at it so far
   int prev_leaf = 1;
   for (uint32_t c = 0; c < C; ++c) {
     const uint32_t start = static_cast<uint32_t>(parent.size());
@@ -292,15 +301,16 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       uint32_t par = kNone;
       if (!root_run) {
         if (stack.empty()) return corrupt("vertex tree run without a parent");
-        par = stack.back();
-        if (dv.bit(vm.last)) stack.pop_back();
+        par = stack.back().first;
+        const uint32_t idx = stack.back().second++;
+        if (idx > 0 && dv.bit(vm.last[idx > 1])) stack.pop_back();
       }
       root_run = false;
       for (uint32_t i = 0; i <= len; ++i) {
         parent.push_back(par);
         par = static_cast<uint32_t>(parent.size() - 1);
       }
-      if (!leaf) stack.push_back(par);
+      if (!leaf) stack.push_back({par, 0});
       ++st.vertex_runs;
       if (leaf && stack.empty()) break;
     }
@@ -339,14 +349,15 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     tr.root = tm.root.decode(dt);
     uint32_t total = 0;
     uint64_t leaves = 0, branches = 0;
-    int prev_end = 1;
+    int prev_end = 1, prev_end2 = 1;
     for (;;) {
       if (overrun()) return corrupt("triangle tree stream is truncated");
-      uint32_t march = tm.march[prev_end].decode(dt);
+      const int br = dt.bit(tm.end[prev_end][prev_end2]);
+      uint32_t march = tm.march[prev_end][br].decode(dt);
       if (march == 0xFFFFFFFFu || total + static_cast<uint64_t>(march) + 1 > L) return corrupt("triangle run too long");
-      int br = dt.bit(tm.end[prev_end][march == 0]);
       tr.march.push_back(march);
       tr.branch.push_back(static_cast<uint8_t>(br));
+      prev_end2 = prev_end;
       prev_end = br;
       total += march + 1;
       // Pre-order runs form a full tree when leaves = branches + 1.

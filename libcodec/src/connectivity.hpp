@@ -151,9 +151,12 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
                             TriangleRuns& out);
 // The marching bits, asked for during the walk with their context: the
 // numbers of triangles already emitted around the gate's two vertices
-// (valence so far, capped at 7) and the previous bit of the run. The encoder
-// answers from its bits, the decoder from the range coder.
-constexpr int kMarchContexts = 8 * 8 * 3;
+// (valence so far, capped at 7), the previous bit of the run, and how often
+// each of the two candidate vertices (the loop vertex after b, for a right
+// march, and the one before a, for a left march) occurs on the loop (its
+// degree in the cut, capped at 3). The encoder answers from its bits, the
+// decoder from the range coder.
+constexpr int kMarchContexts = 8 * 8 * 3 * 3 * 3;
 struct MarchBitSource {
   virtual int bit(int ctx) = 0;
   virtual ~MarchBitSource() = default;

@@ -11,7 +11,7 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 2;
+constexpr uint16_t kFormatVersion = 3;
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder

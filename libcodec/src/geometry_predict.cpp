@@ -11,6 +11,13 @@
 //    flags). With none, the average of p's decoded neighbours.
 //  - gate: the same order, only the parallelogram across the gate (the edge
 //    the march entered by); cheaper to decode.
+//  - spread: as parallelograms, but a vertex with two or more parallelograms
+//    takes its residual context per axis from their spread (the largest
+//    minus the smallest of the single parallelogram predictions on that
+//    axis) instead of the activity: where the parallelograms disagree the
+//    vertex is usually near one of them, so far from their average (on
+//    scanned grids, say; on marching-cubes surfaces the activity does
+//    better, and the encoder keeps whichever is smaller).
 //  - ancestors: the paper's predictor, vertex-tree order, P = sum lambda_i
 //    v_{n-i} over the K nearest tree ancestors, lambda fitted per mesh by
 //    least squares (Eigen) and stored as 16.16 fixed point.
@@ -114,6 +121,7 @@ struct Coder {
   // parallelogram average against the neighbour average, 4.12 fixed point
   // (4096 = parallelograms only), fitted per mesh by least squares.
   int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
+  bool spread_ctx = false;  // predictor spread: contexts from the parallelograms' spread
   bool collect = false;
   std::vector<std::pair<int64_t, int64_t>> samples[3];  // encoder's fit: (P - N, x - N) per coordinate
   std::vector<uint32_t> nearest[3];  // per axis, per grid value: nearest plane (when qmax < 2^18)
@@ -142,12 +150,16 @@ struct Coder {
     }
   }
 
+  // spread: per axis the spread of the parallelogram predictions (>= 0),
+  // the context instead of the activity; null to use the activity.
   template <class Sink>
-  bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity) {
+  bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
+              const int64_t* spread = nullptr) {
     uint64_t sum = 0, top = 0;
     int on_count = 0;
     for (int a = 0; a < 3; ++a) {
-      int ctx = a == 0 ? activity : (activity + bit_length(top) + 1) / 2;
+      int ctx = spread ? bit_length(static_cast<uint64_t>(spread[a]))
+                       : a == 0 ? activity : (activity + bit_length(top) + 1) / 2;
       ctx = std::min(ctx, kActivity - 1);
       const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
@@ -213,6 +225,7 @@ struct SurfaceCoder {
   bool code(uint32_t h0, bool multi) {
     const uint32_t v = g.vertex[g.tri[h0]];
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, pred[3];
+    int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // per axis, the smallest and largest parallelogram
     int npara = 0, nnb = 0, actsum = 0;
     auto neighbour = [&](uint32_t u) {
       for (int a = 0; a < 3; ++a) nb[a] += at(u)[a];
@@ -227,7 +240,12 @@ struct SurfaceCoder {
       if (w == kNone) return;
       uint32_t o = known(g.tri[he_prev(g.twin[he_next(h)])]);
       if (o == kNone) return;
-      for (int a = 0; a < 3; ++a) para[a] += int64_t{at(u)[a]} + at(w)[a] - at(o)[a];
+      for (int a = 0; a < 3; ++a) {
+        const int64_t x = int64_t{at(u)[a]} + at(w)[a] - at(o)[a];
+        para[a] += x;
+        lo[a] = npara ? std::min(lo[a], x) : x;
+        hi[a] = npara ? std::max(hi[a], x) : x;
+      }
       ++npara;
     };
     if (multi) {
@@ -259,10 +277,13 @@ struct SurfaceCoder {
       for (int a = 0; a < 3; ++a) pred[a] = last[a];
       cls = 0;
     }
-    return point(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act);
+    int64_t spread[3];
+    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+    return point(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
+                 c.spread_ctx && npara >= 2 ? spread : nullptr);
   }
-  bool point(uint32_t v, const int64_t pred[3], int cls, int activity) {
-    if (!c.vertex(s, q, v, pred, cls, activity)) return false;
+  bool point(uint32_t v, const int64_t pred[3], int cls, int activity, const int64_t* spread = nullptr) {
+    if (!c.vertex(s, q, v, pred, cls, activity, spread)) return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = c.act[v];
     return true;
@@ -513,7 +534,7 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
   fit.collect = true;
   CollectSink cs;
   std::vector<uint32_t> work = q;
-  if (pred == Predictor::parallelograms)
+  if (pred == Predictor::parallelograms || pred == Predictor::spread)
     code_greedy(g, fit, cs, work);
   else
     code_march_order(g, false, fit, cs, work);
@@ -541,6 +562,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
     for (int i = 0; i < K; ++i) w.u32(static_cast<uint32_t>(lambda[i]));
   }
   Coder c(g.vertex_count, bits);
+  c.spread_ctx = pred == Predictor::spread;
   if (pred != Predictor::ancestors)
     for (int k = 0; k < 3; ++k) {
       c.alpha[k] = weights ? weights[k] : kAlphaOne;
@@ -553,7 +575,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   std::vector<uint32_t> work = q;
   if (pred == Predictor::ancestors)
     code_ancestors(g, K, lambda, c, s, work);
-  else if (pred == Predictor::parallelograms)
+  else if (pred == Predictor::parallelograms || pred == Predictor::spread)
     code_greedy(g, c, s, work);
   else
     code_march_order(g, false, c, s, work);
@@ -678,6 +700,11 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   // The least-squares weights instead of the size estimate's.
   if (level >= 3 && std::memcmp(lsq, est, sizeof lsq) != 0) consider(st.predictor, 0, st.lattice, lsq);
+  // Residual contexts from the parallelograms' spread instead of the activity.
+  if (level >= 3) {
+    const Lattice lattice = st.lattice;
+    consider(Predictor::spread, 0, lattice, weights);
+  }
   // Averaging every parallelogram loses where some of them are poor (across
   // the rows of a latitude-longitude grid, say): the gate's alone, in march
   // order, with its own weights.
@@ -703,7 +730,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   GeometryStats st;
   uint8_t kind;
   if (!r.u8(kind)) return corrupt("empty section");
-  if (kind > static_cast<uint8_t>(Predictor::gate)) return corrupt("unknown predictor " + std::to_string(kind));
+  if (kind > static_cast<uint8_t>(Predictor::spread)) return corrupt("unknown predictor " + std::to_string(kind));
   st.predictor = static_cast<Predictor>(kind);
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (st.predictor == Predictor::ancestors) {
@@ -729,6 +756,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   const size_t at = r.offset();
   Coder c(g.vertex_count, bits);
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
+  c.spread_ctx = st.predictor == Predictor::spread;
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");
@@ -741,7 +769,9 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       if (g.parent[v] != kNone && g.parent[v] >= v) return corrupt("bad vertex tree parent");
     ok = code_ancestors(g, st.ancestors, lambda, c, s, q);
   } else {
-    ok = st.predictor == Predictor::parallelograms ? code_greedy(g, c, s, q) : code_march_order(g, false, c, s, q);
+    ok = st.predictor == Predictor::parallelograms || st.predictor == Predictor::spread
+             ? code_greedy(g, c, s, q)
+             : code_march_order(g, false, c, s, q);
   }
   if (!ok) return corrupt(s.truncated() ? "stream is truncated" : "coordinate outside the grid");
   if (s.truncated()) return corrupt("stream is truncated");

@@ -27,6 +27,7 @@ enum class Predictor : uint8_t {
   ancestors = 0,      // seed 004 §3.2: sum lambda_i v_{n-i} over K tree ancestors, vertex-tree order
   parallelograms = 1, // march order; average of every parallelogram around the new vertex
   gate = 2,           // march order; the single parallelogram across the gate (fast)
+  spread = 3,         // as parallelograms; residual contexts from the parallelograms' spread
 };
 
 // Per axis, the sorted coordinate values many vertices share (the voxel

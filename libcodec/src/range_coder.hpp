@@ -1,31 +1,71 @@
 // Adaptive binary range coder (entropy coding stage; replaces the Huffman
 // coding of seed 004 §3-4, see design notes §6 "a real entropy coder with
-// adaptive contexts"). Probabilities are 12-bit, adapted by a shift after each
-// bit; integers are coded as an adaptive bit length class followed by
-// mantissa bits (the top ones modelled, the rest direct).
+// adaptive contexts"; FORMAT.md §5). Probabilities are 15-bit; each model
+// counts its updates and adapts by a shift that grows with the count (about
+// log2(n + 2): the first bits it sees move it like a frequency count, later
+// ones average over 2^7 bits), and stays within [kProbMin, kProbMax] so that
+// every modelled decision costs at least log2(32768 / 32704) bits (the stream
+// budget below). Integers are coded as an adaptive bit length class followed
+// by mantissa bits (the top ones modelled, the rest direct).
 //
 // The decoder is safe on any input: reading past the end yields zero bytes
 // and counts an overrun, which callers check (overrun() != 0 => corrupt).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
 
 namespace tsm {
 
-constexpr int kProbBits = 12;
+constexpr int kProbBits = 15;
 constexpr uint32_t kProbOne = 1u << kProbBits;
-constexpr int kAdaptShift = 5;
+constexpr uint32_t kProbMax = kProbOne - 64;  // probability of a 0 bit, at most
+constexpr uint32_t kProbMin = 64;             // and at least
+constexpr int kAdaptLimit = 7;                // the slowest adaptation: by 1/128
+constexpr int kAdaptCountMax = 1 << kAdaptLimit;
+
+// Every modelled decision costs at least -log2(kProbMax / kProbOne) =
+// 0.00282 bits, so n coded bytes hold at most 2837 n decisions: the decoder
+// refuses counts a stream is too short to code before it allocates for them
+// (FORMAT.md §9, the stream budget).
+constexpr uint64_t kMaxDecisionsPerByte = 2837;
+inline uint64_t max_decisions(uint64_t stream_bytes) { return kMaxDecisionsPerByte * (stream_bytes + 8); }
+
+// The shift of a model's n-th update: floor(log2(n + 2)), at most kAdaptLimit.
+struct AdaptTable {
+  uint8_t shift[kAdaptCountMax + 1];
+  constexpr AdaptTable() : shift() {
+    for (int n = 0; n <= kAdaptCountMax; ++n) {
+      int s = 0;
+      while ((2 << s) <= n + 2) ++s;
+      shift[n] = static_cast<uint8_t>(s < kAdaptLimit ? s : kAdaptLimit);
+    }
+  }
+};
+inline constexpr AdaptTable kAdapt{};
 
 struct Prob {
-  uint16_t p = kProbOne / 2;  // probability of a 0 bit, in 1/4096
+  uint16_t p = kProbOne / 2;  // probability of a 0 bit, in 1/32768
+  uint16_t n = 0;             // updates so far, up to kAdaptCountMax
 };
+
+template <class P>
+inline void adapt(P& prob, int b) {
+  const int s = kAdapt.shift[prob.n];
+  prob.n = static_cast<uint16_t>(prob.n + (prob.n < kAdaptCountMax));
+  if (!b)
+    prob.p = static_cast<uint16_t>(std::min<uint32_t>(prob.p + ((kProbOne - prob.p) >> s), kProbMax));
+  else
+    prob.p = static_cast<uint16_t>(std::max<uint32_t>(prob.p - (prob.p >> s), kProbMin));
+}
 
 // A probability its model initializes on first use (the mantissa rows of
 // UIntModelT): a model set of many contexts then costs nothing to create,
 // so a small mesh or segment does not pay for the contexts it never uses.
 struct LazyProb {
   uint16_t p;
+  uint16_t n;
 };
 
 class RangeEncoder {
@@ -35,12 +75,11 @@ class RangeEncoder {
     uint32_t bound = (range_ >> kProbBits) * prob.p;
     if (!b) {
       range_ = bound;
-      prob.p = static_cast<uint16_t>(prob.p + ((kProbOne - prob.p) >> kAdaptShift));
     } else {
       low_ += bound;
       range_ -= bound;
-      prob.p = static_cast<uint16_t>(prob.p - (prob.p >> kAdaptShift));
     }
+    adapt(prob, b);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       shift_low();
@@ -80,14 +119,13 @@ class RangeDecoder {
     int b;
     if (code_ < bound) {
       range_ = bound;
-      prob.p = static_cast<uint16_t>(prob.p + ((kProbOne - prob.p) >> kAdaptShift));
       b = 0;
     } else {
       code_ -= bound;
       range_ -= bound;
-      prob.p = static_cast<uint16_t>(prob.p - (prob.p >> kAdaptShift));
       b = 1;
     }
+    adapt(prob, b);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       code_ = (code_ << 8) | next_byte();
@@ -164,7 +202,7 @@ struct UIntModelT {
   LazyProb mantissa[33][1 << M];
   LazyProb* row(int n) {
     if (!((ready >> n) & 1)) {
-      for (LazyProb& q : mantissa[n]) q.p = kProbOne / 2;
+      for (LazyProb& q : mantissa[n]) q = LazyProb{kProbOne / 2, 0};
       ready |= uint64_t{1} << n;
     }
     return mantissa[n];

@@ -121,8 +121,11 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   auto bwd = [L](uint32_t p, uint32_t d) { return (p + L - d) % L; };
   if (loop.size() != L) return corrupt("loop length mismatch");
   std::vector<uint32_t> valence(n, 0);  // triangles emitted so far around each vertex
-  for (uint32_t p = 0; p < L; ++p)
+  std::vector<uint8_t> visits(n, 0);    // loop positions of each vertex (its tree degree), capped at 3
+  for (uint32_t p = 0; p < L; ++p) {
     if (loop[p] >= n) return corrupt("loop vertex out of range");
+    if (visits[loop[p]] < 3) ++visits[loop[p]];
+  }
   uint32_t k = 0;
   auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) {
     ++valence[loop[a]];
@@ -152,8 +155,9 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
     for (uint32_t i = 0; i < runs.march[ri]; ++i) {
       uint32_t span = (cur.a + L - cur.b) % L;
       if (span < 3) return corrupt("a march step leaves no room for the rest of the run");
-      const int ctx = (static_cast<int>(std::min<uint32_t>(valence[loop[cur.a]], 7)) * 8 +
-                       static_cast<int>(std::min<uint32_t>(valence[loop[cur.b]], 7))) * 3 + prev;
+      const int ctx = ((static_cast<int>(std::min<uint32_t>(valence[loop[cur.a]], 7)) * 8 +
+                        static_cast<int>(std::min<uint32_t>(valence[loop[cur.b]], 7))) * 3 + prev) * 9 +
+                      (visits[loop[fwd(cur.b, 1)]] - 1) * 3 + (visits[loop[bwd(cur.a, 1)]] - 1);
       prev = bits.bit(ctx);
       ++bit_count;
       if (prev == 0) {
