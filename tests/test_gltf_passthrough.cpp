@@ -847,3 +847,42 @@ TEST(GltfPassThrough, WithoutTheEntryTheWriterIsUnchanged) {
 }
 
 }  // namespace
+
+namespace {
+
+// fuzz_read_mesh (session 5, crash-3cc75120, after 142k executions): a mesh
+// without "primitives" (glTF requires them; tinygltf reads none) was kept,
+// but building the pass-through entry looked its primitives up with JSON
+// operator[], which added "primitives": null to the stored document, and
+// the document written from it was refused on reading ("'primitives' does
+// not match what tinygltf read"). Both files must read, and the written one
+// must give the same mesh back.
+TEST(GltfPassThrough, MeshWithoutPrimitivesSurvivesTheRoundTrip) {
+  Doc d;
+  d.doc["asset"] = {{"version", "2.0"}};
+  const size_t pos = add_positions(d, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+  d.doc["meshes"] = json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", pos}}}}})}},
+                                 json{{"name", "no primitives"}, {"primitNOFF", json::array()}}});
+  d.doc["nodes"] = json::array({json{{"mesh", 0}}, json{{"mesh", 1}}});
+  d.doc["scenes"] = json::array({json{{"nodes", {0, 1}}}});
+  d.doc["scene"] = 0;
+  d.doc["buffers"] = json::array({json{{"byteLength", d.bin.size()}}});
+  Mesh m;
+  ASSERT_TRUE(read_doc(to_glb(d), m).ok());
+  ASSERT_NE(m.find_metadata("gltf"), nullptr);
+  EXPECT_EQ(m.face_count(), 1u);
+  for (bool binary : {true, false}) {
+    const std::string out = write_doc(m, binary);
+    Doc o;
+    ASSERT_TRUE(parse_output(out, o));
+    EXPECT_FALSE(o.doc["meshes"][1].contains("primitives")) << o.doc["meshes"][1].dump();
+    EXPECT_EQ(o.doc["meshes"][1]["name"], "no primitives");
+    Mesh back;
+    const Status s = tsm::read_gltf(out, binary ? "out.glb" : "out.gltf", back, tsm::ReadOptions(), nullptr);
+    ASSERT_TRUE(s.ok()) << s.to_string();
+    EXPECT_EQ(back.positions, m.positions);
+    EXPECT_EQ(back.indices, m.indices);
+  }
+}
+
+}  // namespace

@@ -1472,8 +1472,12 @@ class GltfReader {
     // Draco data of primitives not read (meshes outside the scene).
     std::vector<ojson*> draco;
     if (meshes)
-      for (size_t m = 0; m < meshes->size(); ++m)
-        for (ojson& prim : (*meshes)[m]["primitives"]) {
+      for (size_t m = 0; m < meshes->size(); ++m) {
+        // find, not operator[]: that would add "primitives": null to a mesh
+        // without any (the written document was then refused on reading).
+        auto prims = (*meshes)[m].find("primitives");
+        if (prims == (*meshes)[m].end() || !prims->is_array()) continue;
+        for (ojson& prim : *prims) {
           if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object()) continue;
           ojson& ext = prim["extensions"];
           if (!ext.contains("KHR_draco_mesh_compression")) continue;
@@ -1484,6 +1488,7 @@ class GltfReader {
             draco.push_back(&d);
           }
         }
+      }
     std::string bin;
     std::vector<size_t> new_view(nviews, 0);
     ojson kept_views = ojson::array();
