@@ -10,6 +10,7 @@
 
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
+#include "tsm/io.hpp"
 #include "tsm/tsm.hpp"
 
 using namespace tsm;
@@ -253,6 +254,38 @@ TEST(Attributes, EncoderRefusesBadAttributes) {
   EXPECT_NE(s.message().find("id"), std::string::npos) << s.message();
   m.attributes[0].values.pop_back();  // wrong size
   EXPECT_EQ(encode(m, EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
+}
+
+// fuzz_read_mesh (session 5, crash-2b31933c): a PLY property name of 1,118
+// bytes became an attribute the encoder wrote and the decoder refused
+// ("truncated attribute header": names are at most 1024 bytes). Now the
+// limit is the mesh's (Mesh::valid, so encode refuses it with the reason)
+// and the PLY reader's, and a name of exactly 1024 bytes round-trips.
+TEST(Attributes, LongNamesAreRefusedBeforeTheEncoderWritesThem) {
+  Mesh m = icosphere(1);
+  Attribute a = make(std::string(kMaxAttributeNameBytes, 'n'), AttributeKind::generic, AttributeDomain::vertex,
+                     AttributeType::u8, 1);
+  a.values.assign(m.vertex_count(), 7.0f);
+  m.attributes = {a};
+  std::string bytes;
+  ASSERT_TRUE(encode(m, EncodeOptions{}, bytes).ok());
+  Mesh back;
+  ASSERT_TRUE(decode(bytes, back).ok());
+  ASSERT_EQ(back.attributes.size(), 1u);
+  EXPECT_EQ(back.attributes[0].name, m.attributes[0].name);
+  m.attributes[0].name += 'n';
+  std::string why;
+  EXPECT_FALSE(m.valid(&why));
+  EXPECT_NE(why.find("1025 bytes"), std::string::npos) << why;
+  const Status s = encode(m, EncodeOptions{}, bytes);
+  EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
+  EXPECT_NE(s.message().find("1025 bytes"), std::string::npos) << s.message();
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                          "property float z\nproperty float " + std::string(1118, 'p') + "\nend_header\n0 0 0 1\n";
+  Mesh r;
+  const Status rs = read_ply(ply, "long.ply", r, ReadOptions{}, nullptr);
+  EXPECT_EQ(rs.code(), ErrorCode::parse_error) << rs.to_string();
+  EXPECT_NE(rs.message().find("1118 bytes"), std::string::npos) << rs.message();
 }
 
 TEST(Attributes, DamagedAttributeStreamsAreRefused) {

@@ -894,7 +894,10 @@ class GltfReader {
 
   Status read_attribute(const std::string& semantic, int accessor, size_t vertex_count, const std::string& where,
                         VertexGroup& g) {
-    const std::string what = where + " " + semantic;
+    const std::string what = where + " " + semantic.substr(0, 64);
+    if (semantic.size() > kMaxAttributeNameBytes)
+      return error(what + "...: an attribute name of " + std::to_string(semantic.size()) +
+                   " bytes; tsm keeps names of at most " + std::to_string(kMaxAttributeNameBytes) + " bytes");
     AccessorView v;
     TSM_RETURN_IF_ERROR(view_accessor(accessor, what, v));
     if (v.count != vertex_count)

@@ -419,6 +419,9 @@ class PlyReader {
         }
         std::string_view pn = cur.token();
         if (pn.empty()) return cur.error("'property' has no name");
+        if (pn.size() > kMaxAttributeNameBytes)
+          return cur.error("a property name of " + std::to_string(pn.size()) + " bytes; tsm keeps names of at most " +
+                           std::to_string(kMaxAttributeNameBytes) + " bytes (rename the property)");
         p.name = std::string(pn);
         elements_.back().props.push_back(std::move(p));
       } else if (kw == "end_header") {

@@ -90,7 +90,10 @@ bool Mesh::valid(std::string* why) const {
                   " of " + std::to_string(nv));
   for (size_t k = 0; k < attributes.size(); ++k) {
     const Attribute& a = attributes[k];
-    const std::string what = "attribute " + std::to_string(k) + " ('" + a.name + "')";
+    const std::string what = "attribute " + std::to_string(k) + " ('" + a.name.substr(0, 64) + "')";
+    if (a.name.size() > kMaxAttributeNameBytes)
+      return fail(what + ": a name of " + std::to_string(a.name.size()) + " bytes (at most " +
+                  std::to_string(kMaxAttributeNameBytes) + ")");
     if (a.components < 1 || a.components > 4) return fail(what + " has " + std::to_string(a.components) + " components (1..4)");
     if (a.values.size() % a.components != 0) return fail(what + ": values size is not a multiple of its components");
     if (static_cast<uint8_t>(a.kind) > 3 || static_cast<uint8_t>(a.domain) > 2 || static_cast<uint8_t>(a.type) > 3)

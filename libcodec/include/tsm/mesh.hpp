@@ -36,8 +36,11 @@ enum class AttributeType : uint8_t { f32 = 0, u8 = 1, u16 = 2, i32 = 3 };
 // corner (in the order of Mesh::indices) naming a value; values may repeat
 // or be used by no corner (OBJ's vt / vn lists, glTF seams): all of it is
 // kept as given.
+// The longest attribute name the format stores (FORMAT.md §8.12).
+constexpr size_t kMaxAttributeNameBytes = 1024;
+
 struct Attribute {
-  std::string name;  // "normal", "color", "texcoord", or the file's own name
+  std::string name;  // "normal", "color", "texcoord", or the file's own name; at most kMaxAttributeNameBytes
   AttributeKind kind = AttributeKind::generic;
   AttributeDomain domain = AttributeDomain::vertex;
   AttributeType type = AttributeType::f32;
