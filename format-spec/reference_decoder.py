@@ -633,7 +633,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             reject('two-vertex component')
         # -- jump edges (stream 5)
         nj = o_count.decode(do)
-        if nj > 2837 * (len(s5) + 8) // 6 or nj % 2 or overrun():
+        if nj > 2843 * (len(s5) + 8) // 6 or nj % 2 or overrun():
             reject('jump count')
         jumps = []
         corner = 0
@@ -1691,7 +1691,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                     o = walk.face_offsets[g]
                     walk.update_sigma([walk.values[indices[o + i]] for i in range(len(f))])
             U = m.unused.decode(d)
-            if U == INVALID or U > 2837 * (len(coded) + 8):
+            if U == INVALID or U > 2843 * (len(coded) + 8):
                 reject('attributes: corner values of %r are invalid' % h.name)
             for _ in range(U):
                 decode_value(d, m, walk, ('unused',))
@@ -1786,7 +1786,7 @@ def decode_part(streams, counts, bits, earlier, trace):
         reject('counts')                                             # step 26
     if rc > vc:
         reject('references')
-    D = lambda b: 2837 * (len(b) + 8)
+    D = lambda b: 2843 * (len(b) + 8)
     if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + D(s5) // 6:
         reject('stream budget')
     if sr is not None and vc > D(sr):

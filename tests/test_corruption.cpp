@@ -21,7 +21,6 @@
 #include <zstd.h>
 
 #include <algorithm>
-#include <iostream>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -29,6 +28,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <new>
 #include <random>

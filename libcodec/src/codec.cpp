@@ -47,10 +47,10 @@ struct PartStreams {
   std::string_view attributes;  // empty: none
 };
 
-// A modelled binary decision costs at least 0.00282 bits (range_coder.hpp:
+// A modelled binary decision costs at least 0.0028146 bits (range_coder.hpp:
 // probabilities stay within 64/32768 of certainty), so a stream of n bytes
 // (plus the 8 zero bytes a decoder may read past its end) holds at most
-// max_decisions(n) = 2837 (n + 8) decisions. Every own vertex costs at least
+// max_decisions(n) = 2843 (n + 8) decisions. Every own vertex costs at least
 // 3 in the geometry stream, every vertex of a segment 1 in its references
 // stream, every triangle of the cut surface at least 1 in the triangle-tree
 // stream (a marching bit or a run's end), every side-face corner at least 6

@@ -4,8 +4,7 @@
 // counts its updates and adapts by a shift that grows with the count (about
 // log2(n + 2): the first bits it sees move it like a frequency count, later
 // ones average over 2^7 bits), and stays within [kProbMin, kProbMax] so that
-// every modelled decision costs at least log2(32768 / 32704) bits (the stream
-// budget below). Integers are coded as an adaptive bit length class followed
+// every modelled decision costs a minimum (the stream budget below). Integers are coded as an adaptive bit length class followed
 // by mantissa bits (the top ones modelled, the rest direct).
 //
 // The decoder is safe on any input: reading past the end yields zero bytes
@@ -25,11 +24,12 @@ constexpr uint32_t kProbMin = 64;             // and at least
 constexpr int kAdaptLimit = 7;                // the slowest adaptation: by 1/128
 constexpr int kAdaptCountMax = 1 << kAdaptLimit;
 
-// Every modelled decision costs at least -log2(kProbMax / kProbOne) =
-// 0.00282 bits, so n coded bytes hold at most 2837 n decisions: the decoder
-// refuses counts a stream is too short to code before it allocates for them
-// (FORMAT.md §9, the stream budget).
-constexpr uint64_t kMaxDecisionsPerByte = 2837;
+// A modelled decision keeps at most 1 - 64/32768 + 64/2^24 of the range
+// (p within [64, 32704], and the rounding of range >> 15 with range >= 2^24),
+// so it costs at least 0.0028146 bits and n coded bytes hold at most 2843 n
+// decisions: the decoder refuses counts a stream is too short to code
+// before it allocates for them (FORMAT.md §9, the stream budget).
+constexpr uint64_t kMaxDecisionsPerByte = 2843;
 inline uint64_t max_decisions(uint64_t stream_bytes) { return kMaxDecisionsPerByte * (stream_bytes + 8); }
 
 // The shift of a model's n-th update: floor(log2(n + 2)), at most kAdaptLimit.

@@ -110,8 +110,8 @@ struct FileInfo {
   uint64_t reference_bytes = 0;  // part of other: the segments' references streams
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
-  // Geometry (from decoding the geometry stream): "parallelograms", "gate"
-  // or "ancestors" (with K), and the lattice planes per axis (0 = unused).
+  // Geometry (from decoding the geometry stream): "parallelograms", "spread",
+  // "gate" or "ancestors" (with K), and the lattice planes per axis (0 = unused).
   std::string geometry_predictor;
   int ancestors = 0;
   uint32_t lattice_planes[3] = {0, 0, 0};
