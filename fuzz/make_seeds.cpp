@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "base64.hpp"
 #include "mesh_gen.hpp"
 #include "tsm/io.hpp"
 #include "tsm/tsm.hpp"
@@ -246,18 +247,6 @@ void handwritten(const fs::path& dir) {
       "endsolid named thing\n");
 }
 
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < in.size(); i += 3) {
-    const size_t n = std::min<size_t>(3, in.size() - i);  // n bytes give n + 1 characters
-    uint32_t v = 0;
-    for (size_t j = 0; j < 3; ++j) v = v << 8 | (j < n ? static_cast<unsigned char>(in[i + j]) : 0u);
-    for (size_t j = 0; j < 4; ++j) out += j <= n ? k[(v >> (18 - 6 * j)) & 63] : '=';
-  }
-  return out;
-}
-
 // A .gltf document as exporters write it: two meshes (one with two
 // primitives sharing a POSITION accessor, one with a morph target), three
 // materials, a node tree with a transform, a camera, an image in a buffer
@@ -290,7 +279,7 @@ std::string gltf_document() {
          R"({"bufferView":2,"byteOffset":48,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[0,0,0.75]}],)" +
          R"("bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12},)" +
          R"({"buffer":0,"byteOffset":60,"byteLength":96},{"buffer":0,"byteOffset":156,"byteLength":12}],)" +
-         R"("buffers":[{"byteLength":168,"uri":"data:application/octet-stream;base64,)" + base64(bin) + R"("}],)" +
+         R"("buffers":[{"byteLength":168,"uri":"data:application/octet-stream;base64,)" + tsm_test::base64(bin) + R"("}],)" +
          R"("extensionsUsed":["EXT_x"],"extensions":{"EXT_x":{"a":1}},"extras":{"k":[1,"two",null]}})";
 }
 

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "base64.hpp"
 #include "test_util.hpp"
 #include "tsm/compare.hpp"
 #include "tsm/io.hpp"
@@ -41,26 +42,6 @@ using tsm_test::contains;
 
 // ---------------------------------------------------------------------------
 // GLB / .gltf containers (test side)
-
-std::string b64_encode(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  size_t i = 0;
-  auto byte = [&](size_t j) { return static_cast<uint32_t>(static_cast<unsigned char>(in[j])); };
-  for (; i + 2 < in.size(); i += 3) {
-    const uint32_t v = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
-    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
-  }
-  if (i < in.size()) {
-    uint32_t v = byte(i) << 16;
-    if (i + 1 < in.size()) v |= byte(i + 1) << 8;
-    out += k[(v >> 18) & 63];
-    out += k[(v >> 12) & 63];
-    out += i + 1 < in.size() ? k[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
 
 std::string b64_decode(const std::string& in) {
   std::string out;
@@ -206,7 +187,7 @@ const std::string& png_bytes() {
   }();
   return s;
 }
-const std::string kDataUriImage = "data:image/png;base64," + b64_encode(std::string("\x89PNG\r\n\x1a\nsmall", 13));
+const std::string kDataUriImage = "data:image/png;base64," + tsm_test::base64(std::string("\x89PNG\r\n\x1a\nsmall", 13));
 
 // Two meshes in the scene (the body: two primitives with two materials
 // sharing one vertex set; the wheel: a triangle fan with colours and a morph

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "base64.hpp"
 #include "test_util.hpp"
 #include "tsm/io.hpp"
 
@@ -125,26 +126,7 @@ Status read(const std::string& bytes, Mesh& m, ReadInfo* info = nullptr, const R
 // ---------------------------------------------------------------------------
 // Hand-made files
 
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const uint32_t v = static_cast<uint32_t>(static_cast<unsigned char>(in[i])) << 16 |
-                       static_cast<uint32_t>(static_cast<unsigned char>(in[i + 1])) << 8 |
-                       static_cast<unsigned char>(in[i + 2]);
-    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
-  }
-  if (i < in.size()) {
-    uint32_t v = static_cast<uint32_t>(static_cast<unsigned char>(in[i])) << 16;
-    if (i + 1 < in.size()) v |= static_cast<uint32_t>(static_cast<unsigned char>(in[i + 1])) << 8;
-    out += k[(v >> 18) & 63];
-    out += k[(v >> 12) & 63];
-    out += i + 1 < in.size() ? k[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
+using tsm_test::base64;
 
 // Little-endian binary buffer builder.
 struct Bin {
