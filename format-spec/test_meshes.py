@@ -43,6 +43,18 @@ def write_obj(path, V, F):
             f.write('f ' + ' '.join(str(i + 1) for i in fa) + '\n')
 
 
+def sphere_rings(v, n_, m_):
+    """The rings of a latitude-longitude unit sphere, made with v(x, y, z):
+    ring[i, j] for latitudes 1 .. n_ - 1 and longitudes 0 .. m_ - 1."""
+    ring = {}
+    for i in range(1, n_):
+        th = math.pi * i / n_
+        for j in range(m_):
+            ph = 2 * math.pi * j / m_
+            ring[i, j] = v(math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th))
+    return ring
+
+
 def mixed(n_=30, m_=60):
     V, F = [], []
 
@@ -50,12 +62,7 @@ def mixed(n_=30, m_=60):
         V.append((x, y, z))
         return len(V) - 1
     top = v(0, 0, 1)
-    ring = {}
-    for i in range(1, n_):
-        th = math.pi * i / n_
-        for j in range(m_):
-            ph = 2 * math.pi * j / m_
-            ring[i, j] = v(math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th))
+    ring = sphere_rings(v, n_, m_)
     bot = v(0, 0, -1)
     for j in range(m_):
         F.append([top, ring[1, j], ring[1, (j + 1) % m_]])
@@ -359,12 +366,7 @@ def uv_corner_obj(path):
         F.append(cs)
     n_, m_ = 14, 24
     top, bot = v(0, 0, 1), v(0, 0, -1)
-    ring = {}
-    for i in range(1, n_):
-        th = math.pi * i / n_
-        for j in range(m_):
-            ph = 2 * math.pi * j / m_
-            ring[i, j] = v(math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th))
+    ring = sphere_rings(v, n_, m_)
 
     def st(i, j):                                          # sphere chart: column m_ is the seam's copy
         return vt(('s', i, j), 0.5 * j / m_, 0.5 * (1 - i / n_))
