@@ -284,6 +284,24 @@ void store_f32(unsigned char* p, float f) {
   store_u32(p, b);
 }
 
+// The bytes of a buffer view the writers add: `elements` elements of `elem`
+// bytes each, appended to `data` at a multiple of 4 and filled by
+// put(i, dst). Vertex data (ARRAY_BUFFER) gets a stride that is a multiple
+// of 4 (the spec's alignment rule: u8 RGB colours take 4 bytes each);
+// indices are packed. Returns the view's offset and stride.
+struct ViewBytes {
+  size_t offset, stride;
+};
+template <class Bytes, class Put>
+ViewBytes append_view_bytes(Bytes& data, size_t elements, size_t elem, int target, Put put) {
+  const size_t stride = target == TINYGLTF_TARGET_ARRAY_BUFFER ? (elem + 3) & ~size_t{3} : elem;
+  while (data.size() % 4) data.push_back(0);
+  const size_t at = data.size();
+  data.resize(at + elements * stride, 0);
+  for (size_t i = 0; i < elements; ++i) put(i, reinterpret_cast<unsigned char*>(&data[at + i * stride]));
+  return {at, stride};
+}
+
 // One component as float: floats keep their exact bits; integers are their
 // value, or the spec's normalized decoding.
 float load_value(int ct, bool normalized, const unsigned char* p) {
@@ -1727,17 +1745,10 @@ class GltfWriter {
  private:
   Status check() const { return check_writable(mesh_, false); }
 
-  // Appends a buffer view of `elements` elements of `elem` bytes each,
-  // filled by put(i, dst); returns its index. Vertex data gets a stride
-  // that is a multiple of 4 (the spec's alignment rule: u8 RGB colours take
-  // 4 bytes each); indices are packed.
+  // Appends a buffer view (append_view_bytes); returns its index.
   template <typename Put>
   int add_view(size_t elements, size_t elem, int target, Put put) {
-    const size_t stride = target == TINYGLTF_TARGET_ARRAY_BUFFER ? (elem + 3) & ~size_t{3} : elem;
-    while (data_.size() % 4) data_.push_back(0);
-    const size_t at = data_.size();
-    data_.resize(at + elements * stride, 0);
-    for (size_t i = 0; i < elements; ++i) put(i, data_.data() + at + i * stride);
+    const auto [at, stride] = append_view_bytes(data_, elements, elem, target, put);
     tinygltf::BufferView view;
     view.buffer = 0;
     view.byteOffset = at;
@@ -2073,15 +2084,10 @@ class PassThroughWriter {
     return Status::Ok();
   }
 
-  // Appends a buffer view of `elements` elements of `elem` bytes (vertex
-  // data: a stride that is a multiple of 4), filled by put(i, dst).
+  // Appends a buffer view (append_view_bytes); returns its index.
   template <typename Put>
   size_t add_view(size_t elements, size_t elem, int target, Put put) {
-    const size_t stride = target == TINYGLTF_TARGET_ARRAY_BUFFER ? (elem + 3) & ~size_t{3} : elem;
-    while (data_.size() % 4) data_.push_back(0);
-    const size_t at = data_.size();
-    data_.resize(at + elements * stride, 0);
-    for (size_t i = 0; i < elements; ++i) put(i, reinterpret_cast<unsigned char*>(&data_[at + i * stride]));
+    const auto [at, stride] = append_view_bytes(data_, elements, elem, target, put);
     ojson view = {{"buffer", 0}, {"byteOffset", at}, {"byteLength", elements * stride}};
     if (target == TINYGLTF_TARGET_ARRAY_BUFFER && stride != elem) view["byteStride"] = stride;
     view["target"] = target;
