@@ -673,6 +673,8 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   fit_alphas(g, q, bits, st.predictor, lsq, est);
   const int32_t* weights = est;
   std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est);
+  // `lattice` may be st.lattice itself (the assignment below is then a
+  // self-assignment, which std::vector handles).
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w) {
     std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w);
     if (alt.size() >= best.size()) return false;
@@ -701,23 +703,17 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // The least-squares weights instead of the size estimate's.
   if (level >= 3 && std::memcmp(lsq, est, sizeof lsq) != 0) consider(st.predictor, 0, st.lattice, lsq);
   // Residual contexts from the parallelograms' spread instead of the activity.
-  if (level >= 3) {
-    const Lattice lattice = st.lattice;
-    consider(Predictor::spread, 0, lattice, weights);
-  }
+  if (level >= 3) consider(Predictor::spread, 0, st.lattice, weights);
   // Averaging every parallelogram loses where some of them are poor (across
   // the rows of a latitude-longitude grid, say): the gate's alone, in march
   // order, with its own weights.
   int32_t gate_lsq[3], gate_est[3];
   if (level >= 3) {
     fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est);
-    const Lattice lattice = st.lattice;
-    consider(Predictor::gate, 0, lattice, gate_est);
+    consider(Predictor::gate, 0, st.lattice, gate_est);
   }
-  if (level >= 7) {
-    const Lattice lattice = st.lattice;
-    for (int K = 1; K <= kMaxAncestors; ++K) consider(Predictor::ancestors, K, lattice, nullptr);
-  }
+  if (level >= 7)
+    for (int K = 1; K <= kMaxAncestors; ++K) consider(Predictor::ancestors, K, st.lattice, nullptr);
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
   return best;
