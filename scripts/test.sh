@@ -19,8 +19,7 @@ for preset in release asan; do
 done
 echo "== format spec: the independent Python decoder (format-spec/reference_decoder.py) against tsm decode"
 bash format-spec/check_decoder.sh build/release/cli/tsm
-fuzz_seconds=${TSM_FUZZ_SMOKE_SECONDS:-20}
-echo "== fuzz smoke run (${fuzz_seconds} s per target)"
-FUZZ_JOBS=$jobs bash fuzz/run.sh "$fuzz_seconds"
+echo "== fuzz smoke run (fixed executions and seed per target)"
+FUZZ_JOBS=$jobs bash fuzz/run.sh --smoke
 echo "== browser test: the WebAssembly decoder in headless Chromium (web/test.sh; it says plainly when it skips)"
 bash web/test.sh

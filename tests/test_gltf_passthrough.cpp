@@ -867,3 +867,41 @@ TEST(GltfPassThrough, MeshWithoutPrimitivesSurvivesTheRoundTrip) {
 }
 
 }  // namespace
+
+// fuzz_read_mesh (CI smoke run, crash-6411d56f): a primitive whose POSITION
+// accessor is empty (count 0, no buffer view) in a document without buffers.
+// The writer gave it a zero-byte buffer view naming buffer 0 and wrote no
+// buffer, and its own reader refused the result. Empty accessors now get no
+// view (a buffer view holds at least one byte).
+TEST(GltfPassThrough, EmptyAccessorGetsNoBufferView) {
+  for (bool with_triangle : {false, true}) {
+    Doc d;
+    d.doc["asset"] = {{"version", "2.0"}};
+    json prims = json::array();
+    if (with_triangle) prims.push_back({{"attributes", {{"POSITION", add_positions(d, {0, 0, 0, 1, 0, 0, 0, 1, 0})}}}});
+    d.doc["accessors"].push_back({{"componentType", 5126}, {"count", 0}, {"type", "VEC3"}});
+    prims.push_back({{"attributes", {{"POSITION", d.doc["accessors"].size() - 1}}}});
+    d.doc["meshes"] = json::array({json{{"primitives", prims}}});
+    if (!d.bin.empty()) d.doc["buffers"] = json::array({json{{"byteLength", d.bin.size()}}});
+    Mesh m;
+    const Status r = read_doc(to_glb(d), m);
+    ASSERT_TRUE(r.ok()) << r.to_string();
+    EXPECT_EQ(m.vertex_count(), with_triangle ? 3u : 0u);
+    for (bool binary : {true, false}) {
+      const std::string out = write_doc(m, binary);
+      Doc o;
+      ASSERT_TRUE(parse_output(out, o));
+      const json& empty = o.doc["accessors"][o.doc["meshes"][0]["primitives"][with_triangle ? 1 : 0]["attributes"]["POSITION"].get<size_t>()];
+      EXPECT_EQ(empty["count"], 0) << o.doc.dump();
+      EXPECT_FALSE(empty.contains("bufferView")) << o.doc.dump();
+      if (o.doc.contains("bufferViews")) {
+        for (const json& v : o.doc["bufferViews"]) EXPECT_GT(v["byteLength"].get<size_t>(), 0u) << o.doc.dump();
+      }
+      Mesh back;
+      const Status s = tsm::read_gltf(out, binary ? "out.glb" : "out.gltf", back, tsm::ReadOptions(), nullptr);
+      ASSERT_TRUE(s.ok()) << s.to_string();
+      EXPECT_EQ(back.positions, m.positions);
+      EXPECT_EQ(back.indices, m.indices);
+    }
+  }
+}

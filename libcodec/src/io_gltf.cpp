@@ -2084,9 +2084,13 @@ class PassThroughWriter {
     return Status::Ok();
   }
 
-  // Appends a buffer view (append_view_bytes); returns its index.
+  // Appends a buffer view (append_view_bytes); returns its index, or
+  // kNoView for no elements (a buffer view holds at least one byte; an
+  // accessor without a view reads as zeros, here none).
+  static constexpr size_t kNoView = ~size_t{0};
   template <typename Put>
   size_t add_view(size_t elements, size_t elem, int target, Put put) {
+    if (elements == 0) return kNoView;
     const auto [at, stride] = append_view_bytes(data_, elements, elem, target, put);
     ojson view = {{"buffer", 0}, {"byteOffset", at}, {"byteLength", elements * stride}};
     if (target == TINYGLTF_TARGET_ARRAY_BUFFER && stride != elem) view["byteStride"] = stride;
@@ -2098,7 +2102,9 @@ class PassThroughWriter {
   // The accessor `slot` with its data fields first, then what it kept (name, extras, ...).
   static void set_accessor(ojson& slot, size_t view, int ct, bool normalized, size_t count, uint32_t comps,
                            const std::vector<double>* lo, const std::vector<double>* hi) {
-    ojson a = {{"bufferView", view}, {"componentType", ct}};
+    ojson a = ojson::object();
+    if (view != kNoView) a["bufferView"] = view;
+    a["componentType"] = ct;
     if (normalized) a["normalized"] = true;
     a["count"] = count;
     a["type"] = type_name(type_for_components(comps));
