@@ -337,18 +337,38 @@ Status encode_part_attributes(const Mesh& part, const std::vector<AttributeHeade
   return encode_attributes(headers, ai, p.attributes);
 }
 
-// qin: grid indices per part input vertex; is_ref: per part input vertex,
-// 1 when an earlier segment holds it (empty: none).
-Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                   const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
-  const int bits = options.quantization_bits;
-  ConnectivityEncoding ce;
+// What the geometry coder sees of a part: its own vertices only (mark: per
+// output vertex, kNone own, 0 a reference), their grid indices in output
+// order, and the layout.
+struct OwnView {
+  std::vector<uint32_t> mark, q;
+  GeometryLayout layout;
+};
+
+OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref) {
+  OwnView w;
+  const size_t n = ce.vertex_order.size();
+  w.mark.assign(n, kNone);
+  if (!is_ref.empty())
+    for (size_t v = 0; v < n; ++v)
+      if (is_ref[ce.vertex_order[v]]) w.mark[v] = 0;
+  for (size_t v = 0; v < n; ++v)
+    if (w.mark[v] == kNone)
+      for (int a = 0; a < 3; ++a) w.q.push_back(qin[3 * static_cast<size_t>(ce.vertex_order[v]) + a]);
+  w.layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, w.mark);
+  return w;
+}
+
+// The connectivity of a part: the layered spiral tree (at level 9 also the
+// midpoint-distance Kruskal tree, kept if smaller; on the corpus it never
+// is), then, when vertices on no triangle have a nearby surface vertex to
+// predict them (their anchor), a second pass that orders them by it.
+Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                         const EncodeOptions& options, ConnectivityEncoding& ce, OwnView& view) {
   CutHints hints;
   hints.qpos = &qin;
   TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
   if (options.level >= 9) {
-    // The midpoint-distance Kruskal tree instead of the layered spiral, kept
-    // if its connectivity is smaller (on the corpus it never is).
     ConnectivityEncoding alt;
     hints.midpoint_tree = true;
     TSM_RETURN_IF_ERROR(encode_connectivity(mesh, alt, hints));
@@ -357,38 +377,81 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
     else
       hints.midpoint_tree = false;
   }
-  // The geometry coder's view: own vertices only, grid indices in output order.
-  std::vector<uint32_t> mark;  // per output vertex: kNone own, 0 reference
-  std::vector<uint32_t> q;
-  GeometryLayout layout;
-  auto prepare = [&] {
-    const size_t n = ce.vertex_order.size();
-    mark.assign(n, kNone);
-    if (!is_ref.empty())
-      for (size_t v = 0; v < n; ++v)
-        if (is_ref[ce.vertex_order[v]]) mark[v] = 0;
-    q.clear();
-    for (size_t v = 0; v < n; ++v)
-      if (mark[v] == kNone)
-        for (int a = 0; a < 3; ++a) q.push_back(qin[3 * static_cast<size_t>(ce.vertex_order[v]) + a]);
-    layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, mark);
-  };
-  prepare();
-  // Vertices on no triangle go last, ordered by a nearby surface vertex
-  // that predicts them: a second pass with those anchors.
-  std::vector<uint32_t> anchor = find_anchors(layout, q, bits);
+  view = own_view(ce, qin, is_ref);
+  std::vector<uint32_t> anchor = find_anchors(view.layout, view.q, options.quantization_bits);
   if (std::any_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) {
     std::vector<uint32_t> own_to_output;
-    for (uint32_t v = 0; v < mark.size(); ++v)
-      if (mark[v] == kNone) own_to_output.push_back(v);
+    for (uint32_t v = 0; v < view.mark.size(); ++v)
+      if (view.mark[v] == kNone) own_to_output.push_back(v);
     std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
     for (size_t r = 0; r < anchor.size(); ++r)
       if (anchor[r] != kNone) by_input[ce.vertex_order[own_to_output[r]]] = own_to_output[anchor[r]];
     ce = ConnectivityEncoding();
     hints.anchor = &by_input;
     TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
-    prepare();
+    view = own_view(ce, qin, is_ref);
   }
+  return Status::Ok();
+}
+
+// Canonical re-encoding (issue 3): a decoded mesh must encode to the bytes
+// it came from. The coder's choices follow vertex ids and face order, and
+// the decoder's order reproduces them, except where vertices were split and
+// stitched back: there the decoded order lets the cut find another copy of
+// a split vertex first. So a part with stitches is coded as its decoded
+// self would be: decode the streams, code that mesh, and repeat until
+// decoding gives back exactly the mesh coded (a fixed point; every stitched
+// mesh we have reaches it after one round, the dragons included).
+constexpr int kCanonicalRounds = 4;
+
+Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                              const EncodeOptions& options, ConnectivityEncoding& ce, OwnView& view) {
+  TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, ce, view));
+  if (ce.stats.stitches == 0) return Status::Ok();
+  const size_t n = mesh.vertex_count();
+  std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids
+  Mesh coded;                  // that mesh (faces only), once it is not `mesh`
+  std::vector<uint32_t> q;
+  std::vector<uint8_t> ref;
+  for (int round = 0; round < kCanonicalRounds; ++round) {
+    Mesh decoded;
+    GeometryLayout scratch;
+    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
+    // Decoding gives back the faces coded: with the same vertex order the
+    // bytes are canonical; with another order the faces map onto themselves
+    // (a symmetric mesh, e.g. a Moebius strip cut along another edge), and
+    // more rounds only permute it again.
+    if (round > 0 && decoded.indices == coded.indices && decoded.face_offsets == coded.face_offsets) break;
+    std::vector<uint32_t> next(n);
+    for (size_t v = 0; v < n; ++v) next[v] = base.empty() ? ce.vertex_order[v] : base[ce.vertex_order[v]];
+    base = std::move(next);
+    coded = std::move(decoded);
+    coded.positions.assign(3 * n, 0.0f);  // the coder reads the grid indices, not these
+    q.resize(3 * n);
+    for (size_t v = 0; v < n; ++v)
+      for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
+    if (!is_ref.empty()) {
+      ref.resize(n);
+      for (size_t v = 0; v < n; ++v) ref[v] = is_ref[base[v]];
+    }
+    ce = ConnectivityEncoding();
+    TSM_RETURN_IF_ERROR(part_connectivity(coded, q, is_ref.empty() ? is_ref : ref, options, ce, view));
+  }
+  for (uint32_t& x : ce.vertex_order) x = base[x];  // back to the part's input ids
+  return Status::Ok();
+}
+
+// qin: grid indices per part input vertex; is_ref: per part input vertex,
+// 1 when an earlier segment holds it (empty: none).
+Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                   const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
+  const int bits = options.quantization_bits;
+  ConnectivityEncoding ce;
+  OwnView view;
+  TSM_RETURN_IF_ERROR(canonical_connectivity(mesh, qin, is_ref, options, ce, view));
+  std::vector<uint32_t>& mark = view.mark;
+  std::vector<uint32_t>& q = view.q;
+  GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
   out.geometry = encode_geometry(layout, q, bits, options.level, &lattice);
   if (!headers.empty()) {
