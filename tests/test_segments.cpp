@@ -70,7 +70,8 @@ Mesh stream_decode(const std::string& bytes, const std::function<size_t()>& next
   return sd.take_mesh();
 }
 
-void expect_segmented_round_trip(const Mesh& m, uint32_t segment_faces, const std::string& what, int q = 14) {
+void expect_segmented_round_trip(const Mesh& m, uint32_t segment_faces, const std::string& what, int q = 14,
+                                 bool canonical = true) {
   const std::string bytes = encode_ok(m, segment_faces, q);
   Mesh back;
   Status s = decode(bytes, back);
@@ -88,6 +89,11 @@ void expect_segmented_round_trip(const Mesh& m, uint32_t segment_faces, const st
   // Streamed whole and one byte at a time.
   expect_same_mesh(back, stream_decode(bytes, [&] { return bytes.size(); }), what + " (streamed whole)");
   expect_same_mesh(back, stream_decode(bytes, [] { return size_t{1}; }), what + " (streamed byte by byte)");
+  // Canonical: the decoded mesh encodes to the same bytes (segments number
+  // their vertices by position and their faces by corners, not by input id).
+  if (canonical) {
+    EXPECT_TRUE(encode_ok(back, segment_faces, q) == bytes) << what << ": re-encoding gives other bytes";
+  }
 }
 
 }  // namespace
@@ -144,6 +150,7 @@ TEST(Segments, RandomMeshesProperty) {
     ASSERT_TRUE(s.ok()) << what << ": " << s.to_string();
     CompareResult r = compare_meshes(m, back, q);
     EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+    EXPECT_TRUE(encode_ok(back, seg, q) == bytes) << what << ": re-encoding gives other bytes";
     std::uniform_int_distribution<size_t> chunk(1, 97);
     expect_same_mesh(back, stream_decode(bytes, [&] { return chunk(rng); }), what + " (random chunks)");
   }
@@ -273,6 +280,7 @@ TEST(Segments, CorpusDragonInSegments) {
   Mesh back;
   ASSERT_TRUE(decode(bytes, back).ok());
   EXPECT_TRUE(compare_meshes(m, back, 11).equal);
+  EXPECT_TRUE(encode_ok(back, 4000, 11, 2) == bytes) << "res3 in segments: re-encoding gives other bytes";
   std::mt19937 rng(3);
   std::uniform_int_distribution<size_t> chunk(1, 5000);
   expect_same_mesh(back, stream_decode(bytes, [&] { return chunk(rng); }), "res3 random chunks");

@@ -3,6 +3,7 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <algorithm>
+#include <numeric>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -472,13 +473,14 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
   return Status::Ok();
 }
 
-// A segment's attributes: the values of its vertices (`in`, ascending input
-// ids) and faces; a corner attribute keeps the values its corners use (in
-// input order), and the last segment also those no corner uses. A value
+// A segment's attributes: the values of its vertices (`in`, in the part's
+// numbering) and faces (`faces`, corners from `rot`); a corner attribute
+// keeps the values its corners use (in input order), and the last segment
+// also those no corner uses. A value
 // used on both sides of a border is stored in each segment that uses it.
 std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<uint32_t>& in,
-                                          const std::vector<uint32_t>& faces, bool last,
-                                          std::vector<std::vector<uint32_t>>& origin) {
+                                          const std::vector<uint32_t>& faces, const std::vector<uint32_t>& rot,
+                                          bool last, std::vector<std::vector<uint32_t>>& origin) {
   std::vector<Attribute> out;
   origin.assign(mesh.attributes.size(), {});
   for (const Attribute& a : mesh.attributes) {
@@ -505,8 +507,10 @@ std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<ui
           origin[out.size()].push_back(static_cast<uint32_t>(j));
           take(j);
         }
-      for (uint32_t f : faces)
-        for (uint32_t i = mesh.face_offsets[f]; i < mesh.face_offsets[f + 1]; ++i) b.indices.push_back(local[a.indices[i]]);
+      for (size_t t = 0; t < faces.size(); ++t) {
+        const uint32_t f = faces[t], n = mesh.face_size(f);
+        for (uint32_t j = 0; j < n; ++j) b.indices.push_back(local[a.indices[mesh.face_offsets[f] + (rot[t] + j) % n]]);
+      }
     }
     out.push_back(std::move(b));
   }
@@ -517,6 +521,89 @@ std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<ui
 // (the vertices its faces use, ascending; the last one also takes the
 // vertices on no face), coded in parallel; then the references, which need
 // the final ids of the segments before.
+// A segment's vertices (`in`, reordered) by grid position, then their
+// neighbours' (a hash), then input id; returns its faces ordered by
+// their corner cycles in that numbering, each from its smallest rotation
+// (`rot`: the corner it starts at; identical faces by input id). Both orders are what a decoded file gives
+// again, so a decoded segmented mesh re-encodes to the same bytes.
+std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<uint32_t>& qin,
+                                           std::vector<uint32_t>& in, const std::vector<uint32_t>& faces,
+                                           std::vector<uint32_t>& rot) {
+  auto pos = [&](uint32_t v) { return &qin[3 * static_cast<size_t>(v)]; };
+  std::unordered_map<uint32_t, uint32_t> local;
+  local.reserve(in.size());
+  for (uint32_t i = 0; i < in.size(); ++i) local.emplace(in[i], i);
+  // Vertices in one grid cell (frequent at low q) are told apart by their
+  // neighbours' cells: an order-free hash of (cell of the next corner, cell
+  // of the previous corner) over the vertex's corners.
+  auto mix = [](uint64_t x) {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ull;
+    return x ^ (x >> 33);
+  };
+  auto cell = [&](uint32_t v) {
+    const uint32_t* p = pos(v);
+    return mix((static_cast<uint64_t>(p[0]) << 42) ^ (static_cast<uint64_t>(p[1]) << 21) ^ p[2]);
+  };
+  std::vector<uint64_t> around(in.size(), 0);
+  for (uint32_t f : faces) {
+    const uint32_t* c = mesh.face(f);
+    const uint32_t n = mesh.face_size(f);
+    for (uint32_t j = 0; j < n; ++j)
+      around[local[c[j]]] += mix(cell(c[(j + 1) % n]) + 3 * mix(cell(c[(j + n - 1) % n])));
+  }
+  std::vector<uint32_t> idx(in.size());
+  std::iota(idx.begin(), idx.end(), 0u);
+  std::sort(idx.begin(), idx.end(), [&](uint32_t a, uint32_t b) {
+    const uint32_t *pa = pos(in[a]), *pb = pos(in[b]);
+    for (int c = 0; c < 3; ++c)
+      if (pa[c] != pb[c]) return pa[c] < pb[c];
+    return around[a] != around[b] ? around[a] < around[b] : in[a] < in[b];
+  });
+  {
+    std::vector<uint32_t> sorted(in.size());
+    for (size_t i = 0; i < idx.size(); ++i) sorted[i] = in[idx[i]];
+    in = std::move(sorted);
+    for (uint32_t i = 0; i < in.size(); ++i) local[in[i]] = i;
+  }
+  // Corner cycles, rotated to their smallest rotation, one after another.
+  std::vector<uint32_t> cyc, start(faces.size() + 1, 0), first(faces.size());
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const uint32_t* c = mesh.face(faces[i]);
+    const uint32_t n = mesh.face_size(faces[i]);
+    uint32_t best = 0;
+    for (uint32_t r = 1; r < n; ++r)
+      for (uint32_t j = 0; j < n; ++j) {
+        const uint32_t x = local[c[(r + j) % n]], y = local[c[(best + j) % n]];
+        if (x != y) {
+          if (x < y) best = r;
+          break;
+        }
+      }
+    for (uint32_t j = 0; j < n; ++j) cyc.push_back(local[c[(best + j) % n]]);
+    first[i] = best;
+    start[i + 1] = static_cast<uint32_t>(cyc.size());
+  }
+  idx.resize(faces.size());
+  std::iota(idx.begin(), idx.end(), 0u);
+  std::sort(idx.begin(), idx.end(), [&](uint32_t a, uint32_t b) {
+    const bool less = std::lexicographical_compare(cyc.begin() + start[a], cyc.begin() + start[a + 1],
+                                                   cyc.begin() + start[b], cyc.begin() + start[b + 1]);
+    const bool more = std::lexicographical_compare(cyc.begin() + start[b], cyc.begin() + start[b + 1],
+                                                   cyc.begin() + start[a], cyc.begin() + start[a + 1]);
+    return less || (!more && faces[a] < faces[b]);
+  });
+  std::vector<uint32_t> out(faces.size());
+  rot.resize(faces.size());
+  for (size_t i = 0; i < idx.size(); ++i) {
+    out[i] = faces[idx[i]];
+    rot[i] = first[idx[i]];
+  }
+  return out;
+}
+
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
                        const EncodeOptions& options, ContainerWriter& cw) {
@@ -540,6 +627,12 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
         if (owner[v] == kNone) in.push_back(v);
     std::sort(in.begin(), in.end());
     in.erase(std::unique(in.begin(), in.end()), in.end());
+    // The part's own numbering does not follow the input's: a decoded file
+    // numbers the vertices another way (those of earlier segments first),
+    // and re-encoding must give the same bytes. Vertices by grid position,
+    // faces by their corners (from the smallest rotation) in that numbering.
+    std::vector<uint32_t> rot;
+    const std::vector<uint32_t> faces = canonical_part_order(mesh, qin, in, segments[k], rot);
     std::unordered_map<uint32_t, uint32_t> local;
     local.reserve(in.size());
     Mesh part;
@@ -555,12 +648,13 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       is_ref[i] = owner[in[i]] != kNone && owner[in[i]] < k;
     }
     std::vector<uint32_t> corners;
-    for (uint32_t f : segments[k]) {
+    for (size_t t = 0; t < faces.size(); ++t) {
       corners.clear();
-      for (uint32_t i = 0; i < mesh.face_size(f); ++i) corners.push_back(local[mesh.face(f)[i]]);
+      const uint32_t n = mesh.face_size(faces[t]);
+      for (uint32_t i = 0; i < n; ++i) corners.push_back(local[mesh.face(faces[t])[(rot[t] + i) % n]]);
       part.add_face(corners.data(), corners.size());
     }
-    part.attributes = segment_attributes(mesh, in, segments[k], k + 1 == S, parts[k].value_origin);
+    part.attributes = segment_attributes(mesh, in, faces, rot, k + 1 == S, parts[k].value_origin);
     parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
     parts[k].part = std::move(part);
   });

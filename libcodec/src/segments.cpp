@@ -28,6 +28,7 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 
 struct Splitter {
   const std::vector<std::array<double, 3>>& c;
+  const std::vector<uint64_t>& tie;  // per face, an order-free hash of its corners' cells
   uint32_t max_faces;
   std::vector<std::vector<uint32_t>>& out;
 
@@ -48,14 +49,15 @@ struct Splitter {
     for (int a = 1; a < 3; ++a)
       if (mx[a] - mn[a] > mx[axis] - mn[axis]) axis = a;
     // A total order (centroid along the axis, then the other two, then the
-    // face), so the set on each side does not depend on the library's
-    // nth_element.
+    // corners' cells, then the face), so the set on each side does not
+    // depend on the library's nth_element, nor (but for faces on the same
+    // cells) on the face order, which a decoded file changes.
     auto less = [&](uint32_t x, uint32_t y) {
       for (int k = 0; k < 3; ++k) {
         const int a = (axis + k) % 3;
         if (c[x][a] != c[y][a]) return c[x][a] < c[y][a];
       }
-      return x < y;
+      return tie[x] != tie[y] ? tie[x] < tie[y] : x < y;
     };
     const size_t mid = lo + (hi - lo) / 2;
     std::nth_element(ids.begin() + static_cast<std::ptrdiff_t>(lo), ids.begin() + static_cast<std::ptrdiff_t>(mid),
@@ -77,14 +79,25 @@ std::vector<std::vector<uint32_t>> split_faces(const Mesh& mesh, const std::vect
     return out;
   }
   std::vector<std::array<double, 3>> c(F);
+  std::vector<uint64_t> tie(F, 0);
+  auto mix = [](uint64_t x) {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ull;
+    return x ^ (x >> 33);
+  };
   for (uint32_t f = 0; f < F; ++f) {
     double s[3] = {0, 0, 0};
     const uint32_t n = mesh.face_size(f);
-    for (uint32_t k = 0; k < n; ++k)
-      for (int a = 0; a < 3; ++a) s[a] += q[3 * static_cast<size_t>(mesh.face(f)[k]) + a];
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t* p = &q[3 * static_cast<size_t>(mesh.face(f)[k])];
+      for (int a = 0; a < 3; ++a) s[a] += p[a];
+      tie[f] += mix((static_cast<uint64_t>(p[0]) << 42) ^ (static_cast<uint64_t>(p[1]) << 21) ^ p[2]);
+    }
     for (int a = 0; a < 3; ++a) c[f][a] = s[a] / n;
   }
-  Splitter sp{c, max_faces, out};
+  Splitter sp{c, tie, max_faces, out};
   sp.split(ids, 0, F);
   return out;
 }
