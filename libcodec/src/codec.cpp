@@ -536,23 +536,13 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
   // Vertices in one grid cell (frequent at low q) are told apart by their
   // neighbours' cells: an order-free hash of (cell of the next corner, cell
   // of the previous corner) over the vertex's corners.
-  auto mix = [](uint64_t x) {
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    x *= 0xc4ceb9fe1a85ec53ull;
-    return x ^ (x >> 33);
-  };
-  auto cell = [&](uint32_t v) {
-    const uint32_t* p = pos(v);
-    return mix((static_cast<uint64_t>(p[0]) << 42) ^ (static_cast<uint64_t>(p[1]) << 21) ^ p[2]);
-  };
+  auto cell = [&](uint32_t v) { return cell_hash(pos(v)); };
   std::vector<uint64_t> around(in.size(), 0);
   for (uint32_t f : faces) {
     const uint32_t* c = mesh.face(f);
     const uint32_t n = mesh.face_size(f);
     for (uint32_t j = 0; j < n; ++j)
-      around[local[c[j]]] += mix(cell(c[(j + 1) % n]) + 3 * mix(cell(c[(j + n - 1) % n])));
+      around[local[c[j]]] += mix64(cell(c[(j + 1) % n]) + 3 * mix64(cell(c[(j + n - 1) % n])));
   }
   std::vector<uint32_t> idx(in.size());
   std::iota(idx.begin(), idx.end(), 0u);

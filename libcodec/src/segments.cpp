@@ -69,6 +69,18 @@ struct Splitter {
 
 }  // namespace
 
+uint64_t mix64(uint64_t x) {
+  x ^= x >> 33;
+  x *= 0xff51afd7ed558ccdull;
+  x ^= x >> 33;
+  x *= 0xc4ceb9fe1a85ec53ull;
+  return x ^ (x >> 33);
+}
+
+uint64_t cell_hash(const uint32_t* cell) {
+  return mix64((static_cast<uint64_t>(cell[0]) << 42) ^ (static_cast<uint64_t>(cell[1]) << 21) ^ cell[2]);
+}
+
 std::vector<std::vector<uint32_t>> split_faces(const Mesh& mesh, const std::vector<uint32_t>& q, uint32_t max_faces) {
   const uint32_t F = static_cast<uint32_t>(mesh.face_count());
   std::vector<uint32_t> ids(F);
@@ -80,20 +92,13 @@ std::vector<std::vector<uint32_t>> split_faces(const Mesh& mesh, const std::vect
   }
   std::vector<std::array<double, 3>> c(F);
   std::vector<uint64_t> tie(F, 0);
-  auto mix = [](uint64_t x) {
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    x *= 0xc4ceb9fe1a85ec53ull;
-    return x ^ (x >> 33);
-  };
   for (uint32_t f = 0; f < F; ++f) {
     double s[3] = {0, 0, 0};
     const uint32_t n = mesh.face_size(f);
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t* p = &q[3 * static_cast<size_t>(mesh.face(f)[k])];
       for (int a = 0; a < 3; ++a) s[a] += p[a];
-      tie[f] += mix((static_cast<uint64_t>(p[0]) << 42) ^ (static_cast<uint64_t>(p[1]) << 21) ^ p[2]);
+      tie[f] += cell_hash(p);
     }
     for (int a = 0; a < 3; ++a) c[f][a] = s[a] / n;
   }

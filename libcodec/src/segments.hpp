@@ -21,6 +21,11 @@ constexpr uint32_t kDefaultSegmentFaces = 1u << 18;
 // the mesh has at most max_faces faces.
 std::vector<std::vector<uint32_t>> split_faces(const Mesh& mesh, const std::vector<uint32_t>& q, uint32_t max_faces);
 
+// Tie-breaks that a decoded file keeps (segments numbered and split alike
+// on re-encoding): a 64-bit mix, and the hash of a grid cell (3 indices).
+uint64_t mix64(uint64_t x);
+uint64_t cell_hash(const uint32_t* cell);
+
 // Per output vertex of a decoded part: 2 when it lies on a hole of the part's
 // cut surface (next to a virtual vertex), 1 when on another triangle, 0 when
 // on none. The context of its reference flag: a vertex shared with an
