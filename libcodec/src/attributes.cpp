@@ -725,6 +725,19 @@ unsigned predictors_for(const AttributeHeader& h) {
 
 }  // namespace
 
+uint32_t smallest_rotation(const uint32_t* c, uint32_t n) {
+  uint32_t best = 0;
+  for (uint32_t r = 1; r < n; ++r)
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t a = c[(r + i) % n], b = c[(best + i) % n];
+      if (a != b) {
+        if (a < b) best = r;
+        break;
+      }
+    }
+  return best;
+}
+
 Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out) {
   out.clear();
   if (headers.empty()) return Status::Ok();
@@ -745,15 +758,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     for (size_t v = 0; v < V; ++v) out_id[order[v]] = static_cast<uint32_t>(v);
     // Key of a face: its corner cycle (output ids) from its smallest rotation.
     auto key = [](const uint32_t* c, uint32_t k, uint32_t& best) {
-      best = 0;
-      for (uint32_t r = 1; r < k; ++r)
-        for (uint32_t i = 0; i < k; ++i) {
-          const uint32_t a = c[(r + i) % k], b = c[(best + i) % k];
-          if (a != b) {
-            if (a < b) best = r;
-            break;
-          }
-        }
+      best = smallest_rotation(c, k);
       std::vector<uint32_t> cycle(k);
       for (uint32_t i = 0; i < k; ++i) cycle[i] = c[(best + i) % k];
       return cycle;

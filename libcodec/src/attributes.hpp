@@ -60,6 +60,10 @@ struct AttributeInput {
 };
 Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out);
 
+// The corner a face's cycle starts at in its lexicographically smallest
+// rotation (the face's key when faces are matched or ordered by corners).
+uint32_t smallest_rotation(const uint32_t* corners, uint32_t n);
+
 // Decoder, one part: the attributes of its own vertices (output order), its
 // faces and corners (output order), each corner attribute with the part's own
 // value list.

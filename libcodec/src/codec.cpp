@@ -3,10 +3,10 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <algorithm>
-#include <numeric>
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <unordered_map>
 #ifndef TSM_NO_THREADS
 #include <thread>
@@ -401,8 +401,9 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 // stitched back: there the decoded order lets the cut find another copy of
 // a split vertex first. So a part with stitches is coded as its decoded
 // self would be: decode the streams, code that mesh, and repeat until
-// decoding gives back exactly the mesh coded (a fixed point; every stitched
-// mesh we have reaches it after one round, the dragons included).
+// decoding gives back the faces coded (a fixed point when the vertex order
+// comes back too: every stitched mesh we have reaches it after one round,
+// the dragons included; the Moebius strip comes back mirrored).
 constexpr int kCanonicalRounds = 4;
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
@@ -517,20 +518,18 @@ std::vector<Attribute> segment_attributes(const Mesh& mesh, const std::vector<ui
   return out;
 }
 
-// The segmented file's parts: each segment's mesh with its own vertex ids
-// (the vertices its faces use, ascending; the last one also takes the
-// vertices on no face), coded in parallel; then the references, which need
-// the final ids of the segments before.
-// A segment's vertices (`in`, reordered) by grid position, then their
-// neighbours' (a hash), then input id; returns its faces ordered by
+// A segment's own numbering, the one a decoded file gives again (it numbers
+// the vertices otherwise, those of earlier segments first, and re-encoding
+// must give the same bytes): `in` (its vertices, input ids) reordered by
+// grid position, then their neighbours' cells (a hash), then input id, and
+// `local` from input id to that numbering; returns its faces ordered by
 // their corner cycles in that numbering, each from its smallest rotation
-// (`rot`: the corner it starts at; identical faces by input id). Both orders are what a decoded file gives
-// again, so a decoded segmented mesh re-encodes to the same bytes.
+// (`rot`: the corner it starts at; identical faces by input id).
 std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<uint32_t>& qin,
                                            std::vector<uint32_t>& in, const std::vector<uint32_t>& faces,
-                                           std::vector<uint32_t>& rot) {
+                                           std::unordered_map<uint32_t, uint32_t>& local, std::vector<uint32_t>& rot) {
   auto pos = [&](uint32_t v) { return &qin[3 * static_cast<size_t>(v)]; };
-  std::unordered_map<uint32_t, uint32_t> local;
+  local.clear();
   local.reserve(in.size());
   for (uint32_t i = 0; i < in.size(); ++i) local.emplace(in[i], i);
   // Vertices in one grid cell (frequent at low q) are told apart by their
@@ -558,22 +557,16 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
     in = std::move(sorted);
     for (uint32_t i = 0; i < in.size(); ++i) local[in[i]] = i;
   }
-  // Corner cycles, rotated to their smallest rotation, one after another.
-  std::vector<uint32_t> cyc, start(faces.size() + 1, 0), first(faces.size());
+  // Corner cycles in the new numbering, from their smallest rotation, one
+  // after another.
+  std::vector<uint32_t> cyc, start(faces.size() + 1, 0), first(faces.size()), tmp;
   for (size_t i = 0; i < faces.size(); ++i) {
     const uint32_t* c = mesh.face(faces[i]);
     const uint32_t n = mesh.face_size(faces[i]);
-    uint32_t best = 0;
-    for (uint32_t r = 1; r < n; ++r)
-      for (uint32_t j = 0; j < n; ++j) {
-        const uint32_t x = local[c[(r + j) % n]], y = local[c[(best + j) % n]];
-        if (x != y) {
-          if (x < y) best = r;
-          break;
-        }
-      }
-    for (uint32_t j = 0; j < n; ++j) cyc.push_back(local[c[(best + j) % n]]);
-    first[i] = best;
+    tmp.resize(n);
+    for (uint32_t j = 0; j < n; ++j) tmp[j] = local[c[j]];
+    first[i] = smallest_rotation(tmp.data(), n);
+    for (uint32_t j = 0; j < n; ++j) cyc.push_back(tmp[(first[i] + j) % n]);
     start[i + 1] = static_cast<uint32_t>(cyc.size());
   }
   idx.resize(faces.size());
@@ -594,6 +587,10 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
   return out;
 }
 
+// The segmented file's parts: each segment's mesh with its own vertex ids
+// (the vertices its faces use, the last one also the vertices on no face,
+// numbered by canonical_part_order), coded in parallel; then the
+// references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
                        const EncodeOptions& options, ContainerWriter& cw) {
@@ -617,20 +614,14 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
         if (owner[v] == kNone) in.push_back(v);
     std::sort(in.begin(), in.end());
     in.erase(std::unique(in.begin(), in.end()), in.end());
-    // The part's own numbering does not follow the input's: a decoded file
-    // numbers the vertices another way (those of earlier segments first),
-    // and re-encoding must give the same bytes. Vertices by grid position,
-    // faces by their corners (from the smallest rotation) in that numbering.
+    std::unordered_map<uint32_t, uint32_t> local;  // input id -> part id
     std::vector<uint32_t> rot;
-    const std::vector<uint32_t> faces = canonical_part_order(mesh, qin, in, segments[k], rot);
-    std::unordered_map<uint32_t, uint32_t> local;
-    local.reserve(in.size());
+    const std::vector<uint32_t> faces = canonical_part_order(mesh, qin, in, segments[k], local, rot);
     Mesh part;
     std::vector<uint32_t> q(3 * in.size());
     std::vector<uint8_t> is_ref(in.size());
     part.positions.resize(3 * in.size());
     for (uint32_t i = 0; i < in.size(); ++i) {
-      local.emplace(in[i], i);
       for (int a = 0; a < 3; ++a) {
         part.positions[3 * i + a] = mesh.positions[3 * static_cast<size_t>(in[i]) + a];
         q[3 * i + a] = qin[3 * static_cast<size_t>(in[i]) + a];

@@ -4,8 +4,9 @@
 // counts its updates and adapts by a shift that grows with the count (about
 // log2(n + 2): the first bits it sees move it like a frequency count, later
 // ones average over 2^7 bits), and stays within [kProbMin, kProbMax] so that
-// every modelled decision costs a minimum (the stream budget below). Integers are coded as an adaptive bit length class followed
-// by mantissa bits (the top ones modelled, the rest direct).
+// every modelled decision costs a minimum (the stream budget below).
+// Integers are coded as an adaptive bit length class followed by mantissa
+// bits (the top ones modelled, the rest direct).
 //
 // The decoder is safe on any input: reading past the end yields zero bytes
 // and counts an overrun, which callers check (overrun() != 0 => corrupt).

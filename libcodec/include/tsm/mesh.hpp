@@ -29,6 +29,9 @@ enum class AttributeDomain : uint8_t {
 // integer values (a u8 colour is 0..255), coded exactly.
 enum class AttributeType : uint8_t { f32 = 0, u8 = 1, u16 = 2, i32 = 3 };
 
+// The longest attribute name the format stores (FORMAT.md §8.12).
+constexpr size_t kMaxAttributeNameBytes = 1024;
+
 // A per-vertex, per-face or per-corner attribute. `values` holds
 // value_count() values of `components` floats each. For the vertex and face
 // domains there is one value per vertex / face, in their order, and
@@ -36,9 +39,6 @@ enum class AttributeType : uint8_t { f32 = 0, u8 = 1, u16 = 2, i32 = 3 };
 // corner (in the order of Mesh::indices) naming a value; values may repeat
 // or be used by no corner (OBJ's vt / vn lists, glTF seams): all of it is
 // kept as given.
-// The longest attribute name the format stores (FORMAT.md §8.12).
-constexpr size_t kMaxAttributeNameBytes = 1024;
-
 struct Attribute {
   std::string name;  // "normal", "color", "texcoord", or the file's own name; at most kMaxAttributeNameBytes
   AttributeKind kind = AttributeKind::generic;
