@@ -360,6 +360,23 @@ OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qi
   return w;
 }
 
+// True when the vertices on no triangle already come in the order the cut
+// gives them when sorted (stably) by `key`, their anchor's output id.
+bool in_anchor_order(const ConnectivityEncoding& ce, const std::vector<uint32_t>& key) {
+  const GeometryLayout& g = ce.layout;
+  std::vector<uint8_t> on_triangle(g.vertex_count, 0);
+  for (uint32_t p : g.tri)
+    if (g.vertex[p] != kNone) on_triangle[g.vertex[p]] = 1;
+  uint32_t last = 0;
+  for (uint32_t v = 0; v < g.vertex_count; ++v) {
+    if (on_triangle[v]) continue;
+    const uint32_t k = key[ce.vertex_order[v]];
+    if (k < last) return false;
+    last = k;
+  }
+  return true;
+}
+
 // The connectivity of a part: the layered spiral tree (at level 9 also the
 // midpoint-distance Kruskal tree, kept if smaller; on the corpus it never
 // is), then, when vertices on no triangle have a nearby surface vertex to
@@ -387,9 +404,16 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
     std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
     for (size_t r = 0; r < anchor.size(); ++r)
       if (anchor[r] != kNone) by_input[ce.vertex_order[own_to_output[r]]] = own_to_output[anchor[r]];
-    ce = ConnectivityEncoding();
-    hints.anchor = &by_input;
-    TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+    if (in_anchor_order(ce, by_input)) {
+      // The cut would keep its order (a decoded mesh, in canonical rounds):
+      // the second pass would code the same streams, so only hand the
+      // anchors to the geometry coder.
+      for (uint32_t v = 0; v < ce.layout.vertex_count; ++v) ce.layout.anchor[v] = by_input[ce.vertex_order[v]];
+    } else {
+      ce = ConnectivityEncoding();
+      hints.anchor = &by_input;
+      TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+    }
     view = own_view(ce, qin, is_ref);
   }
   return Status::Ok();

@@ -24,10 +24,23 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
 }
 
 // Sorted (key, half-edge) pairs of all half-edges, for pairing and counting.
+// Linear: a counting sort by the smaller vertex, then each vertex's few
+// pairs sorted (the same order as sorting them all).
 std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32_t>& tri) {
-  std::vector<std::pair<uint64_t, uint32_t>> e(tri.size());
-  for (uint32_t h = 0; h < tri.size(); ++h) e[h] = {edge_key(tri[h], tri[he_next(h)]), h};
-  std::sort(e.begin(), e.end());
+  const uint32_t nh = static_cast<uint32_t>(tri.size());
+  uint32_t nv = 0;
+  for (uint32_t v : tri) nv = std::max(nv, v + 1);
+  std::vector<uint32_t> start(size_t{nv} + 1, 0);
+  for (uint32_t h = 0; h < nh; ++h) ++start[std::min(tri[h], tri[he_next(h)]) + size_t{1}];
+  for (uint32_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<uint64_t, uint32_t>> e(nh);
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (uint32_t h = 0; h < nh; ++h) {
+    uint32_t a = tri[h], b = tri[he_next(h)];
+    e[fill[std::min(a, b)]++] = {edge_key(a, b), h};
+  }
+  for (uint32_t v = 0; v < nv; ++v)
+    if (start[v + 1] - start[v] > 1) std::sort(e.begin() + start[v], e.begin() + start[v + 1]);
   return e;
 }
 

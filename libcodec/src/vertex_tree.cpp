@@ -15,6 +15,22 @@
 
 namespace tsm {
 
+namespace {
+
+// Stable counting sort of v[begin, end) by key(x) in [0, buckets): linear,
+// where a comparison sort of a million edges is most of the tree's time.
+template <class T, class Key>
+void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std::vector<T>& tmp) {
+  std::vector<uint32_t> start(buckets + 1, 0);
+  for (size_t i = begin; i < v.size(); ++i) ++start[key(v[i]) + 1];
+  for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+  tmp.resize(v.size() - begin);
+  for (size_t i = begin; i < v.size(); ++i) tmp[start[key(v[i])]++] = v[i];
+  std::copy(tmp.begin(), tmp.end(), v.begin() + static_cast<std::ptrdiff_t>(begin));
+}
+
+}  // namespace
+
 VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos, bool midpoint) {
   const uint32_t nv = m.vertex_count;
   const uint32_t nh = static_cast<uint32_t>(m.tri.size());
@@ -130,7 +146,32 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     if (x.dist != y.dist) return x.dist < y.dist;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
   };
-  std::sort(edges.begin(), edges.end(), by_key);
+  // The layered tree sorts in linear time to the same order as by_key (dist
+  // is 0 there): the edges are in half-edge order; stably by the first
+  // rank, each vertex's few edges by (second rank, half-edge), then stably
+  // by class and ring. Ranks are below nv except at vertices no ring
+  // reaches, which a closed cut mesh does not have (then by_key).
+  auto ring_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 32) & ((1u << 26) - 1)); };
+  auto ra_of = [](const Edge& e) { return static_cast<uint32_t>(e.key); };
+  bool linear = !midpoint;
+  uint32_t max_ring = 0;
+  for (const Edge& e : edges) {
+    if (ra_of(e) >= nv || e.rb >= nv) linear = false;
+    max_ring = std::max(max_ring, ring_of(e));
+  }
+  const size_t rings = size_t{max_ring} + 1;
+  std::vector<Edge> tmp;
+  if (linear) {
+    counting_sort(edges, 0, nv, ra_of, tmp);
+    auto by_rb = [](const Edge& x, const Edge& y) { return x.rb != y.rb ? x.rb < y.rb : x.h < y.h; };
+    for (size_t a = 0, b; a < edges.size(); a = b) {
+      for (b = a + 1; b < edges.size() && ra_of(edges[b]) == ra_of(edges[a]);) ++b;
+      if (b - a > 1) std::sort(edges.begin() + static_cast<std::ptrdiff_t>(a), edges.begin() + static_cast<std::ptrdiff_t>(b), by_rb);
+    }
+    counting_sort(edges, 0, 5 * rings, [&](const Edge& e) { return (e.key >> 60) * rings + ring_of(e); }, tmp);
+  } else {
+    std::sort(edges.begin(), edges.end(), by_key);
+  }
   UnionFind uf(nv);
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
@@ -163,16 +204,22 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     uint64_t ends = (ring_deg[outer] >= 2 ? 2u : 0u) + (ring_deg[inner] >= 2 ? 1u : 0u);
     e.key = (e.key & ~(uint64_t{3} << 58)) | (ends << 58);
   }
-  std::sort(edges.begin() + static_cast<std::ptrdiff_t>(i), edges.end(), [](const Edge& x, const Edge& y) {
-    // class, then ring, then path-end preference, then ranks
-    uint64_t cx = x.key >> 60, cy = y.key >> 60;
-    if (cx != cy) return cx < cy;
-    uint64_t rx = (x.key >> 32) & ((1u << 26) - 1), ry = (y.key >> 32) & ((1u << 26) - 1);
-    if (rx != ry) return rx < ry;
-    uint64_t ex = (x.key >> 58) & 3, ey = (y.key >> 58) & 3;
-    if (ex != ey) return ex < ey;
-    return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
-  });
+  // Class, then ring, then path-end preference, then ranks: the edges are
+  // in that order but for the preference, so a stable counting sort by
+  // (class, ring, preference) is enough (class >= 2 here).
+  auto ends_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 58) & 3); };
+  if (linear) {
+    counting_sort(edges, i, 3 * rings * 4,
+                  [&](const Edge& e) { return (((e.key >> 60) - 2) * rings + ring_of(e)) * 4 + ends_of(e); }, tmp);
+  } else {
+    std::sort(edges.begin() + static_cast<std::ptrdiff_t>(i), edges.end(), [&](const Edge& x, const Edge& y) {
+      uint64_t cx = x.key >> 60, cy = y.key >> 60;
+      if (cx != cy) return cx < cy;
+      if (ring_of(x) != ring_of(y)) return ring_of(x) < ring_of(y);
+      if (ends_of(x) != ends_of(y)) return ends_of(x) < ends_of(y);
+      return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : x.h < y.h;
+    });
+  }
   // Before any edge to a virtual vertex or polygon diagonal: the same-ring
   // edges the path rule left out. The real vertices of a component are
   // connected without those two kinds of edges (a polygon's corners by its
