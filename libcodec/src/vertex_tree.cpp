@@ -5,9 +5,10 @@
 // ring becomes paths, not branching trees), then the ring-to-ring edges,
 // those that join path ends first, then the same-ring edges the path rule
 // left out, then edges to virtual vertices (which so become leaves), polygon
-// diagonals last (so they are never cut). Rings are
-// paths joined by single edges: a spiral with few, long runs. The tree is linearized in pre-order with the children of a node in
-// clockwise order starting from the edge to its parent.
+// diagonals last (so they are never cut). Rings are paths joined by single
+// edges: a spiral with few, long runs. The edges are ordered by counting
+// sorts (linear time). The tree is linearized in pre-order with the
+// children of a node in clockwise order starting from the edge to its parent.
 #include <algorithm>
 #include <numeric>
 
@@ -166,7 +167,8 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     auto by_rb = [](const Edge& x, const Edge& y) { return x.rb != y.rb ? x.rb < y.rb : x.h < y.h; };
     for (size_t a = 0, b; a < edges.size(); a = b) {
       for (b = a + 1; b < edges.size() && ra_of(edges[b]) == ra_of(edges[a]);) ++b;
-      if (b - a > 1) std::sort(edges.begin() + static_cast<std::ptrdiff_t>(a), edges.begin() + static_cast<std::ptrdiff_t>(b), by_rb);
+      const auto first = edges.begin() + static_cast<std::ptrdiff_t>(a);
+      if (b - a > 1) std::sort(first, first + static_cast<std::ptrdiff_t>(b - a), by_rb);
     }
     counting_sort(edges, 0, 5 * rings, [&](const Edge& e) { return (e.key >> 60) * rings + ring_of(e); }, tmp);
   } else {
