@@ -310,8 +310,8 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
   uint64_t len = 0;
   std::string_view name;
   uint8_t kind, domain, type, comps, quant, bits;
-  if (!r.varint(len) || len > kMaxAttributeNameBytes || !r.bytes(static_cast<size_t>(len), name) || !r.u8(kind) || !r.u8(domain) ||
-      !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
+  if (!r.varint(len) || len > kMaxAttributeNameBytes || !r.bytes(static_cast<size_t>(len), name) || !r.u8(kind) ||
+      !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
     return corrupt("truncated attribute header");
   h.name.assign(name);
   if (kind > 3 || domain > 2 || type > 3 || comps < 1 || comps > 4 || quant > 2) return corrupt("bad attribute header");

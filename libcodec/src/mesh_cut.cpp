@@ -25,7 +25,10 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
 
 // Sorted (key, half-edge) pairs of all half-edges, for pairing and counting.
 // Linear: a counting sort by the smaller vertex, then each vertex's few
-// pairs sorted (the same order as sorting them all).
+// pairs sorted (the same order as sorting them all). The pairs are made
+// during the scatter, not sorted afterwards with vertex_tree.cpp's
+// counting_sort: that needs a second array of pairs (the res4 connectivity
+// encode was 5% slower with it).
 std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32_t>& tri) {
   const uint32_t nh = static_cast<uint32_t>(tri.size());
   uint32_t nv = 0;
