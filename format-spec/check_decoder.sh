@@ -90,6 +90,7 @@ corpus_case() {  # check-function name file q level [segment_faces]
 check triangle "$work/triangle.obj" 8 0
 for l in 0 6 9; do check mixed_l$l "$work/mixed.obj" 16 $l; done
 check mixed_small_l9 "$work/mixed_small.obj" 10 9
+check fan_l9 "$work/fan.obj" 12 9
 for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format version 3), written from
+"""An independent decoder for .tsm files (format versions 3 and 4), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version != 3:
+    if version not in (3, 4):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -135,7 +135,7 @@ def read_container(data):
         reject('header checksum missing')                           # step 6
     if struct.unpack_from('<I', data, hend)[0] != xxh32(data[:hend]):
         reject('header checksum')                                   # step 7
-    h = {}
+    h = {'version': version}
     p = hstart                                                      # step 8
     h['vertex_count'], p = read_varint(data, p, hend)
     h['face_count'], p = read_varint(data, p, hend)
@@ -197,7 +197,9 @@ def read_container(data):
                 reject('segment section')
         elif sid in sections:
             reject('duplicate section id')
-        elif (3 <= sid <= 6 or sid == 8) and h['segment_count'] > 1:
+        elif version >= 4 and (3 <= sid <= 6 or sid == 8):
+            reject('version-3 section in a version-4 file')
+        elif (sid == 10 if version >= 4 else (3 <= sid <= 6 or sid == 8)) and h['segment_count'] > 1:
             reject('whole-mesh section in a segmented file')
         if codec == 1:                                              # step 21
             try:
@@ -889,7 +891,62 @@ def floordiv(a, b):
     return a // b    # Python's // is floor division for any sign
 
 
-def decode_geometry(payload, layout, qbits, trace=None):
+PREDICTOR_NAMES = ['ancestors', 'parallelograms', 'gate', 'spread', 'raw']
+
+
+def decode_lattice(d, qmax, vc):
+    """§8.5.2: per axis the sorted lattice planes."""
+    lattice_count, lattice_gap = SIntModel(6), SIntModel(6)
+    lattice = [[], [], []]
+    for a in range(3):
+        n = lattice_count.decode(d)
+        if n < 0 or n > qmax + 1 or n > vc:
+            reject('geometry: lattice count')
+        prev = -1
+        for _ in range(n):
+            x = prev + 1 + lattice_gap.decode(d)
+            if x <= prev or x > qmax or d.truncated():
+                reject('geometry: lattice plane')
+            lattice[a].append(x)
+            prev = x
+    return lattice
+
+
+def decode_geometry_raw(payload, vc, qbits):
+    """§8.5.10 (version 4): the lattice planes, then each coordinate as
+    equiprobable bits: a plane index where its axis has planes, else the grid value."""
+    d = RangeDecoder(payload[1:])
+    qmax = (1 << qbits) - 1
+    lattice = decode_lattice(d, qmax, vc)
+    nbits = []
+    for L in lattice:
+        if not L:
+            nbits.append(qbits)
+        else:
+            k = 0
+            while (1 << k) < len(L):
+                k += 1
+            nbits.append(k)
+    q = [[0, 0, 0] for _ in range(vc)]
+    for v in range(vc):
+        for a in range(3):
+            x = d.direct(nbits[a])
+            if lattice[a]:
+                if x >= len(lattice[a]):
+                    reject('geometry: plane index')
+                x = lattice[a][x]
+            q[v][a] = x
+        if v % 4096 == 0 and d.truncated():
+            reject('geometry: truncated')
+    if d.truncated():
+        reject('geometry: truncated')
+    ginfo = {'predictor': 'raw', 'K': 0, 'lambda': [], 'alpha': [4096, 4096, 4096],
+             'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun,
+             'no_triangle': 0, 'anchored': 0, 'on_plane': 0}
+    return q, ginfo
+
+
+def decode_geometry(payload, layout, qbits, trace=None, version=4):
     vc = layout['vertex_count']
     tri, twin, ids, vparent = layout['tri'], layout['twin'], layout['id'], layout['vparent']
     H = len(tri)
@@ -898,8 +955,16 @@ def decode_geometry(payload, layout, qbits, trace=None):
     if len(payload) < 1:
         reject('geometry: empty')
     predictor = payload[0]
-    if predictor > 3:
+    default_weights = False
+    if version >= 4 and predictor & 0x80 and predictor != 0x80:      # §8.5.1, version 4
+        predictor &= 0x7F
+        default_weights = True
+        if predictor > 3:
+            reject('geometry: predictor without weights')
+    if predictor > (4 if version >= 4 else 3):
         reject('geometry: predictor')
+    if predictor == 4:                                               # §8.5.10 raw
+        return decode_geometry_raw(payload, layout['vertex_count'], qbits)
     pos = 1
     K = 0
     lam = []
@@ -917,32 +982,19 @@ def decode_geometry(payload, layout, qbits, trace=None):
                 reject('geometry: lambda range')
         pos = 2 + 4 * K
     alpha = [4096, 4096, 4096]
-    if predictor != 0:
+    if predictor != 0 and not default_weights:
         if len(payload) < 7:
             reject('geometry: weights missing')
         alpha = list(struct.unpack_from('<3h', payload, 1))
         pos = 7
     d = RangeDecoder(payload[pos:])
     # §8.2 models
-    lattice_count, lattice_gap = SIntModel(6), SIntModel(6)
     residual = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
     on = [probs(3) for _ in range(3)]
     index = [[[SIntModel(6) for _ in range(14)] for _ in range(3)] for _ in range(3)]
     has_anchor = probs(1)
     anchor_gap = UIntModel(2)
-    # §8.5.2 lattice
-    lattice = [[], [], []]
-    for a in range(3):
-        n = lattice_count.decode(d)
-        if n < 0 or n > qmax + 1 or n > vc:
-            reject('geometry: lattice count')
-        prev = -1
-        for _ in range(n):
-            x = prev + 1 + lattice_gap.decode(d)
-            if x <= prev or x > qmax or d.truncated():
-                reject('geometry: lattice plane')
-            lattice[a].append(x)
-            prev = x
+    lattice = decode_lattice(d, qmax, vc)
     q = [[0, 0, 0] for _ in range(vc)]
     act = [UNKNOWN] * vc
     st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0}
@@ -1207,7 +1259,7 @@ def decode_geometry(payload, layout, qbits, trace=None):
                 reject('geometry: truncated')
     if d.truncated():                                        # §8.5.9
         reject('geometry: truncated')
-    ginfo = {'predictor': ['ancestors', 'parallelograms', 'gate', 'spread'][predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
+    ginfo = {'predictor': PREDICTOR_NAMES[predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
              'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun}
     ginfo.update(stats)
     return q, ginfo
@@ -1776,7 +1828,7 @@ def f32(x):
     return struct.unpack('<f', struct.pack('<f', x))[0]
 
 
-def decode_part(streams, counts, bits, earlier, trace):
+def decode_part(streams, counts, bits, earlier, trace, version=4):
     """Steps 26-31 for the whole mesh or one segment (§4.5, §8.11, §8.12). Returns
     faces (part-local ids), q (per own vertex), glob (per part vertex: the
     output id of a reference, NONE for an own vertex), info, attributes (§8.12)."""
@@ -1836,7 +1888,7 @@ def decode_part(streams, counts, bits, earlier, trace):
                 vparent[rank[v]] = rank[layout['vparent'][v]]
         own['vparent'] = vparent
         layout = own
-    q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 30
+    q, ginfo = decode_geometry(s6, layout, bits, trace, version)    # step 30
     info.update(ginfo)
     attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 31
     return faces, q, glob, info, attrs
@@ -1845,7 +1897,23 @@ def decode_part(streams, counts, bits, earlier, trace):
 def decode(data, trace=None):
     h, sections = read_container(data)
     vc, fc, cc = h['vertex_count'], h['face_count'], h['corner_count']
-    if h['segment_count'] == 1:
+    if h['segment_count'] == 1 and h['version'] >= 4:              # §4.7
+        if 10 not in sections:
+            reject('mesh section missing')                           # step 27
+        body = sections[10]
+        p = 0
+        lengths = []
+        for _ in range(4):
+            x, p = read_varint(body, p, len(body))
+            lengths.append(x)
+        streams = []
+        for n in lengths:
+            if n > len(body) - p:
+                reject('mesh section stream length')
+            streams.append(body[p:p + n])
+            p += n
+        parts = [((streams[0], streams[1], streams[2], None, streams[3], body[p:]), (vc, fc, cc, 0))]
+    elif h['segment_count'] == 1:
         for sid in (3, 4, 5):
             if sid not in sections:
                 reject('connectivity section missing')               # step 27
@@ -1880,7 +1948,7 @@ def decode(data, trace=None):
     info = None
     part_attrs = []
     for streams, counts in parts:
-        pf, pq, glob, pinfo, pattrs = decode_part(streams, counts, h['bits'], len(q), trace)
+        pf, pq, glob, pinfo, pattrs = decode_part(streams, counts, h['bits'], len(q), trace, h['version'])
         part_attrs.append(pattrs)
         base = len(q)
         out_id = []

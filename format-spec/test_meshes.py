@@ -6,8 +6,11 @@
                 predictor), a torus of quads with two holes (a handle, polygons),
                 a fin of three triangles on one edge (a non-manifold edge), a
                 hexagon, a degenerate face (a side face), three isolated vertices
-  mixed_small.obj  the same with a 6 x 10 sphere (at -q 10 -l 9: ancestors
-                with lattice planes)
+  mixed_small.obj  the same with a 6 x 10 sphere (at -q 10 -l 9: the gate
+                predictor with its weights left out, version 4)
+  fan.obj       a fan of 300 triangles around a wavy rim: the rim is a path of
+                the vertex tree whose coordinates follow a linear recurrence,
+                so at -l 9 the ancestor predictor (K = 3 or 4) wins
   lattice.obj   a marching-tetrahedra isosurface on a 20^3 voxel grid: every
                 vertex lies on a grid edge, so many coordinates share voxel planes
                 (the geometry lattice), plus an isolated vertex
@@ -41,6 +44,14 @@ def write_obj(path, V, F):
             f.write('v %.6f %.6f %.6f\n' % p)
         for fa in F:
             f.write('f ' + ' '.join(str(i + 1) for i in fa) + '\n')
+
+
+def fan(n=300):
+    V = [(0.0, 0.0, 0.3)]
+    for i in range(n):
+        a = 2 * math.pi * i / n
+        V.append((math.cos(a), math.sin(a), 0.2 * math.sin(3 * a)))
+    return V, [[0, 1 + i, 1 + (i + 1) % n] for i in range(n)]
 
 
 def sphere_rings(v, n_, m_):
@@ -508,6 +519,7 @@ def main():
     write_obj(os.path.join(out, 'mixed.obj'), *mixed())
     write_obj(os.path.join(out, 'mixed_small.obj'), *mixed(6, 10))
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
+    write_obj(os.path.join(out, 'fan.obj'), *fan())
     attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))

@@ -38,7 +38,8 @@ const Section* find_section(const std::vector<Section>& sections, uint16_t id) {
   return nullptr;
 }
 
-// One part of a file: the whole mesh (sections 3-6) or one segment (§4.5).
+// One part of a file: the whole mesh (section 10, or in version 3 sections
+// 3-6) or one segment (§4.5).
 struct PartCounts {
   uint64_t vertex_count = 0, face_count = 0, corner_count = 0, reference_count = 0;
 };
@@ -46,6 +47,7 @@ struct PartStreams {
   std::string_view vertex_tree, triangle_tree, topology, references, geometry;
   bool segmented = false;  // has a references stream
   std::string_view attributes;  // empty: none
+  uint16_t version = kFormatVersion;  // the file's format version (what the geometry header may hold)
 };
 
 // A modelled binary decision costs at least 0.0028146 bits (range_coder.hpp:
@@ -118,11 +120,12 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
   if (!s.segmented) {
     out.global.assign(c.vertex_count, kNone);
-    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
+    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats, s.version));
   } else {
     TSM_RETURN_IF_ERROR(
         decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
-    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats));
+    TSM_RETURN_IF_ERROR(
+        decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats, s.version));
   }
   AttributePart ap;
   ap.faces = &out.faces;
@@ -157,10 +160,10 @@ void parallel_for(size_t n, int threads, F&& f) {
 }
 
 // A segment section as a part: its streams (views into the section) and counts.
-Status read_part(const Section& sec, PartStreams& s, PartCounts& c) {
+Status read_part(const Section& sec, uint16_t version, PartStreams& s, PartCounts& c) {
   SegmentPayload p;
   TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
+  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes, version};
   c = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
   return Status::Ok();
 }
@@ -170,14 +173,27 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
                      std::vector<DecodedPart>& parts) {
   if (h.segment_count == 1) {
     PartStreams s;
-    std::string_view* slot[4] = {&s.vertex_tree, &s.triangle_tree, &s.topology, &s.geometry};
-    const uint16_t ids[4] = {kSectionVertexTree, kSectionTriangleTree, kSectionTopology, kSectionGeometry};
-    for (int k = 0; k < 4; ++k) {
-      const Section* sec = find_section(sections, ids[k]);
-      if (!sec) return corrupt(k < 3 ? "a connectivity section is missing" : "the geometry section is missing");
-      *slot[k] = sec->data;
+    s.version = h.version;
+    if (h.version >= 4) {
+      const Section* sec = find_section(sections, kSectionMesh);
+      if (!sec) return corrupt("the mesh section is missing");
+      MeshPayload p;
+      TSM_RETURN_IF_ERROR(read_mesh_payload(sec->data, p));
+      s.vertex_tree = p.vertex_tree;
+      s.triangle_tree = p.triangle_tree;
+      s.topology = p.topology;
+      s.geometry = p.geometry;
+      s.attributes = p.attributes;
+    } else {
+      std::string_view* slot[4] = {&s.vertex_tree, &s.triangle_tree, &s.topology, &s.geometry};
+      const uint16_t ids[4] = {kSectionVertexTree, kSectionTriangleTree, kSectionTopology, kSectionGeometry};
+      for (int k = 0; k < 4; ++k) {
+        const Section* sec = find_section(sections, ids[k]);
+        if (!sec) return corrupt(k < 3 ? "a connectivity section is missing" : "the geometry section is missing");
+        *slot[k] = sec->data;
+      }
+      if (const Section* a = find_section(sections, kSectionAttributes)) s.attributes = a->data;
     }
-    if (const Section* a = find_section(sections, kSectionAttributes)) s.attributes = a->data;
     streams.assign(1, s);
     parts.resize(1);
     parts[0].counts = PartCounts{h.vertex_count, h.face_count, h.corner_count, 0};
@@ -188,7 +204,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
     if (sec.id != kSectionSegment) continue;
     PartStreams s;
     PartCounts c;
-    TSM_RETURN_IF_ERROR(read_part(sec, s, c));
+    TSM_RETURN_IF_ERROR(read_part(sec, h.version, s, c));
     streams.push_back(s);
     parts.emplace_back();
     parts.back().counts = c;
@@ -777,11 +793,8 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   if (segments.size() == 1) {
     EncodedPart p;
     TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
-    cw.add_section(kSectionVertexTree, p.streams.vertex_tree, 0);
-    cw.add_section(kSectionTriangleTree, p.streams.triangle_tree, 0);
-    cw.add_section(kSectionTopology, p.streams.topology, 0);
-    cw.add_section(kSectionGeometry, p.geometry, 0);
-    if (!p.attributes.empty()) cw.add_section(kSectionAttributes, p.attributes, 0);
+    MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
+    cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
   } else {
     TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
   }
@@ -809,7 +822,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   Header h;
   std::vector<Section> sections;
   TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  info.format_version = kFormatVersion;
+  info.format_version = h.version;
   info.vertex_count = h.vertex_count;
   info.face_count = h.face_count;
   info.corner_count = h.corner_count;
@@ -858,6 +871,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
                             : gs.predictor == Predictor::gate    ? "gate"
                             : gs.predictor == Predictor::spread  ? "spread"
+                            : gs.predictor == Predictor::raw     ? "raw"
                                                                  : "parallelograms";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
@@ -889,7 +903,7 @@ struct StreamDecoder::Impl {
   Status segment(const Section& sec) {
     PartStreams s;
     DecodedPart part;
-    TSM_RETURN_IF_ERROR(read_part(sec, s, part.counts));
+    TSM_RETURN_IF_ERROR(read_part(sec, h.version, s, part.counts));
     const PartCounts& p = part.counts;
     // Against the header before anything is allocated: the header's counts
     // passed the caller's limits.
@@ -944,7 +958,7 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(end());
         break;
       }
-      TSM_RETURN_IF_ERROR(rules.admit(s, h.segment_count));
+      TSM_RETURN_IF_ERROR(rules.admit(s, h));
       if (s.id == kSectionMetadata)
         TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
       else if (s.id == kSectionSegment)

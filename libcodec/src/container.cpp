@@ -1,8 +1,10 @@
 // The .tsm container (format-spec/FORMAT.md §2-3): magic, version, header,
 // then self-delimiting sections, each with an id, a codec (raw or zstd), its
 // lengths and an XXH32 checksum, ended by an end marker. The method's streams
-// (seed 004 §3-4: vertex tree, triangle tree, marching pattern, geometry) are
-// sections; side data is zstd-compressed where that wins. Sections are read in
+// (seed 004 §3-4: vertex tree, triangle tree, marching pattern, geometry) go
+// in one section per segment (version 4: a mesh of one segment has its own,
+// the mesh section; version 3 files, which the decoder still reads, had a
+// section per stream); side data is zstd-compressed where that wins. Sections are read in
 // order, so a decoder can start on a section as soon as its bytes are in.
 //
 // Every length is checked against the bytes that remain before anything is
@@ -30,6 +32,7 @@ const char* section_name(uint16_t id) {
     case kSectionSegment: return "segment";
     case kSectionAttributes: return "attributes";
     case kSectionMetadata: return "metadata";
+    case kSectionMesh: return "mesh";
   }
   return "unknown";
 }
@@ -110,10 +113,12 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
     missing = "file ends inside the header";
     return Status::Ok();
   }
-  if (version != kFormatVersion)
+  if (version < kOldestFormatVersion || version > kFormatVersion)
     return Status(ErrorCode::unsupported, "format version " + std::to_string(version) +
-                                              " is not supported by this decoder (it reads version " +
+                                              " is not supported by this decoder (it reads versions " +
+                                              std::to_string(kOldestFormatVersion) + " to " +
                                               std::to_string(kFormatVersion) + ")");
+  header.version = version;
   if (!r.u16(flags)) {
     missing = "file ends inside the header";
     return Status::Ok();
@@ -216,20 +221,47 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
   return Status::Ok();
 }
 
-Status SectionRules::admit(const Section& s, uint32_t segment_count) {
+Status SectionRules::admit(const Section& s, const Header& h) {
   const size_t at = s.offset;
+  const uint32_t segment_count = h.segment_count;
   if (s.id == kSectionSegment) {
     if (segment_count == 1) return corrupt_at(at, s.id, "a segment section in a file of one segment");
     if (++segments > segment_count)
       return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
     return Status::Ok();
   }
-  if (segment_count > 1 && ((s.id >= kSectionVertexTree && s.id <= kSectionGeometry) || s.id == kSectionAttributes))
+  const bool v3_whole = (s.id >= kSectionVertexTree && s.id <= kSectionGeometry) || s.id == kSectionAttributes;
+  if (h.version >= 4 && v3_whole)
+    return corrupt_at(at, s.id, "a version-3 section in a version-" + std::to_string(h.version) +
+                                    " file (its streams belong in the mesh section)");
+  const bool whole = h.version >= 4 ? s.id == kSectionMesh : v3_whole;
+  if (segment_count > 1 && whole)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
   for (uint16_t prev : seen)
     if (prev == s.id) return corrupt_at(at, s.id, "appears twice");
   seen.push_back(s.id);
   if (seen.size() > 4096) return corrupt("too many sections");
+  return Status::Ok();
+}
+
+std::string write_mesh_payload(const MeshPayload& p) {
+  std::string out;
+  ByteWriter w(out);
+  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.geometry}) w.varint(s.size());
+  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.geometry, p.attributes}) w.bytes(s);
+  return out;
+}
+
+Status read_mesh_payload(std::string_view bytes, MeshPayload& p) {
+  ByteReader r(bytes);
+  uint64_t len[4];
+  for (uint64_t& n : len)
+    if (!r.varint(n)) return corrupt("mesh section: truncated stream lengths");
+  std::string_view* parts[4] = {&p.vertex_tree, &p.triangle_tree, &p.topology, &p.geometry};
+  for (int i = 0; i < 4; ++i)
+    if (len[i] > r.remaining() || !r.bytes(static_cast<size_t>(len[i]), *parts[i]))
+      return corrupt("mesh section: a stream runs past the section's end");
+  r.bytes(r.remaining(), p.attributes);
   return Status::Ok();
 }
 
@@ -246,7 +278,7 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
     TSM_RETURN_IF_ERROR(read_section(bytes, offset, s, decode_payloads, missing));
     if (!missing.empty()) return corrupt(missing);
     if (s.id == kSectionEnd) break;
-    TSM_RETURN_IF_ERROR(rules.admit(s, header.segment_count));
+    TSM_RETURN_IF_ERROR(rules.admit(s, header));
     sections.push_back(std::move(s));
   }
   if (offset != bytes.size())

@@ -11,7 +11,8 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 3;
+constexpr uint16_t kFormatVersion = 4;        // what the encoder writes
+constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 and 4
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder
@@ -29,10 +30,12 @@ enum SectionId : uint16_t {
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
   kSectionAttributes = 8,     // normals, colours, texture coordinates, ... (headers + range coded)
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
+  kSectionMesh = 10,          // version 4: a one-segment mesh's streams 3-6 and attributes in one section
 };
 const char* section_name(uint16_t id);
 
 struct Header {
+  uint16_t version = kFormatVersion;  // as read from the file (kOldestFormatVersion .. kFormatVersion)
   uint64_t vertex_count = 0;
   uint64_t face_count = 0;
   uint64_t corner_count = 0;
@@ -77,12 +80,22 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
 
 // Which ids may follow which (FORMAT.md §4.3): segment sections only in a
 // file of several segments, at most segment_count of them; the whole-mesh
-// sections only in a file of one; any other id at most once.
+// sections only in a file of one (version 3: sections 3-6 and 8; version 4:
+// section 10); any other id at most once.
 struct SectionRules {
   std::vector<uint16_t> seen;
   uint32_t segments = 0;
-  Status admit(const Section& s, uint32_t segment_count);
+  Status admit(const Section& s, const Header& h);
 };
+
+// The mesh section's payload (version 4, FORMAT.md §4.7): the byte lengths
+// of the vertex-tree, triangle-tree, topology and geometry streams, the
+// streams, then the attribute payload (the rest; empty when none).
+struct MeshPayload {
+  std::string_view vertex_tree, triangle_tree, topology, geometry, attributes;
+};
+std::string write_mesh_payload(const MeshPayload& p);
+Status read_mesh_payload(std::string_view bytes, MeshPayload& p);
 
 // Parses the whole container: header, then every section with checksum and
 // length checks. Raw payloads are returned decompressed.

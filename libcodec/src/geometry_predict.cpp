@@ -21,6 +21,9 @@
 //  - ancestors: the paper's predictor, vertex-tree order, P = sum lambda_i
 //    v_{n-i} over the K nearest tree ancestors, lambda fitted per mesh by
 //    least squares (Eigen) and stored as 16.16 fixed point.
+//  - raw (format version 4): no prediction; every coordinate as plain bits
+//    (a plane index where its axis has lattice planes). On a mesh of a few
+//    vertices fresh adaptive models cost more than they save.
 // Residuals: per axis an adaptive signed-integer model chosen by the
 // prediction class (how much was known) and an activity context (the bit
 // length of the residuals of the neighbours, and of this vertex's earlier
@@ -29,6 +32,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -49,6 +53,8 @@ constexpr int kMaxAncestors = 4;
 constexpr int kLambdaShift = 16;
 constexpr int kAlphaShift = 12;
 constexpr int32_t kAlphaOne = 1 << kAlphaShift;
+// Meshes up to this many vertices also try the default weights and no prediction.
+constexpr uint32_t kSmallMesh = 4096;
 
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
@@ -557,11 +563,77 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
   }
 }
 
+// Predictor raw (version 4): the lattice planes, then every coordinate of
+// every vertex in output order as equiprobable bits: the index of its plane
+// when its axis has planes (every value of the axis is one), else its grid
+// value. No models to train: on a mesh of a few vertices this beats any
+// prediction from the grid centre with fresh models.
+int index_bits(size_t planes) {
+  int n = 0;
+  while ((size_t{1} << n) < planes) ++n;
+  return n;
+}
+
+std::string encode_geometry_raw(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits,
+                                const Lattice& lattice) {
+  EncodeSink s;
+  Coder c(g.vertex_count, bits);
+  c.lattice = lattice;
+  code_lattice(s, c);
+  for (size_t i = 0; i < 3 * size_t{g.vertex_count}; ++i) {
+    const std::vector<uint32_t>& L = lattice.values[i % 3];
+    if (L.empty()) {
+      s.e.direct(q[i], bits);
+    } else {
+      const auto it = std::lower_bound(L.begin(), L.end(), q[i]);
+      assert(it != L.end() && *it == q[i]);
+      s.e.direct(static_cast<uint32_t>(it - L.begin()), index_bits(L.size()));
+    }
+  }
+  return std::string(1, static_cast<char>(Predictor::raw)) + s.e.finish();
+}
+
+bool decode_geometry_raw(DecodeSink& s, Coder& c, uint32_t vertex_count, int bits, std::vector<uint32_t>& q) {
+  if (!code_lattice(s, c)) return false;
+  int nbits[3];
+  for (int a = 0; a < 3; ++a) nbits[a] = c.lattice.values[a].empty() ? bits : index_bits(c.lattice.values[a].size());
+  for (uint32_t v = 0; v < vertex_count; ++v) {
+    for (int a = 0; a < 3; ++a) {
+      const std::vector<uint32_t>& L = c.lattice.values[a];
+      const uint32_t x = s.d.direct(nbits[a]);
+      if (L.empty()) {
+        q[3 * size_t{v} + a] = x;
+      } else {
+        if (x >= L.size()) return false;
+        q[3 * size_t{v} + a] = L[x];
+      }
+    }
+    if ((v & 4095) == 0 && s.truncated()) return false;
+  }
+  return !s.truncated();
+}
+
+// Whether every coordinate of an axis with planes is on one of them (what
+// the raw predictor needs).
+bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t vertex_count) {
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<uint32_t>& L = lattice.values[a];
+    if (L.empty()) continue;
+    for (uint32_t v = 0; v < vertex_count; ++v)
+      if (!std::binary_search(L.begin(), L.end(), q[3 * size_t{v} + a])) return false;
+  }
+  return true;
+}
+
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int K, const Lattice& lattice, const int32_t* weights) {
+  if (pred == Predictor::raw) return encode_geometry_raw(g, q, bits, covers(lattice, q, g.vertex_count) ? lattice : Lattice());
   std::string head;
   ByteWriter w(head);
-  w.u8(static_cast<uint8_t>(pred));
+  const bool default_weights =
+      pred != Predictor::ancestors && (!weights || (weights[0] == kAlphaOne && weights[1] == kAlphaOne &&
+                                                    weights[2] == kAlphaOne));
+  w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (pred == Predictor::ancestors) {
     fit_lambda(g, q, K, lambda);
@@ -570,9 +642,9 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   }
   Coder c(g.vertex_count, bits);
   c.spread_ctx = pred == Predictor::spread;
-  if (pred != Predictor::ancestors)
+  if (pred != Predictor::ancestors && !default_weights)
     for (int k = 0; k < 3; ++k) {
-      c.alpha[k] = weights ? weights[k] : kAlphaOne;
+      c.alpha[k] = weights[k];
       w.u16(static_cast<uint16_t>(static_cast<int16_t>(c.alpha[k])));
     }
   EncodeSink s;
@@ -721,20 +793,62 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   if (level >= 7)
     for (int K = 1; K <= kMaxAncestors; ++K) consider(Predictor::ancestors, K, st.lattice, nullptr);
+  // On small meshes the stored weights may cost more than they save, and
+  // (a few vertices) no prediction may beat every predictor: both are cheap
+  // to try there.
+  if (g.vertex_count <= kSmallMesh) {
+    if (st.predictor != Predictor::ancestors) consider(st.predictor, 0, st.lattice, nullptr);
+    // Every value an axis repeats as planes, when the vertices share few
+    // values (the 8 corners of a box: 2 per axis); find_lattice's statistical
+    // test needs more vertices than that.
+    Lattice shared;
+    std::vector<uint32_t> vals(g.vertex_count);
+    for (int a = 0; a < 3; ++a) {
+      for (uint32_t v = 0; v < g.vertex_count; ++v) vals[v] = q[3 * size_t{v} + a];
+      std::sort(vals.begin(), vals.end());
+      vals.erase(std::unique(vals.begin(), vals.end()), vals.end());
+      if (2 * vals.size() <= g.vertex_count) shared.values[a] = vals;
+      vals.resize(g.vertex_count);
+    }
+    if (!shared.values[0].empty() || !shared.values[1].empty() || !shared.values[2].empty()) {
+      for (Predictor pred : {Predictor::gate, Predictor::parallelograms}) consider(pred, 0, shared, nullptr);
+      consider(Predictor::raw, 0, shared, nullptr);
+    }
+    consider(Predictor::raw, 0, Lattice(), nullptr);
+  }
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
   return best;
 }
 
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats) {
+                       GeometryStats* stats, int version) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "geometry: " + what); };
   ByteReader r(bytes);
   GeometryStats st;
   uint8_t kind;
   if (!r.u8(kind)) return corrupt("empty section");
-  if (kind > static_cast<uint8_t>(Predictor::spread)) return corrupt("unknown predictor " + std::to_string(kind));
+  const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
+  bool default_weights = false;
+  if (version >= 4 && (kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
+    kind = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
+    default_weights = true;
+    if (kind > static_cast<uint8_t>(Predictor::spread))
+      return corrupt("predictor " + std::to_string(kind) + " has no weights to leave out");
+  }
+  if (kind > newest) return corrupt("unknown predictor " + std::to_string(kind));
   st.predictor = static_cast<Predictor>(kind);
+  if (st.predictor == Predictor::raw) {
+    q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
+    Coder c(g.vertex_count, bits);
+    DecodeSink ds;
+    ds.d.init(bytes.substr(1));
+    if (!decode_geometry_raw(ds, c, g.vertex_count, bits, q))
+      return corrupt(ds.truncated() ? "stream is truncated" : "bad lattice or plane index");
+    for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(c.lattice.values[a].size());
+    if (stats) *stats = st;
+    return Status::Ok();
+  }
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (st.predictor == Predictor::ancestors) {
     uint8_t K;
@@ -750,7 +864,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     }
   }
   int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
-  if (st.predictor != Predictor::ancestors)
+  if (st.predictor != Predictor::ancestors && !default_weights)
     for (int k = 0; k < 3; ++k) {
       uint16_t x;
       if (!r.u16(x)) return corrupt("truncated predictor header");

@@ -28,7 +28,11 @@ enum class Predictor : uint8_t {
   parallelograms = 1, // march order; average of every parallelogram around the new vertex
   gate = 2,           // march order; the single parallelogram across the gate (fast)
   spread = 3,         // as parallelograms; residual contexts from the parallelograms' spread
+  raw = 4,            // version 4: no prediction, every coordinate as `bits` equiprobable bits (tiny meshes)
 };
+// Version 4: the predictor byte of 1, 2 or 3 with this bit set says the
+// parallelogram weights are all 1.0 and not stored (6 bytes less).
+constexpr uint8_t kDefaultWeightsFlag = 0x80;
 
 // Per axis, the sorted coordinate values many vertices share (the voxel
 // planes of a marching-cubes surface, a CAD grid); empty when not used.
@@ -63,7 +67,9 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
 // experiments).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr);
+// `version`: the file's format version (3 knows neither the raw predictor
+// nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr);
+                       GeometryStats* stats = nullptr, int version = 4);
 
 }  // namespace tsm

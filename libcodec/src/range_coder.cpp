@@ -18,9 +18,25 @@ void RangeEncoder::shift_low() {
 }
 
 std::string RangeEncoder::finish() {
+  // Any value in [low, low + range) decodes the same symbols, and the decoder
+  // reads bytes past the end of a stream as zeros: take the value in that
+  // interval with the most trailing zero bits (range >= 2^24, so one with 24
+  // exists), shift it out, and leave its trailing zero bytes unwritten, at
+  // most kMaxOverrun of them so the decoder does not take the stream for a
+  // truncated one (FORMAT.md §8.1).
+  for (uint64_t mask : {0xFFFFFFFFull, 0xFFFFFFull}) {
+    const uint64_t v = (low_ + mask) & ~mask;
+    if (v < low_ + range_) {
+      low_ = v;
+      break;
+    }
+  }
   for (int i = 0; i < 5; ++i) shift_low();
   // The first byte is always 0 (the cache's initial value): drop it.
   std::string out = out_.substr(1);
+  size_t zeros = 0;
+  while (zeros < RangeDecoder::kMaxOverrun && zeros < out.size() && out[out.size() - 1 - zeros] == 0) ++zeros;
+  out.resize(out.size() - zeros);
   *this = RangeEncoder();
   return out;
 }

@@ -9,7 +9,9 @@
 // bits (the top ones modelled, the rest direct).
 //
 // The decoder is safe on any input: reading past the end yields zero bytes
-// and counts an overrun, which callers check (overrun() != 0 => corrupt).
+// and counts an overrun, which callers check (overrun() > kMaxOverrun =>
+// truncated). The encoder relies on that: it ends a stream on the shortest
+// value its last interval holds and leaves out up to 8 trailing zero bytes.
 #pragma once
 #include <algorithm>
 #include <cstdint>

@@ -1,0 +1,313 @@
+// Format version 4 (FORMAT.md §4.7, §8.5.1, §8.5.10): the mesh section, the
+// default-weights flag and the raw predictor, the shorter range-coder flush,
+// and version 3 files, which the decoder still reads.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "byte_io.hpp"
+#include "container.hpp"
+#include "geometry_predict.hpp"
+#include "mesh_gen.hpp"
+#include "range_coder.hpp"
+#include "test_util.hpp"
+#include "tsm/compare.hpp"
+#include "tsm/tsm.hpp"
+
+namespace {
+
+using tsm::Mesh;
+
+std::string encode(const Mesh& m, int q, int level) {
+  std::string out;
+  tsm::EncodeOptions o;
+  o.quantization_bits = q;
+  o.level = level;
+  const tsm::Status s = tsm::encode(m, o, out);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return out;
+}
+
+Mesh decode_ok(const std::string& bytes) {
+  Mesh m;
+  const tsm::Status s = tsm::decode(bytes, m);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return m;
+}
+
+void expect_round_trip(const Mesh& m, const std::string& bytes, int q, const std::string& what) {
+  Mesh back;
+  const tsm::Status s = tsm::decode(bytes, back);
+  ASSERT_TRUE(s.ok()) << what << ": " << s.to_string();
+  const tsm::CompareResult r = tsm::compare_meshes(m, back, q);
+  EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+  EXPECT_LE(r.max_position_error, 0.5 + 1e-3) << what;
+}
+
+tsm::ErrorCode decode_code(const std::string& bytes) {
+  Mesh m;
+  return tsm::decode(bytes, m).code();
+}
+
+std::string predictor_of(const std::string& bytes) {
+  tsm::FileInfo fi;
+  EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+  return fi.geometry_predictor;
+}
+
+// A file of one segment rewritten with other sections (same header fields,
+// the given version).
+std::string rebuild(const std::string& v4, uint16_t version,
+                    const std::vector<std::pair<uint16_t, std::string>>& sections) {
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  EXPECT_TRUE(tsm::read_container(v4, h, parsed).ok());
+  tsm::ContainerWriter w(h);
+  for (const auto& [id, payload] : sections) w.add_section(id, payload, 0);
+  std::string out = w.finish();
+  // The writer always writes the current version: patch it and the header checksum.
+  out[4] = static_cast<char>(version & 0xFF);
+  out[5] = static_cast<char>(version >> 8);
+  size_t p = 8;
+  uint64_t len = 0;
+  std::string_view rest(out);
+  tsm::ByteReader r(rest.substr(8));
+  EXPECT_TRUE(r.varint(len));
+  p += r.offset() + static_cast<size_t>(len);
+  const uint32_t sum = tsm::checksum32(std::string_view(out).substr(0, p));
+  for (int i = 0; i < 4; ++i) out[p + i] = static_cast<char>(sum >> (8 * i));
+  return out;
+}
+
+// The version 3 layout of a version 4 file: sections 3-6 (and 8), the
+// predictor header's default weights written out.
+std::string as_version3(const std::string& v4) {
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  EXPECT_TRUE(tsm::read_container(v4, h, parsed).ok());
+  const tsm::Section* mesh = nullptr;
+  for (const tsm::Section& s : parsed)
+    if (s.id == tsm::kSectionMesh) mesh = &s;
+  EXPECT_NE(mesh, nullptr);
+  if (!mesh) return {};
+  tsm::MeshPayload p;
+  EXPECT_TRUE(tsm::read_mesh_payload(mesh->data, p).ok());
+  std::string geometry(p.geometry);
+  const uint8_t kind = static_cast<uint8_t>(geometry[0]);
+  if (kind & tsm::kDefaultWeightsFlag) {
+    geometry[0] = static_cast<char>(kind & 0x7F);
+    geometry.insert(1, std::string("\x00\x10\x00\x10\x00\x10", 6));  // 4096 x 3, little-endian
+  }
+  std::vector<std::pair<uint16_t, std::string>> sections = {{tsm::kSectionVertexTree, std::string(p.vertex_tree)},
+                                                            {tsm::kSectionTriangleTree, std::string(p.triangle_tree)},
+                                                            {tsm::kSectionTopology, std::string(p.topology)},
+                                                            {tsm::kSectionGeometry, geometry}};
+  if (!p.attributes.empty()) sections.push_back({tsm::kSectionAttributes, std::string(p.attributes)});
+  return rebuild(v4, 3, sections);
+}
+
+TEST(FormatV4, OneSegmentIsOneMeshSection) {
+  const std::string bytes = encode(tsm_test::icosphere(2), 12, 6);
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(bytes, h, parsed).ok());
+  EXPECT_EQ(h.version, 4);
+  ASSERT_EQ(parsed.size(), 1u);
+  EXPECT_EQ(parsed[0].id, tsm::kSectionMesh);
+}
+
+TEST(FormatV4, Version3FilesStillDecode) {
+  // Meshes whose geometry is not raw (version 3 has no predictor 4), with
+  // and without default weights and attributes.
+  std::vector<Mesh> meshes = {tsm_test::icosphere(3), tsm_test::genus_surface(2), tsm_test::grid_with_holes(8, 2)};
+  Mesh with_attr = tsm_test::icosphere(2);
+  tsm::Attribute a;
+  a.name = "value";
+  a.kind = tsm::AttributeKind::generic;
+  a.domain = tsm::AttributeDomain::vertex;
+  a.components = 1;
+  for (size_t v = 0; v < with_attr.vertex_count(); ++v) a.values.push_back(static_cast<float>(v % 7));
+  with_attr.attributes.push_back(a);
+  meshes.push_back(with_attr);
+  int flagged = 0;
+  for (const Mesh& m : meshes)
+    for (int level : {0, 6}) {
+      const std::string v4 = encode(m, 12, level);
+      ASSERT_NE(predictor_of(v4), "raw");
+      const std::string v3 = as_version3(v4);
+      tsm::FileInfo fi;
+      ASSERT_TRUE(tsm::inspect(v3, fi).ok());
+      EXPECT_EQ(fi.format_version, 3u);
+      const Mesh a4 = decode_ok(v4), a3 = decode_ok(v3);
+      EXPECT_EQ(a3.indices, a4.indices);
+      EXPECT_EQ(a3.positions, a4.positions);
+      EXPECT_EQ(a3.attributes.size(), a4.attributes.size());
+      if (!a3.attributes.empty()) {
+        EXPECT_EQ(a3.attributes[0].values, a4.attributes[0].values);
+      }
+      tsm::Header h;
+      std::vector<tsm::Section> parsed;
+      ASSERT_TRUE(tsm::read_container(v4, h, parsed).ok());
+      for (const tsm::Section& s : parsed)
+        if (s.id == tsm::kSectionMesh) {
+          tsm::MeshPayload p;
+          ASSERT_TRUE(tsm::read_mesh_payload(s.data, p).ok());
+          flagged += (static_cast<uint8_t>(p.geometry[0]) & tsm::kDefaultWeightsFlag) != 0;
+        }
+    }
+  EXPECT_GT(flagged, 0) << "no case exercised the default-weights flag";
+}
+
+TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
+  const std::string v4 = encode(tsm_test::icosphere(2), 12, 6);
+  const std::string v3 = as_version3(v4);
+  ASSERT_FALSE(v3.empty());
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(v4, h, parsed).ok());
+  const std::string mesh = parsed[0].data;
+  // A version 4 file with version 3 sections is corrupt.
+  EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, mesh}, {tsm::kSectionAttributes, "x"}})),
+            tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionVertexTree, "x"}, {tsm::kSectionMesh, mesh}})),
+            tsm::ErrorCode::corrupt_data);
+  // ... and one without its mesh section.
+  EXPECT_EQ(decode_code(rebuild(v4, 4, {})), tsm::ErrorCode::corrupt_data);
+  // In version 3, id 10 is an unknown section: ignored beside sections 3-6,
+  // and not a substitute for them.
+  std::vector<tsm::Section> v3_sections;
+  ASSERT_TRUE(tsm::read_container(v3, h, v3_sections).ok());
+  std::vector<std::pair<uint16_t, std::string>> with_unknown;
+  for (const tsm::Section& s : v3_sections) with_unknown.push_back({s.id, s.data});
+  with_unknown.push_back({tsm::kSectionMesh, "anything"});
+  EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
+  EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
+  // Version 5 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 5, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // A mesh section whose stream lengths run past its end.
+  EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
+            tsm::ErrorCode::corrupt_data);
+}
+
+TEST(FormatV4, PredictorByteRules) {
+  const Mesh m = tsm_test::icosphere(1);
+  const std::string v4 = encode(m, 10, 6);
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(v4, h, parsed).ok());
+  tsm::MeshPayload p;
+  ASSERT_TRUE(tsm::read_mesh_payload(parsed[0].data, p).ok());
+  auto with_geometry = [&](uint16_t version, const std::string& geometry) {
+    tsm::MeshPayload q = p;
+    q.geometry = geometry;
+    if (version == 4) return rebuild(v4, 4, {{tsm::kSectionMesh, tsm::write_mesh_payload(q)}});
+    return rebuild(v4, 3,
+                   {{tsm::kSectionVertexTree, std::string(p.vertex_tree)},
+                    {tsm::kSectionTriangleTree, std::string(p.triangle_tree)},
+                    {tsm::kSectionTopology, std::string(p.topology)},
+                    {tsm::kSectionGeometry, geometry}});
+  };
+  const std::string stream(40, '\x5a');
+  for (int bad : {0x05, 0x80, 0x84, 0x85, 0xff})
+    EXPECT_EQ(decode_code(with_geometry(4, std::string(1, static_cast<char>(bad)) + stream)),
+              tsm::ErrorCode::corrupt_data)
+        << bad;
+  // Version 3 knows neither the flag nor predictor 4.
+  for (int v4_only : {0x04, 0x81, 0x82, 0x83})
+    EXPECT_EQ(decode_code(with_geometry(3, std::string(1, static_cast<char>(v4_only)) + std::string(6, '\0') + stream)),
+              tsm::ErrorCode::corrupt_data)
+        << v4_only;
+}
+
+TEST(FormatV4, TinyMeshesTakeTheRawPredictorAndFewBytes) {
+  // The triangle of FORMAT.md §11 at 11 bits: 122 bytes in version 3 (Draco
+  // 1.5.5 at cl10: 82 for the same triangle in the corpus).
+  Mesh tri;
+  tri.add_vertex(0.123f, 0.6514f, 0.000001f);
+  tri.add_vertex(0.342f, 0.1234f, 0.000002f);
+  tri.add_vertex(0.156f, 0.8422f, 0.000003f);
+  tri.add_triangle(0, 1, 2);
+  const std::string t = encode(tri, 11, 6);
+  EXPECT_EQ(predictor_of(t), "raw");
+  EXPECT_LE(t.size(), 80u);
+  expect_round_trip(tri, t, 11, "triangle");
+  // A closed cube of quads: 2 values per axis, so planes and 1-bit indices
+  // (Draco: 80 bytes for cube_quads.ply at 11 bits).
+  const Mesh cube = tsm_test::cube_quads();
+  const std::string c = encode(cube, 11, 6);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(c, fi).ok());
+  EXPECT_EQ(fi.lattice_planes[0], 2u);
+  EXPECT_LE(c.size(), 80u);
+  expect_round_trip(cube, c, 11, "cube");
+  // Raw at every level and many grid sizes, in segments too.
+  for (int q : {1, 5, 11, 20, 30})
+    for (int level : {0, 6, 9}) {
+      const std::string b = encode(tri, q, level);
+      expect_round_trip(tri, b, q, "triangle q=" + std::to_string(q));
+    }
+}
+
+TEST(FormatV4, RawPredictorTruncationAndBadIndices) {
+  const Mesh cube = tsm_test::cube_quads();
+  const std::string good = encode(cube, 11, 6);
+  ASSERT_EQ(predictor_of(good), "raw");
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(good, h, parsed).ok());
+  tsm::MeshPayload p;
+  ASSERT_TRUE(tsm::read_mesh_payload(parsed[0].data, p).ok());
+  // Every shorter geometry stream: refused once more than 8 bytes are missing,
+  // never a crash; every byte flipped: refused or decoded, never a crash.
+  std::mt19937 rng(4);
+  for (size_t cut = 1; cut < p.geometry.size(); ++cut) {
+    tsm::MeshPayload q = p;
+    q.geometry = p.geometry.substr(0, cut);
+    (void)decode_code(rebuild(good, 4, {{tsm::kSectionMesh, tsm::write_mesh_payload(q)}}));
+  }
+  for (size_t i = 1; i < p.geometry.size(); ++i) {
+    std::string g(p.geometry);
+    g[i] = static_cast<char>(g[i] ^ (1 + rng() % 255));
+    tsm::MeshPayload q = p;
+    q.geometry = g;
+    (void)decode_code(rebuild(good, 4, {{tsm::kSectionMesh, tsm::write_mesh_payload(q)}}));
+  }
+  tsm::MeshPayload q = p;
+  q.geometry = std::string(1, '\x04');  // raw, nothing else: 24 coordinates from 8 zero bytes
+  EXPECT_EQ(decode_code(rebuild(good, 4, {{tsm::kSectionMesh, tsm::write_mesh_payload(q)}})),
+            tsm::ErrorCode::corrupt_data);
+}
+
+TEST(FormatV4, ShortFlushLeavesAtMostEightBytesOut) {
+  // Random symbol streams: the trimmed flush decodes to the same symbols and
+  // the decoder never reads more than 8 bytes past the end.
+  std::mt19937 rng(11);
+  for (int t = 0; t < 300; ++t) {
+    const int n = static_cast<int>(rng() % 200);
+    std::vector<int> bits(n);
+    const uint32_t skew = rng() % 32768;
+    tsm::Prob pe;
+    tsm::RangeEncoder e;
+    for (int& b : bits) {
+      b = (rng() % 32768) < skew;
+      e.bit(pe, b);
+    }
+    const uint32_t tail = static_cast<uint32_t>(rng());
+    e.direct(tail, 32);
+    const std::string out = e.finish();
+    tsm::RangeDecoder d(out);
+    tsm::Prob pd;
+    for (int b : bits) ASSERT_EQ(d.bit(pd), b);
+    ASSERT_EQ(d.direct(32), tail);
+    EXPECT_LE(d.overrun(), tsm::RangeDecoder::kMaxOverrun);
+    if (!out.empty() && d.overrun() < tsm::RangeDecoder::kMaxOverrun) {
+      EXPECT_NE(out.back(), '\0') << "a trailing zero byte left in";
+    }
+  }
+  tsm::RangeEncoder empty;
+  EXPECT_EQ(empty.finish().size(), 0u);
+}
+
+}  // namespace
