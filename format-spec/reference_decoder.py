@@ -1894,25 +1894,30 @@ def decode_part(streams, counts, bits, earlier, trace, version=4):
     return faces, q, glob, info, attrs
 
 
+def read_streams(body, p, n, what):
+    """§4.5, §4.7: n varint lengths from offset p, the n streams, then the rest."""
+    lengths = []
+    for _ in range(n):
+        x, p = read_varint(body, p, len(body))
+        lengths.append(x)
+    streams = []
+    for length in lengths:
+        if length > len(body) - p:
+            reject(what)
+        streams.append(body[p:p + length])
+        p += length
+    streams.append(body[p:])
+    return streams
+
+
 def decode(data, trace=None):
     h, sections = read_container(data)
     vc, fc, cc = h['vertex_count'], h['face_count'], h['corner_count']
     if h['segment_count'] == 1 and h['version'] >= 4:              # §4.7
         if 10 not in sections:
             reject('mesh section missing')                           # step 27
-        body = sections[10]
-        p = 0
-        lengths = []
-        for _ in range(4):
-            x, p = read_varint(body, p, len(body))
-            lengths.append(x)
-        streams = []
-        for n in lengths:
-            if n > len(body) - p:
-                reject('mesh section stream length')
-            streams.append(body[p:p + n])
-            p += n
-        parts = [((streams[0], streams[1], streams[2], None, streams[3], body[p:]), (vc, fc, cc, 0))]
+        s3, s4, s5, s6, rest = read_streams(sections[10], 0, 4, 'mesh section stream length')
+        parts = [((s3, s4, s5, None, s6, rest), (vc, fc, cc, 0))]
     elif h['segment_count'] == 1:
         for sid in (3, 4, 5):
             if sid not in sections:
@@ -1924,18 +1929,13 @@ def decode(data, trace=None):
         parts = []
         for body in sections[7]:
             p = 0
-            fields = []
-            for _ in range(9):
+            counts = []
+            for _ in range(4):
                 x, p = read_varint(body, p, len(body))
-                fields.append(x)
-            counts = tuple(fields[:4])
-            streams = []
-            for n in fields[4:]:
-                if n > len(body) - p:
-                    reject('segment stream length')
-                streams.append(body[p:p + n])
-                p += n
-            streams.append(body[p:])       # the rest: the segment's attribute payload (§8.12)
+                counts.append(x)
+            counts = tuple(counts)
+            # the streams, then the rest: the segment's attribute payload (§8.12)
+            streams = read_streams(body, p, 5, 'segment stream length')
             if counts[3] > counts[0]:
                 reject('segment references')
             parts.append((tuple(streams), counts))

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 
@@ -75,5 +76,27 @@ class ByteReader {
   const uint8_t* end_ = nullptr;
   const uint8_t* begin_ = nullptr;
 };
+
+// Streams one after another behind their byte lengths (a segment payload,
+// FORMAT.md §4.5, and the mesh section, §4.7): the lengths as varints, the
+// streams, then `rest`, whose length is what remains.
+inline void write_streams(ByteWriter& w, std::initializer_list<std::string_view> streams, std::string_view rest) {
+  for (std::string_view s : streams) w.varint(s.size());
+  for (std::string_view s : streams) w.bytes(s);
+  w.bytes(rest);
+}
+
+// Reads what write_streams wrote into *parts[0 .. N) and `rest`.
+enum class StreamsRead { ok, lengths_truncated, stream_past_end };
+template <size_t N>
+StreamsRead read_streams(ByteReader& r, std::string_view* const (&parts)[N], std::string_view& rest) {
+  uint64_t len[N];
+  for (size_t i = 0; i < N; ++i)
+    if (!r.varint(len[i])) return StreamsRead::lengths_truncated;
+  for (size_t i = 0; i < N; ++i)
+    if (len[i] > r.remaining() || !r.bytes(static_cast<size_t>(len[i]), *parts[i])) return StreamsRead::stream_past_end;
+  r.bytes(r.remaining(), rest);
+  return StreamsRead::ok;
+}
 
 }  // namespace tsm

@@ -247,21 +247,18 @@ Status SectionRules::admit(const Section& s, const Header& h) {
 std::string write_mesh_payload(const MeshPayload& p) {
   std::string out;
   ByteWriter w(out);
-  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.geometry}) w.varint(s.size());
-  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.geometry, p.attributes}) w.bytes(s);
+  write_streams(w, {p.vertex_tree, p.triangle_tree, p.topology, p.geometry}, p.attributes);
   return out;
 }
 
 Status read_mesh_payload(std::string_view bytes, MeshPayload& p) {
   ByteReader r(bytes);
-  uint64_t len[4];
-  for (uint64_t& n : len)
-    if (!r.varint(n)) return corrupt("mesh section: truncated stream lengths");
-  std::string_view* parts[4] = {&p.vertex_tree, &p.triangle_tree, &p.topology, &p.geometry};
-  for (int i = 0; i < 4; ++i)
-    if (len[i] > r.remaining() || !r.bytes(static_cast<size_t>(len[i]), *parts[i]))
-      return corrupt("mesh section: a stream runs past the section's end");
-  r.bytes(r.remaining(), p.attributes);
+  std::string_view* const parts[4] = {&p.vertex_tree, &p.triangle_tree, &p.topology, &p.geometry};
+  switch (read_streams(r, parts, p.attributes)) {
+    case StreamsRead::lengths_truncated: return corrupt("mesh section: truncated stream lengths");
+    case StreamsRead::stream_past_end: return corrupt("mesh section: a stream runs past the section's end");
+    case StreamsRead::ok: break;
+  }
   return Status::Ok();
 }
 

@@ -201,24 +201,21 @@ std::string write_segment(const SegmentPayload& p) {
   w.varint(p.face_count);
   w.varint(p.corner_count);
   w.varint(p.reference_count);
-  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry}) w.varint(s.size());
-  for (std::string_view s : {p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, p.attributes})
-    w.bytes(s);
+  write_streams(w, {p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry}, p.attributes);
   return out;
 }
 
 Status read_segment(std::string_view bytes, SegmentPayload& p) {
   ByteReader r(bytes);
-  uint64_t len[5];
-  bool ok = r.varint(p.vertex_count) && r.varint(p.face_count) && r.varint(p.corner_count) &&
-            r.varint(p.reference_count);
-  for (uint64_t& n : len) ok = ok && r.varint(n);
-  if (!ok) return corrupt("segment section: truncated counts");
-  std::string_view* parts[5] = {&p.vertex_tree, &p.triangle_tree, &p.topology, &p.references, &p.geometry};
-  for (int i = 0; i < 5; ++i)
-    if (len[i] > r.remaining() || !r.bytes(static_cast<size_t>(len[i]), *parts[i]))
-      return corrupt("segment section: a stream runs past the section's end");
-  r.bytes(r.remaining(), p.attributes);
+  if (!r.varint(p.vertex_count) || !r.varint(p.face_count) || !r.varint(p.corner_count) ||
+      !r.varint(p.reference_count))
+    return corrupt("segment section: truncated counts");
+  std::string_view* const parts[5] = {&p.vertex_tree, &p.triangle_tree, &p.topology, &p.references, &p.geometry};
+  switch (read_streams(r, parts, p.attributes)) {
+    case StreamsRead::lengths_truncated: return corrupt("segment section: truncated counts");
+    case StreamsRead::stream_past_end: return corrupt("segment section: a stream runs past the section's end");
+    case StreamsRead::ok: break;
+  }
   if (p.reference_count > p.vertex_count) return corrupt("segment section: more references than vertices");
   return Status::Ok();
 }

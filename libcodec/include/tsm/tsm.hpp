@@ -111,7 +111,8 @@ struct FileInfo {
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
-  // "gate" or "ancestors" (with K), and the lattice planes per axis (0 = unused).
+  // "gate", "ancestors" (with K) or "raw", and the lattice planes per axis
+  // (0 = unused).
   std::string geometry_predictor;
   int ancestors = 0;
   uint32_t lattice_planes[3] = {0, 0, 0};
