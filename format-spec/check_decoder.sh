@@ -25,6 +25,8 @@
 #   --add-metadata inserts a raw section 9 into an encoded file; well-formed
 #   ones must decode (and compare) on both sides, malformed ones must be
 #   refused by both.
+# * forged attribute headers (test_meshes.py --replace-in-mesh rewrites bytes
+#   of a mesh section and its checksum) must be refused by both.
 # Exit status: 0 when every case is IDENTICAL (and every malformed file
 # refused by both), 1 otherwise.
 here=$(cd "$(dirname "$0")" && pwd)
@@ -131,6 +133,13 @@ for bad in duplicate_key:02016100016100 empty_key:01000000 trailing_byte:0101610
            count_too_large:02016100 value_too_long:0101610500 truncated_count:80; do
   $meta "$work/triangle.tsm" "$work/metadata_${bad%%:*}.tsm" --raw "${bad#*:}" && refused "metadata_${bad%%:*}"
 done
+
+# ---- forged attribute headers (§8.12): an integer type on a grid, f32 as exact integers
+forge="$PY $here/test_meshes.py --replace-in-mesh"
+$forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 056c6162656c000002010000 \
+  056c6162656c000002010108000000000000000000000000 && refused forged_u16_grid
+$forge "$work/attributes_ply_l0.tsm" "$work/forged_f32_exact.tsm" 0b74656d70657261747572650000000101 \
+  0b74656d70657261747572650000000100 && refused forged_f32_exact
 
 if [ -n "$failed" ]; then
   echo "$cases cases, FAILED:$failed"

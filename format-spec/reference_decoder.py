@@ -1306,6 +1306,9 @@ def read_attribute_header(buf, p):
         reject('attributes: bad attribute header')
     if h.quant != 0 and not 1 <= h.bits <= 24:
         reject('attributes: bad quantization bits')
+    if (h.type == 0) == (h.quant == 0):
+        reject('attributes: an f32 attribute coded as exact integers' if h.quant == 0 else
+               'attributes: an integer attribute not coded as exact integers')
     if h.quant == 2 and h.components != 3:
         reject('attributes: octahedral needs 3 components')
     if (h.kind == 1 and h.components != 3) or (h.kind == 3 and h.components != 2) or \

@@ -31,6 +31,7 @@ Usage: test_meshes.py DIR
        test_meshes.py --add-metadata SRC.tsm DST.tsm KEY=VALUE ...
        test_meshes.py --add-metadata SRC.tsm DST.tsm --raw HEX   (a malformed payload)
          (with --zstd: the section zstd-coded, by the zstd command)
+       test_meshes.py --replace-in-mesh SRC.tsm DST.tsm OLD_HEX NEW_HEX   (a forged mesh section)
 """
 import math
 import os
@@ -502,7 +503,48 @@ def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
                + struct.pack('<I', xxh32(stored)) + stored)
     open(dst, 'wb').write(data[:at] + section + data[at:])
 
+def replace_in_mesh(src, dst, old, new):
+    """Copies the .tsm file src to dst with the first occurrence of the bytes
+    old in its raw mesh section (id 10, §4.7) replaced by new, and that
+    section's lengths and checksum rewritten to match (a forged file that
+    only the payload rules can refuse)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from reference_decoder import xxh32, read_varint
+
+    def varint(n):
+        out = bytearray()
+        while True:
+            if n < 0x80:
+                out.append(n)
+                return bytes(out)
+            out.append(0x80 | (n & 0x7F))
+            n >>= 7
+    data = open(src, 'rb').read()
+    hlen, p = read_varint(data, 8, len(data))
+    p += hlen + 4
+    while True:
+        sid, codec = struct.unpack_from('<HB', data, p)
+        if sid == 0:
+            sys.exit('%s: no raw mesh section' % src)
+        stored_len, q = read_varint(data, p + 3, len(data))
+        _, q = read_varint(data, q, len(data))
+        payload = data[q + 4:q + 4 + stored_len]
+        if sid == 10 and codec == 0:
+            if old not in payload:
+                sys.exit('%s: %s not in the mesh section' % (src, old.hex()))
+            payload = payload.replace(old, new, 1)
+            section = (struct.pack('<HB', 10, 0) + varint(len(payload)) + varint(len(payload))
+                       + struct.pack('<I', xxh32(payload)) + payload)
+            open(dst, 'wb').write(data[:p] + section + data[q + 4 + stored_len:])
+            return
+        p = q + 4 + stored_len
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == '--replace-in-mesh':
+        # --replace-in-mesh SRC DST OLD_HEX NEW_HEX
+        replace_in_mesh(sys.argv[2], sys.argv[3], bytes.fromhex(sys.argv[4]), bytes.fromhex(sys.argv[5]))
+        return
     if len(sys.argv) > 1 and sys.argv[1] == '--add-metadata':
         # --add-metadata SRC DST KEY=VALUE ...   or   --add-metadata SRC DST --raw HEX
         args = sys.argv[4:]

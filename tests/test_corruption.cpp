@@ -791,3 +791,69 @@ TEST(Corruption, ForgedMetadataRefused) {
   EXPECT_EQ(guarded_decode(build(twice)).status.code(), ErrorCode::corrupt_data) << "two metadata sections";
 }
 
+// An attribute's type and quantization pair one way only (FORMAT.md §8.12):
+// integer types are coded exactly, f32 on a grid or octahedrally. fuzz_decode
+// found a forged file whose u8 attribute said "octahedral" and decoded to
+// fractions, a mesh the encoder then refused; both forged pairings are now
+// refused by the decoder, whole and streamed.
+TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
+  Mesh m = tsm_test::icosphere(1);
+  tsm::Attribute color;
+  color.name = "color";
+  color.kind = tsm::AttributeKind::color;
+  color.type = tsm::AttributeType::u8;
+  color.components = 3;
+  tsm::Attribute temp;
+  temp.name = "temp";
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    for (int c = 0; c < 3; ++c) color.values.push_back(static_cast<float>((v * 37 + 11 * c) % 256));
+    temp.values.push_back(0.25f * static_cast<float>(v));
+  }
+  m.attributes = {color, temp};
+  const Container good = parse(encode_ok(m, 12));
+  ASSERT_EQ(guarded_decode(build(good)).status.code(), ErrorCode::ok);
+  size_t at = good.sections.size();
+  for (size_t i = 0; i < good.sections.size(); ++i)
+    if (good.sections[i].id == 10) at = i;
+  ASSERT_LT(at, good.sections.size()) << "no mesh section";
+  ASSERT_EQ(good.sections[at].codec, 0);
+  const std::string& payload = good.sections[at].stored;
+  // Header: name, kind, domain, type, components, quant, bits[, origin f32 x components, extent f64].
+  const size_t c_at = payload.find(std::string("\x05" "color\x02\x00\x01\x03\x00", 10));
+  const size_t t_at = payload.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
+  ASSERT_NE(c_at, std::string::npos) << "colour header not found";
+  ASSERT_NE(t_at, std::string::npos) << "temp header not found";
+  struct Case {
+    const char* what;
+    std::string payload;
+    const char* message;
+  };
+  std::vector<Case> cases;
+  std::string octahedral_u8 = payload;  // u8 colour as octahedral, 8 bits
+  octahedral_u8[c_at + 10] = 2;
+  octahedral_u8[c_at + 11] = 8;
+  cases.push_back({"u8 octahedral", octahedral_u8, "integer attribute not coded as exact"});
+  std::string grid_u8 = payload;  // u8 colour on a grid: origin and extent added
+  grid_u8[c_at + 10] = 1;
+  grid_u8[c_at + 11] = 8;
+  grid_u8.insert(c_at + 12, std::string(3 * 4 + 8, '\0'));
+  cases.push_back({"u8 grid", grid_u8, "integer attribute not coded as exact"});
+  std::string exact_f32 = payload;  // f32 temp as exact integers: origin and extent dropped
+  exact_f32[t_at + 9] = 0;
+  exact_f32.erase(t_at + 11, 4 + 8);
+  cases.push_back({"f32 exact", exact_f32, "f32 attribute coded as exact integers"});
+  for (const Case& k : cases) {
+    Container c = good;
+    c.sections[at].stored = k.payload;
+    const std::string bytes = build(c);
+    const DecodeResult r = guarded_decode(bytes);
+    expect_clean(r, k.what);
+    EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << k.what << ": " << describe(r);
+    EXPECT_TRUE(tsm_test::contains(r.status.message(), k.message)) << k.what << ": " << describe(r);
+    tsm::StreamDecoder sd;
+    tsm::Status s = sd.feed(bytes);
+    if (s.ok()) s = sd.finish();
+    EXPECT_EQ(s.code(), ErrorCode::corrupt_data) << k.what << " (stream): " << s.to_string();
+  }
+}
+

@@ -322,6 +322,9 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
   h.quant = static_cast<AttributeQuant>(quant);
   h.bits = bits;
   if (h.quant != AttributeQuant::exact && (bits < 1 || bits > 24)) return corrupt("bad quantization bits");
+  if ((h.type == AttributeType::f32) == (h.quant == AttributeQuant::exact))
+    return corrupt(h.quant == AttributeQuant::exact ? "an f32 attribute coded as exact integers"
+                                                    : "an integer attribute not coded as exact integers");
   if (h.quant == AttributeQuant::octahedral && comps != 3) return corrupt("octahedral needs 3 components");
   if (h.kind == AttributeKind::normal && comps != 3) return corrupt("a normal has 3 components");
   if (h.kind == AttributeKind::texcoord && comps != 2) return corrupt("a texture coordinate has 2 components");
