@@ -215,13 +215,15 @@ struct SurfaceCoder {
   std::vector<uint32_t>& q;
   int64_t last[3];
   int last_act = 0;
+  std::vector<uint32_t> cv;  // per half-edge: the output vertex at its origin (kNone: virtual), one load less
 
   SurfaceCoder(const GeometryLayout& layout, Coder& coder, Sink& sink, std::vector<uint32_t>& qs)
-      : g(layout), c(coder), s(sink), q(qs) {
+      : g(layout), c(coder), s(sink), q(qs), cv(layout.tri.size()) {
     for (int a = 0; a < 3; ++a) last[a] = (c.qmax + 1) / 2;
+    for (size_t h = 0; h < cv.size(); ++h) cv[h] = g.vertex[g.tri[h]];
   }
-  uint32_t known(uint32_t p) const {  // output vertex at position p if decoded, else kNone
-    uint32_t v = g.vertex[p];
+  uint32_t known(uint32_t h) const {  // output vertex at the origin of half-edge h if decoded, else kNone
+    uint32_t v = cv[h];
     return v != kNone && c.act[v] != kUnknown ? v : kNone;
   }
   const uint32_t* at(uint32_t v) const { return &q[3 * static_cast<size_t>(v)]; }
@@ -229,7 +231,7 @@ struct SurfaceCoder {
   // Codes the vertex at the origin of half-edge h0 (undecoded, not virtual);
   // multi: every triangle around it, else only h0's triangle.
   bool code(uint32_t h0, bool multi) {
-    const uint32_t v = g.vertex[g.tri[h0]];
+    const uint32_t v = cv[h0];
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, pred[3];
     int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // per axis, the smallest and largest parallelogram
     int npara = 0, nnb = 0, actsum = 0;
@@ -239,12 +241,12 @@ struct SurfaceCoder {
       actsum += c.act[u];
     };
     auto visit = [&](uint32_t h) {
-      uint32_t u = known(g.tri[he_next(h)]);
+      uint32_t u = known(he_next(h));
       if (u == kNone) return;
       neighbour(u);
-      uint32_t w = known(g.tri[he_prev(h)]);
+      uint32_t w = known(he_prev(h));
       if (w == kNone) return;
-      uint32_t o = known(g.tri[he_prev(g.twin[he_next(h)])]);
+      uint32_t o = known(he_prev(g.twin[he_next(h)]));
       if (o == kNone) return;
       for (int a = 0; a < 3; ++a) {
         const int64_t x = int64_t{at(u)[a]} + at(w)[a] - at(o)[a];
@@ -263,7 +265,7 @@ struct SurfaceCoder {
       } while (h != h0 && ++guard < g.tri.size());
     } else {
       visit(h0);
-      uint32_t w = known(g.tri[he_prev(h0)]);  // the root triangle's third corner sees two
+      uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
       if (w != kNone && npara == 0) neighbour(w);
     }
     int cls;
@@ -329,7 +331,7 @@ template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   for (uint32_t h0 = 0; h0 < g.tri.size(); ++h0) {
-    if (sc.known(g.tri[h0]) != kNone || g.vertex[g.tri[h0]] == kNone) continue;
+    if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
     if (!sc.code(h0, multi)) return false;
     if ((h0 & 4095) == 0 && s.truncated()) return false;
   }
@@ -348,7 +350,7 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   const uint32_t H = static_cast<uint32_t>(g.tri.size());
   std::vector<uint32_t> first_he(n, kNone);
   for (uint32_t h = 0; h < H; ++h) {
-    uint32_t v = g.vertex[g.tri[h]];
+    uint32_t v = sc.cv[h];
     if (v != kNone && first_he[v] == kNone) first_he[v] = h;
   }
   std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
@@ -368,27 +370,27 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
     size_t guard = 0;
     do {
       const uint32_t hn = he_next(h), hp = he_prev(h);
-      const uint32_t pu = g.tri[hn], pw = g.tri[hp];
-      const uint32_t u = sc.known(pu), w = sc.known(pw);
+      const uint32_t xu = sc.cv[hn], xw = sc.cv[hp];
+      const uint32_t u = sc.known(hn), w = sc.known(hp);
       // v as a neighbour of u.
-      if (u == kNone && g.vertex[pu] != kNone) {
-        uint32_t x = g.vertex[pu];
+      if (u == kNone && xu != kNone) {
+        uint32_t x = xu;
         if (nnb[x] < 255) ++nnb[x];
         // Parallelogram of u in triangle (u, w, v), across w-v.
-        if (w != kNone && sc.known(g.tri[he_prev(g.twin[hp])]) != kNone && npara[x] < 255) ++npara[x];
+        if (w != kNone && sc.known(he_prev(g.twin[hp])) != kNone && npara[x] < 255) ++npara[x];
         bump(x);
       }
       // Parallelogram of w in triangle (w, v, u), across v-u.
-      if (w == kNone && g.vertex[pw] != kNone && u != kNone && sc.known(g.tri[he_prev(g.twin[h])]) != kNone) {
-        uint32_t x = g.vertex[pw];
+      if (w == kNone && xw != kNone && u != kNone && sc.known(he_prev(g.twin[h])) != kNone) {
+        uint32_t x = xw;
         if (npara[x] < 255) ++npara[x];
         bump(x);
       }
       // v as the far corner o of the vertex across u-w.
       if (u != kNone && w != kNone) {
-        uint32_t px = g.tri[he_prev(g.twin[hn])];
-        uint32_t x = g.vertex[px];
-        if (x != kNone && sc.known(px) == kNone) {
+        uint32_t hx = he_prev(g.twin[hn]);
+        uint32_t x = sc.cv[hx];
+        if (x != kNone && sc.known(hx) == kNone) {
           if (npara[x] < 255) ++npara[x];
           bump(x);
         }
@@ -413,9 +415,9 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
       }
     }
     if (v == kNone) {  // a new component: first undecoded corner in march order
-      while (scan < H && (g.vertex[g.tri[scan]] == kNone || sc.known(g.tri[scan]) != kNone)) ++scan;
+      while (scan < H && (sc.cv[scan] == kNone || sc.known(scan) != kNone)) ++scan;
       if (scan == H) break;
-      v = g.vertex[g.tri[scan]];
+      v = sc.cv[scan];
     }
     if (!sc.code(first_he[v], true)) return false;
     decoded(v);
