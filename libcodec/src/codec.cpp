@@ -441,9 +441,13 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 // stitched back: there the decoded order lets the cut find another copy of
 // a split vertex first. So a part with stitches is coded as its decoded
 // self would be: decode the streams, code that mesh, and repeat until
-// decoding gives back the faces coded (a fixed point when the vertex order
-// comes back too: every stitched mesh we have reaches it after one round,
-// the dragons included; the Moebius strip comes back mirrored).
+// decoding gives back the faces coded, corner for corner (every stitched
+// mesh we have reaches it after at most one round, the dragons included).
+// At that point output vertex v may simply be the coded mesh's vertex v,
+// whatever order the coder chose: the decoded faces name the same ids at
+// the same corners. That matters for a symmetric mesh (the Moebius strip),
+// whose coder order is a symmetry of its faces (its mirror image): taken as
+// it is, it would permute the positions on every re-encoding.
 constexpr int kCanonicalRounds = 4;
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
@@ -451,7 +455,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, ce, view));
   if (ce.stats.stitches == 0) return Status::Ok();
   const size_t n = mesh.vertex_count();
-  std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids
+  std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids (empty: the same)
   Mesh coded;                  // that mesh (faces only), once it is not `mesh`
   std::vector<uint32_t> q;
   std::vector<uint8_t> ref;
@@ -459,11 +463,18 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     Mesh decoded;
     GeometryLayout scratch;
     TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
-    // Decoding gives back the faces coded: with the same vertex order the
-    // bytes are canonical; with another order the faces map onto themselves
-    // (a symmetric mesh, e.g. a Moebius strip cut along another edge), and
-    // more rounds only permute it again.
-    if (round > 0 && decoded.indices == coded.indices && decoded.face_offsets == coded.face_offsets) break;
+    const Mesh& now = round == 0 ? mesh : coded;
+    if (decoded.indices == now.indices && decoded.face_offsets == now.face_offsets) {
+      // Output vertex v as `now`'s vertex v, when every vertex is on a face
+      // (a vertex on none is placed by its anchor, which the order found).
+      std::vector<uint8_t> on_face(n, 0);
+      for (uint32_t v : now.indices) on_face[v] = 1;
+      if (std::all_of(on_face.begin(), on_face.end(), [](uint8_t x) { return x != 0; })) {
+        std::iota(ce.vertex_order.begin(), ce.vertex_order.end(), 0u);
+        view = round == 0 ? own_view(ce, qin, is_ref) : own_view(ce, q, is_ref.empty() ? is_ref : ref);
+      }
+      break;
+    }
     std::vector<uint32_t> next(n);
     for (size_t v = 0; v < n; ++v) next[v] = base.empty() ? ce.vertex_order[v] : base[ce.vertex_order[v]];
     base = std::move(next);
@@ -479,7 +490,8 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     ce = ConnectivityEncoding();
     TSM_RETURN_IF_ERROR(part_connectivity(coded, q, is_ref.empty() ? is_ref : ref, options, ce, view));
   }
-  for (uint32_t& x : ce.vertex_order) x = base[x];  // back to the part's input ids
+  if (!base.empty())
+    for (uint32_t& x : ce.vertex_order) x = base[x];  // back to the part's input ids
   return Status::Ok();
 }
 
