@@ -471,6 +471,17 @@ def uv_corner_obj(path):
         f.writelines('f ' + ' '.join('%d/%d' % (c + 1, t) for c, t in fa) + '\n' for fa in F)
 
 
+def varint(n):
+    """n as a LEB128 varint (FORMAT.md §3)."""
+    out = bytearray()
+    while True:
+        if n < 0x80:
+            out.append(n)
+            return bytes(out)
+        out.append(0x80 | (n & 0x7F))
+        n >>= 7
+
+
 def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
     """Copies the .tsm file src to dst with a metadata section (id 9, §4.6)
     inserted after the header checksum, as the reference encoder places it.
@@ -479,15 +490,6 @@ def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
     command), else raw."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from reference_decoder import xxh32, read_varint
-
-    def varint(n):
-        out = bytearray()
-        while True:
-            if n < 0x80:
-                out.append(n)
-                return bytes(out)
-            out.append(0x80 | (n & 0x7F))
-            n >>= 7
     data = open(src, 'rb').read()
     hlen, p = read_varint(data, 8, len(data))
     at = p + hlen + 4
@@ -503,6 +505,7 @@ def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
                + struct.pack('<I', xxh32(stored)) + stored)
     open(dst, 'wb').write(data[:at] + section + data[at:])
 
+
 def replace_in_mesh(src, dst, old, new):
     """Copies the .tsm file src to dst with the first occurrence of the bytes
     old in its raw mesh section (id 10, §4.7) replaced by new, and that
@@ -510,15 +513,6 @@ def replace_in_mesh(src, dst, old, new):
     only the payload rules can refuse)."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from reference_decoder import xxh32, read_varint
-
-    def varint(n):
-        out = bytearray()
-        while True:
-            if n < 0x80:
-                out.append(n)
-                return bytes(out)
-            out.append(0x80 | (n & 0x7F))
-            n >>= 7
     data = open(src, 'rb').read()
     hlen, p = read_varint(data, 8, len(data))
     p += hlen + 4
