@@ -50,7 +50,10 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
   const PreparedInput prep = prepare_input(mesh);
   const CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), hints);
-  const VertexForest f = build_vertex_tree(m, hints.qpos, hints.midpoint_tree && hints.qpos);
+  const bool by_position = hints.root_rule > 0 && hints.qpos;
+  out.root_tie = m.root_tie;
+  const VertexForest f =
+      build_vertex_tree(m, hints.qpos, hints.midpoint_tree && hints.qpos, by_position, &out.root_tie);
 
   RangeEncoder ev, et, eo;
   VertexTreeModels vm;

@@ -64,6 +64,9 @@ struct CutMesh {
   uint32_t triangle_count() const { return static_cast<uint32_t>(tri.size() / 3); }
   // Statistics.
   uint32_t holes = 0, duplicates = 0, cut_edges = 0;
+  // CutHints::root_rule > 0: two vertices shared the extreme position, so
+  // the roots depend on vertex ids (the caller then drops that rule).
+  bool root_tie = false;
 };
 
 // The input split into what the manifold coder takes and side lists.
@@ -87,7 +90,26 @@ struct CutHints {
   // The vertex tree: the midpoint-distance Kruskal variant (needs qpos)
   // instead of the layered spiral.
   bool midpoint_tree = false;
+  // Where each component's tree starts. 0: at its smallest vertex id, the
+  // reference edge to its neighbour of smallest id. 1..6 (needs qpos): at
+  // the vertex with the smallest (odd rule) or largest (even rule) quantized
+  // position, compared lexicographically from axis (rule - 1) / 2 on; the
+  // reference edge to the neighbour with the smallest position. A decoded
+  // mesh has the same positions, so a rule picks the same roots and edges
+  // there (the encoder tries several and keeps the smallest file).
+  int root_rule = 0;
 };
+
+// Lexicographic order of quantized positions (3 per input vertex), from
+// axis `first` on: -1, 0 or 1.
+inline int compare_positions(const std::vector<uint32_t>& qpos, uint32_t a, uint32_t b, int first) {
+  for (int i = 0; i < 3; ++i) {
+    const int axis = (first + i) % 3;
+    const uint32_t x = qpos[3 * size_t{a} + axis], y = qpos[3 * size_t{b} + axis];
+    if (x != y) return x < y ? -1 : 1;
+  }
+  return 0;
+}
 
 CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
 
@@ -107,7 +129,11 @@ struct VertexForest {
 // midpoint: the Kruskal variant over edges by their midpoint's distance from
 // the root (needs qpos, quantized positions per input vertex); else the
 // layered spiral.
-VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos = nullptr, bool midpoint = false);
+// geometric_ref: a root's reference edge goes to its neighbour with the
+// smallest position (CutHints::root_rule > 0; a tie sets *tie), else to
+// its neighbour of smallest id.
+VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos = nullptr, bool midpoint = false,
+                               bool geometric_ref = false, bool* tie = nullptr);
 
 // Stage 3: bounding loop of one component (encoder side: with half-edges).
 struct JumpEndpoint {
@@ -196,6 +222,7 @@ struct ConnectivityEncoding {
   // The cut surface as the decoder will rebuild it, for the geometry coder.
   GeometryLayout layout;
   ConnectivityStats stats;
+  bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
 };
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints = CutHints());

@@ -47,6 +47,37 @@ std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32
   return e;
 }
 
+// CutHints::root_rule > 0: each component with triangles starts at its real
+// vertex of extreme position instead of its smallest id (the components keep
+// their order, by smallest id). A tie on position sets m.root_tie.
+void root_by_position(CutMesh& m, const std::vector<uint8_t>& on_triangle, const std::vector<uint32_t>& qpos,
+                      int rule) {
+  const int first = (rule - 1) / 2;
+  const int sign = rule % 2 == 1 ? 1 : -1;  // odd: smallest, even: largest
+  std::vector<uint32_t> best(m.component_count(), kNone);
+  std::vector<uint8_t> tie(m.component_count(), 0);
+  for (uint32_t v = 0; v < m.vertex_count; ++v) {
+    if (m.kind[v] != VertexKind::real || !on_triangle[v]) continue;
+    const uint32_t c = m.vertex_component[v];
+    if (best[c] == kNone) {
+      best[c] = v;
+      continue;
+    }
+    const int order = sign * compare_positions(qpos, m.source[v], m.source[best[c]], first);
+    if (order < 0) {
+      best[c] = v;
+      tie[c] = 0;
+    } else if (order == 0) {
+      tie[c] = 1;
+    }
+  }
+  for (uint32_t c = 0; c < m.component_count(); ++c) {
+    if (best[c] == kNone) continue;  // a component on no triangle: its only vertex
+    m.component_root[c] = best[c];
+    if (tie[c]) m.root_tie = true;
+  }
+}
+
 }  // namespace
 
 PreparedInput prepare_input(const Mesh& mesh) {
@@ -241,6 +272,7 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
     }
     m.vertex_component[v] = m.vertex_component[r];
   }
+  if (hints.root_rule > 0 && hints.qpos) root_by_position(m, on_triangle, *hints.qpos, hints.root_rule);
   if (isolated_key)
     std::stable_sort(isolated.begin(), isolated.end(),
                      [&](uint32_t a, uint32_t b) { return (*isolated_key)[a] < (*isolated_key)[b]; });

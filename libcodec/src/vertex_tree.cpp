@@ -32,7 +32,8 @@ void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std
 
 }  // namespace
 
-VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos, bool midpoint) {
+VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos, bool midpoint,
+                               bool geometric_ref, bool* tie) {
   const uint32_t nv = m.vertex_count;
   const uint32_t nh = static_cast<uint32_t>(m.tri.size());
   VertexForest f;
@@ -45,6 +46,8 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
   // decoded mesh (ids in pre-order) the same neighbour is again the smallest:
   // every later choice depends only on the root and this edge, never on the
   // input's numbering, and re-encoding a decoded mesh gives the same bytes.
+  // With geometric_ref the neighbour of smallest position, which a decoded
+  // mesh has too (a tie on position sets *tie).
   std::vector<uint32_t> out_he(nv, kNone);
   for (uint32_t h = 0; h < nh; ++h)
     if (out_he[m.tri[h]] == kNone) out_he[m.tri[h]] = h;
@@ -53,11 +56,23 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     uint32_t start = out_he[root];
     if (start == kNone) continue;
     uint32_t best = kNone, h = start;
+    bool tied = false;
     do {
       uint32_t w = m.tri[he_next(h)];
-      if (!is_virtual(w) && !m.diagonal[h] && (best == kNone || w < m.tri[he_next(best)])) best = h;
+      if (!is_virtual(w) && !m.diagonal[h]) {
+        if (best == kNone) {
+          best = h;
+        } else if (geometric_ref) {
+          const int order = compare_positions(*qpos, m.source[w], m.source[m.tri[he_next(best)]], 0);
+          if (order < 0) best = h;
+          tied = order == 0 ? true : order < 0 ? false : tied;
+        } else if (w < m.tri[he_next(best)]) {
+          best = h;
+        }
+      }
       h = he_next(m.twin[h]);
     } while (h != start);
+    if (tied && tie) *tie = true;
     out_he[root] = best;
   }
 
