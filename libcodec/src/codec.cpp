@@ -497,18 +497,37 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
 
 // qin: grid indices per part input vertex; is_ref: per part input vertex,
 // 1 when an earlier segment holds it (empty: none).
+constexpr int kRootSearchLevel = 7;  // see encode_part
+
+// The connectivity codings encode_part has tried for a part: a tree choice
+// that codes the same streams in the same vertex order as one before (small
+// components, where several rules pick the same roots; faces that are all
+// degenerate) gives the same part, so it is not coded again.
+using TriedCodings = std::vector<std::pair<ConnectivityStreams, std::vector<uint32_t>>>;
+
+bool same_streams(const ConnectivityStreams& a, const ConnectivityStreams& b) {
+  return a.vertex_tree == b.vertex_tree && a.triangle_tree == b.triangle_tree && a.topology == b.topology;
+}
+
 // A part coded with the given vertex trees; `usable` is false when that
 // choice is left out (encode_part).
 Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                         const std::vector<AttributeHeader>& headers, const EncodeOptions& options, TreeChoice tree,
-                        EncodedPart& out, bool& usable, bool& stitched) {
+                        EncodedPart& out, bool& usable, bool& stitched, TriedCodings& tried) {
   const int bits = options.quantization_bits;
   ConnectivityEncoding ce;
   OwnView view;
   TSM_RETURN_IF_ERROR(canonical_connectivity(mesh, qin, is_ref, options, tree, ce, view));
   stitched = ce.stats.stitches != 0;
   usable = !ce.root_tie && !stitched;
-  if (tree.root_rule != 0 && !usable) return Status::Ok();
+  for (const auto& [streams, order] : tried)
+    if (same_streams(streams, ce.streams) && order == ce.vertex_order) usable = false;
+  if (tree.root_rule != 0 || tree.midpoint) {
+    if (!usable) return Status::Ok();
+    tried.emplace_back(ce.streams, ce.vertex_order);
+  } else if (options.level >= kRootSearchLevel && !stitched) {
+    tried.emplace_back(ce.streams, ce.vertex_order);
+  }
   std::vector<uint32_t>& mark = view.mark;
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
@@ -548,8 +567,6 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
 // Left out: a rule whose root or reference edge ties on position (it would
 // follow ids), and parts with stitches (their canonical rounds re-code the
 // decoded mesh; they keep the smallest-id spiral).
-constexpr int kRootSearchLevel = 7;
-
 size_t part_bytes(const EncodedPart& p) {
   return p.streams.vertex_tree.size() + p.streams.triangle_tree.size() + p.streams.topology.size() +
          p.geometry.size() + p.attributes.size();
@@ -558,7 +575,9 @@ size_t part_bytes(const EncodedPart& p) {
 Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                    const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
   bool usable = true, stitched = false;
-  TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, TreeChoice(), out, usable, stitched));
+  TriedCodings tried;
+  TSM_RETURN_IF_ERROR(
+      encode_part_from(mesh, qin, is_ref, headers, options, TreeChoice(), out, usable, stitched, tried));
   if (options.level < kRootSearchLevel || stitched || mesh.face_count() == 0) return Status::Ok();
   std::vector<TreeChoice> trees;
   if (options.level >= 9) {
@@ -581,7 +600,7 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
   size_t best = part_bytes(out);
   for (const TreeChoice& tree : trees) {
     EncodedPart alt;
-    TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, tree, alt, usable, stitched));
+    TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, tree, alt, usable, stitched, tried));
     if (!usable) continue;
     const size_t size = part_bytes(alt);
     if (size < best) {
