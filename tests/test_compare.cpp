@@ -21,25 +21,8 @@ using tsm::compare_meshes;
 using tsm::Grid;
 using tsm::Mesh;
 
-// Renumbers vertices: new vertex perm[v] is old vertex v.
-Mesh permute_vertices(const Mesh& m, const std::vector<uint32_t>& perm) {
-  Mesh out;
-  out.positions.resize(m.positions.size());
-  for (size_t v = 0; v < m.vertex_count(); ++v)
-    for (size_t a = 0; a < 3; ++a) out.positions[3 * perm[v] + a] = m.positions[3 * v + a];
-  out.face_offsets = m.face_offsets;
-  out.indices.resize(m.indices.size());
-  for (size_t i = 0; i < m.indices.size(); ++i) out.indices[i] = perm[m.indices[i]];
-  return out;
-}
-
-std::vector<uint32_t> random_permutation(size_t n, uint32_t seed) {
-  std::vector<uint32_t> p(n);
-  std::iota(p.begin(), p.end(), 0u);
-  std::mt19937 rng(seed);
-  std::shuffle(p.begin(), p.end(), rng);
-  return p;
-}
+using tsm_test::permute_vertices;
+using tsm_test::random_permutation;
 
 // Rebuilds the mesh with faces in the order `order` (old face ids), each face's
 // corners rotated left by `rotate(f)`, and reversed when f == flip.

@@ -2,9 +2,7 @@
 // mesh a user can hand us (issue: connectivity), through the public API.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <filesystem>
-#include <numeric>
 #include <random>
 
 #include "connectivity.hpp"
@@ -87,15 +85,7 @@ namespace {
 
 // The same mesh with its vertices numbered by a random permutation.
 Mesh renumbered(const Mesh& m, uint32_t seed) {
-  std::vector<uint32_t> perm(m.vertex_count());
-  std::iota(perm.begin(), perm.end(), 0u);
-  std::mt19937 rng(seed);
-  std::shuffle(perm.begin(), perm.end(), rng);
-  Mesh o = m;
-  for (size_t v = 0; v < perm.size(); ++v)
-    for (int a = 0; a < 3; ++a) o.positions[3 * size_t{perm[v]} + a] = m.positions[3 * v + a];
-  for (uint32_t& i : o.indices) i = perm[i];
-  return o;
+  return tsm_test::permute_vertices(m, tsm_test::random_permutation(m.vertex_count(), seed));
 }
 
 std::string encode_at(const Mesh& m, int q, int level) {

@@ -2,9 +2,11 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -75,6 +77,27 @@ struct TempDir {
   ~TempDir();
   std::string file(const std::string& name) const { return (path / name).string(); }
 };
+
+// Renumbers vertices: new vertex perm[v] is old vertex v (positions and
+// faces; attributes are dropped).
+inline tsm::Mesh permute_vertices(const tsm::Mesh& m, const std::vector<uint32_t>& perm) {
+  tsm::Mesh out;
+  out.positions.resize(m.positions.size());
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    for (size_t a = 0; a < 3; ++a) out.positions[3 * size_t{perm[v]} + a] = m.positions[3 * v + a];
+  out.face_offsets = m.face_offsets;
+  out.indices.resize(m.indices.size());
+  for (size_t i = 0; i < m.indices.size(); ++i) out.indices[i] = perm[m.indices[i]];
+  return out;
+}
+
+inline std::vector<uint32_t> random_permutation(size_t n, uint32_t seed) {
+  std::vector<uint32_t> p(n);
+  std::iota(p.begin(), p.end(), 0u);
+  std::mt19937 rng(seed);
+  std::shuffle(p.begin(), p.end(), rng);
+  return p;
+}
 
 }  // namespace tsm_test
 
