@@ -111,6 +111,26 @@ inline int compare_positions(const std::vector<uint32_t>& qpos, uint32_t a, uint
   return 0;
 }
 
+// Of the candidates offered (an id and its input vertex), the one whose
+// position comes first in compare_positions (sign 1) or last (sign -1), and
+// whether another had the same position (a tie).
+struct PositionExtreme {
+  const std::vector<uint32_t>* qpos = nullptr;
+  int first = 0, sign = 1;
+  uint32_t best = kNone, best_input = kNone;
+  bool tie = false;
+  void offer(uint32_t id, uint32_t input) {
+    const int order = best == kNone ? -1 : sign * compare_positions(*qpos, input, best_input, first);
+    if (order < 0) {
+      best = id;
+      best_input = input;
+      tie = false;
+    } else if (order == 0) {
+      tie = true;
+    }
+  }
+};
+
 CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
 
 // Stage 2: the vertex spanning forest, in pre-order.

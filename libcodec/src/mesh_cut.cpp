@@ -52,29 +52,13 @@ std::vector<std::pair<uint64_t, uint32_t>> sorted_edges(const std::vector<uint32
 // their order, by smallest id). A tie on position sets m.root_tie.
 void root_by_position(CutMesh& m, const std::vector<uint8_t>& on_triangle, const std::vector<uint32_t>& qpos,
                       int rule) {
-  const int first = (rule - 1) / 2;
-  const int sign = rule % 2 == 1 ? 1 : -1;  // odd: smallest, even: largest
-  std::vector<uint32_t> best(m.component_count(), kNone);
-  std::vector<uint8_t> tie(m.component_count(), 0);
-  for (uint32_t v = 0; v < m.vertex_count; ++v) {
-    if (m.kind[v] != VertexKind::real || !on_triangle[v]) continue;
-    const uint32_t c = m.vertex_component[v];
-    if (best[c] == kNone) {
-      best[c] = v;
-      continue;
-    }
-    const int order = sign * compare_positions(qpos, m.source[v], m.source[best[c]], first);
-    if (order < 0) {
-      best[c] = v;
-      tie[c] = 0;
-    } else if (order == 0) {
-      tie[c] = 1;
-    }
-  }
+  std::vector<PositionExtreme> root(m.component_count(), PositionExtreme{&qpos, (rule - 1) / 2, rule % 2 ? 1 : -1});
+  for (uint32_t v = 0; v < m.vertex_count; ++v)
+    if (m.kind[v] == VertexKind::real && on_triangle[v]) root[m.vertex_component[v]].offer(v, m.source[v]);
   for (uint32_t c = 0; c < m.component_count(); ++c) {
-    if (best[c] == kNone) continue;  // a component on no triangle: its only vertex
-    m.component_root[c] = best[c];
-    if (tie[c]) m.root_tie = true;
+    if (root[c].best == kNone) continue;  // a component on no triangle: its only vertex
+    m.component_root[c] = root[c].best;
+    if (root[c].tie) m.root_tie = true;
   }
 }
 

@@ -56,23 +56,21 @@ VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qp
     uint32_t start = out_he[root];
     if (start == kNone) continue;
     uint32_t best = kNone, h = start;
-    bool tied = false;
+    PositionExtreme nearest{qpos};
     do {
       uint32_t w = m.tri[he_next(h)];
       if (!is_virtual(w) && !m.diagonal[h]) {
-        if (best == kNone) {
+        if (geometric_ref)
+          nearest.offer(h, m.source[w]);
+        else if (best == kNone || w < m.tri[he_next(best)])
           best = h;
-        } else if (geometric_ref) {
-          const int order = compare_positions(*qpos, m.source[w], m.source[m.tri[he_next(best)]], 0);
-          if (order < 0) best = h;
-          tied = order == 0 ? true : order < 0 ? false : tied;
-        } else if (w < m.tri[he_next(best)]) {
-          best = h;
-        }
       }
       h = he_next(m.twin[h]);
     } while (h != start);
-    if (tied && tie) *tie = true;
+    if (geometric_ref) {
+      best = nearest.best;
+      if (nearest.tie && tie) *tie = true;
+    }
     out_he[root] = best;
   }
 
