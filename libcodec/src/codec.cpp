@@ -495,10 +495,6 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   return Status::Ok();
 }
 
-// qin: grid indices per part input vertex; is_ref: per part input vertex,
-// 1 when an earlier segment holds it (empty: none).
-constexpr int kRootSearchLevel = 7;  // see encode_part
-
 // The connectivity codings encode_part has tried for a part: a tree choice
 // that codes the same streams in the same vertex order as one before (small
 // components, where several rules pick the same roots; faces that are all
@@ -510,24 +506,26 @@ bool same_streams(const ConnectivityStreams& a, const ConnectivityStreams& b) {
 }
 
 // A part coded with the given vertex trees; `usable` is false when that
-// choice is left out (encode_part).
+// choice is left out (encode_part), and then only the default tree is coded
+// on. `tried`: the codings so far, when encode_part compares several.
+// qin: grid indices per part input vertex; is_ref: per part input vertex,
+// 1 when an earlier segment holds it (empty: none).
 Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                         const std::vector<AttributeHeader>& headers, const EncodeOptions& options, TreeChoice tree,
-                        EncodedPart& out, bool& usable, bool& stitched, TriedCodings& tried) {
+                        EncodedPart& out, bool& usable, bool& stitched, TriedCodings* tried) {
   const int bits = options.quantization_bits;
   ConnectivityEncoding ce;
   OwnView view;
   TSM_RETURN_IF_ERROR(canonical_connectivity(mesh, qin, is_ref, options, tree, ce, view));
   stitched = ce.stats.stitches != 0;
   usable = !ce.root_tie && !stitched;
-  for (const auto& [streams, order] : tried)
-    if (same_streams(streams, ce.streams) && order == ce.vertex_order) usable = false;
-  if (tree.root_rule != 0 || tree.midpoint) {
-    if (!usable) return Status::Ok();
-    tried.emplace_back(ce.streams, ce.vertex_order);
-  } else if (options.level >= kRootSearchLevel && !stitched) {
-    tried.emplace_back(ce.streams, ce.vertex_order);
+  if (usable && tried) {
+    for (const auto& [streams, order] : *tried)
+      if (same_streams(streams, ce.streams) && order == ce.vertex_order) usable = false;
+    if (usable) tried->emplace_back(ce.streams, ce.vertex_order);
   }
+  const bool default_tree = tree.root_rule == 0 && !tree.midpoint;
+  if (!usable && !default_tree) return Status::Ok();
   std::vector<uint32_t>& mark = view.mark;
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
@@ -567,6 +565,8 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
 // Left out: a rule whose root or reference edge ties on position (it would
 // follow ids), and parts with stitches (their canonical rounds re-code the
 // decoded mesh; they keep the smallest-id spiral).
+constexpr int kRootSearchLevel = 7;
+
 size_t part_bytes(const EncodedPart& p) {
   return p.streams.vertex_tree.size() + p.streams.triangle_tree.size() + p.streams.topology.size() +
          p.geometry.size() + p.attributes.size();
@@ -576,9 +576,10 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
                    const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
   bool usable = true, stitched = false;
   TriedCodings tried;
-  TSM_RETURN_IF_ERROR(
-      encode_part_from(mesh, qin, is_ref, headers, options, TreeChoice(), out, usable, stitched, tried));
-  if (options.level < kRootSearchLevel || stitched || mesh.face_count() == 0) return Status::Ok();
+  const bool search = options.level >= kRootSearchLevel;
+  TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, TreeChoice(), out, usable, stitched,
+                                       search ? &tried : nullptr));
+  if (!search || stitched || mesh.face_count() == 0) return Status::Ok();
   std::vector<TreeChoice> trees;
   if (options.level >= 9) {
     // Every rule with each tree: a decoded mesh's smallest-id root is the
@@ -600,7 +601,7 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
   size_t best = part_bytes(out);
   for (const TreeChoice& tree : trees) {
     EncodedPart alt;
-    TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, tree, alt, usable, stitched, tried));
+    TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, tree, alt, usable, stitched, &tried));
     if (!usable) continue;
     const size_t size = part_bytes(alt);
     if (size < best) {
