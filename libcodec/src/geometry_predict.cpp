@@ -746,12 +746,6 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
   return out;
 }
 
-size_t estimate_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
-  int32_t lsq[3], est[3];
-  fit_alphas(g, q, bits, Predictor::parallelograms, lsq, est);
-  return encode_geometry_as(g, q, bits, Predictor::parallelograms, 0, Lattice(), est).size();
-}
-
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
                             const Lattice* candidate, GeometryStats* stats) {
   GeometryStats st;

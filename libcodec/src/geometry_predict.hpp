@@ -67,10 +67,6 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
 // experiments).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr);
-// A quick size estimate of the geometry of a coding (the parallelogram
-// predictor with its fitted weights, no lattice, no trials): how the encoder
-// compares vertex-tree roots.
-size_t estimate_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits);
 // `version`: the file's format version (3 knows neither the raw predictor
 // nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
