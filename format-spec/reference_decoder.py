@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 and 4), written from
+"""An independent decoder for .tsm files (format versions 3, 4 and 5), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4):
+    if version not in (3, 4, 5):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -956,6 +956,10 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         reject('geometry: empty')
     predictor = payload[0]
     default_weights = False
+    tangent = False
+    if version >= 5 and predictor in (0x41, 0x42, 0x43, 0xC1, 0xC2, 0xC3):   # §8.5.1, version 5
+        predictor &= 0xBF
+        tangent = True
     if version >= 4 and predictor & 0x80 and predictor != 0x80:      # §8.5.1, version 4
         predictor &= 0x7F
         default_weights = True
@@ -987,6 +991,14 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             reject('geometry: weights missing')
         alpha = list(struct.unpack_from('<3h', payload, 1))
         pos = 7
+    beta = [4096, 4096]
+    if tangent:                                                      # §8.5.1, version 5
+        if len(payload) < pos + 4:
+            reject('geometry: tangent weights missing')
+        beta = list(struct.unpack_from('<2H', payload, pos))
+        if beta[0] > 8192 or beta[1] > 8192:
+            reject('geometry: tangent weight range')
+        pos += 4
     d = RangeDecoder(payload[pos:])
     # §8.2 models
     residual = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
@@ -1015,17 +1027,35 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         return j
 
     # §8.5.3
-    def code_vertex(v, pred, cls, activity, spread=None):
+    def code_vertex(v, pred, cls, activity, spread=None, normal=None, tset=0):
         sm = 0
         top = 0
         n_on = 0
-        for a in range(3):
+        order = (0, 1, 2)
+        kn = None                                            # the axis nearest the normal (version 5)
+        res = [0, 0, 0]
+        if normal is not None:                               # the tangent step
+            kn = 0
+            for a in (1, 2):
+                if abs(normal[a]) > abs(normal[kn]):
+                    kn = a
+            if normal[kn] == 0:
+                kn = None
+            else:
+                order = tuple(a for a in range(3) if a != kn) + (kn,)
+        for i in range(3):
+            a = order[i]
             if spread is not None:                           # predictor 3, 2+ parallelograms
                 ctx = bit_length(spread[a])
             else:
-                ctx = activity if a == 0 else (activity + bit_length(top) + 1) // 2
+                ctx = activity if i == 0 else (activity + bit_length(top) + 1) // 2
             ctx = min(ctx, 13)
             p = min(max(pred[a], 0), qmax)
+            if a == kn:                                      # through the tangent plane
+                b, c = order[0], order[1]
+                sg = 1 if normal[kn] > 0 else -1
+                num = -sg * (normal[b] * res[b] + normal[c] * res[c])
+                p = min(max(pred[a] + div_round(beta[tset] * num, 4096 * sg * normal[kn]), 0), qmax)
             coded = False
             L = lattice[a]
             if L:
@@ -1040,20 +1070,23 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                     n_on += 1
                     coded = True
             if not coded:
-                r = residual[a][cls][ctx].decode(d)
+                r = residual[i][cls][ctx].decode(d)          # by coding position i (= a without a normal)
                 x = p + r
                 if x < 0 or x > qmax:
                     reject('geometry: coordinate outside the grid')
             q[v][a] = x
+            res[a] = x - min(max(pred[a], 0), qmax)          # from the clamped prediction before the step
             e = abs(x - p)
             sm += e
             top = max(top, e)
         act[v] = min(bit_length(sm), 254)
         if trace is not None:
-            trace.append('v%d pred=%s cls=%d act_in=%d -> q=%s act=%d' % (v, list(pred), cls, activity, q[v], act[v]))
+            trace.append('v%d pred=%s cls=%d act_in=%d%s -> q=%s act=%d' % (
+                v, list(pred), cls, activity,
+                ' normal=%s set=%d' % (list(normal), tset) if normal is not None else '', q[v], act[v]))
 
-    def point(v, pred, cls, activity, spread=None):
-        code_vertex(v, pred, cls, activity, spread)
+    def point(v, pred, cls, activity, spread=None, normal=None, tset=0):
+        code_vertex(v, pred, cls, activity, spread, normal, tset)
         st['last'] = list(q[v])
         st['last_act'] = act[v]
 
@@ -1072,6 +1105,22 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     def div_round(s, n):
         return floordiv(2 * s + n, 2 * n)
 
+    # §8.5.4, version 5: a normal at c from the triangles (c, u, w), (u, w) in T
+    def tangent_normal(c, T):
+        if len(T) == 0 or len(T) > 4096:
+            return None
+        n = [0, 0, 0]
+        for u, w in T:
+            d1 = [q[u][a] - c[a] for a in range(3)]
+            d2 = [q[w][a] - c[a] for a in range(3)]
+            if any(abs(x) >= 1 << 20 for x in d1 + d2):
+                return None
+            n[0] += d1[1] * d2[2] - d1[2] * d2[1]
+            n[1] += d1[2] * d2[0] - d1[0] * d2[2]
+            n[2] += d1[0] * d2[1] - d1[1] * d2[0]
+        sh = max(0, bit_length(max(abs(n[0]), abs(n[1]), abs(n[2]))) - 16)
+        return [x >> sh if x >= 0 else -((-x) >> sh) for x in n]
+
     # §8.5.4
     def predict(h0, multi):
         para = [0, 0, 0]
@@ -1079,6 +1128,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         lo = [0, 0, 0]                 # per axis the smallest and largest single parallelogram
         hi = [0, 0, 0]
         cnt = {'npara': 0, 'nnb': 0, 'actsum': 0}
+        T = []                         # version 5: the pairs (u, w) found decoded
 
         def neighbour(u):
             for a in range(3):
@@ -1094,6 +1144,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             w = known(tri[prv_he(h)])
             if w == NONE:
                 return
+            T.append((u, w))
             o = known(tri[prv_he(twin[nxt_he(h)])])
             if o == NONE:
                 return
@@ -1128,9 +1179,30 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             cls = 0
         activity = (cnt['actsum'] + nnb // 2) // nnb if nnb > 0 else st['last_act']
         spread = [hi[a] - lo[a] for a in range(3)] if predictor == 3 and npara >= 2 else None
-        return pred, cls, activity, spread
+        normal = tangent_normal(pred, T) if tangent and npara > 0 else None
+        return pred, cls, activity, spread, normal        # set 0
 
     # §8.5.7
+    def anchor_normal(A):                                    # §8.5.7, version 5
+        if not first_he_any:
+            first_he_any.extend([NONE] * vc)
+            for h in range(H - 1, -1, -1):
+                x = ids[tri[h]]
+                if x != NONE:
+                    first_he_any[x] = h
+        h0 = first_he_any[A]
+        if h0 == NONE:
+            return None
+        T = []
+        for h in fan(h0):
+            u = known(tri[nxt_he(h)])
+            w = known(tri[prv_he(h)])
+            if u != NONE and w != NONE:
+                T.append((u, w))
+        return tangent_normal(q[A], T)
+
+    first_he_any = []
+
     def on_no_triangle():
         prev_anchor = 0
         for v in range(vc):
@@ -1147,9 +1219,11 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                 prev_anchor = anchor
                 stats['anchored'] += 1
                 pred = list(q[anchor])
+                normal = anchor_normal(anchor) if tangent else None
             else:
                 pred = list(st['last'])
-            point(v, pred, 0, st['last_act'])
+                normal = None
+            point(v, pred, 0, st['last_act'], None, normal, 1)
             if v % 4096 == 0 and d.truncated():
                 reject('geometry: truncated')
 
@@ -1260,6 +1334,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if d.truncated():                                        # §8.5.9
         reject('geometry: truncated')
     ginfo = {'predictor': PREDICTOR_NAMES[predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
+             'tangent': tangent, 'beta': beta if tangent else None,
              'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun}
     ginfo.update(stats)
     return q, ginfo
@@ -2288,7 +2363,7 @@ def main(argv):
           'attributes %s; metadata %s' % (
               path, len(q), len(faces), h['bits'], info['predictor'],
               (' K=%d lambda=%s' % (info['K'], info['lambda'])) if info['predictor'] == 'ancestors'
-              else ' alpha=%s' % info['alpha'],
+              else ' alpha=%s' % info['alpha'] + (' tangent beta=%s' % info['beta'] if info.get('tangent') else ''),
               info['lattice_planes'], info['on_plane'], info['no_triangle'], info['anchored'], info['overrun'],
               info['components'], info['jump_edges'], info['virtual'],
               info['stitches'], info['side_faces'], info['polygons'], info['segments'],

@@ -239,7 +239,7 @@ TEST(Codec, InspectReportsHeader) {
   tsm::FileInfo fi;
   tsm::Status s = tsm::inspect(bytes, fi);
   ASSERT_TRUE(s.ok()) << s.to_string();
-  EXPECT_EQ(fi.format_version, 4u);
+  EXPECT_EQ(fi.format_version, 5u);
   EXPECT_EQ(fi.vertex_count, m.vertex_count());
   EXPECT_EQ(fi.face_count, m.face_count());
   EXPECT_EQ(fi.corner_count, m.corner_count());
@@ -523,7 +523,7 @@ TEST(Codec, ForgingHelpersRebuildTheEncodersBytes) {
   std::string bytes = encode_ok(m, 9, 4);
   Parsed h = parse(bytes);
   ASSERT_TRUE(h.extent_bytes == 4 || h.extent_bytes == 8) << h.extent_bytes;
-  EXPECT_EQ(h.version, 4);
+  EXPECT_EQ(h.version, 5);
   EXPECT_EQ(h.vertices, m.vertex_count());
   EXPECT_EQ(h.faces, m.face_count());
   EXPECT_EQ(h.corners, m.corner_count());

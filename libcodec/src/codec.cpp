@@ -530,7 +530,8 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice);
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr,
+                                 options.format_version == 0 || options.format_version >= 5);
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -847,12 +848,16 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
                   "quantization bits must be 1..30, got " + std::to_string(options.quantization_bits));
   if (options.level < 0 || options.level > 9)
     return Status(ErrorCode::invalid_argument, "level must be 0..9, got " + std::to_string(options.level));
+  if (options.format_version != 0 && (options.format_version < 4 || options.format_version > kFormatVersion))
+    return Status(ErrorCode::invalid_argument, "format version must be 4.." + std::to_string(kFormatVersion) +
+                                                   " (0 = the newest), got " + std::to_string(options.format_version));
   if (!mesh.all_finite())
     return Status(ErrorCode::invalid_argument,
                   "mesh has NaN or infinite coordinates, which no quantization grid can hold; fix or drop those "
                   "vertices first");
 
   Header h;
+  h.version = static_cast<uint16_t>(options.format_version ? options.format_version : kFormatVersion);
   h.vertex_count = mesh.vertex_count();
   h.face_count = mesh.face_count();
   h.corner_count = mesh.corner_count();
@@ -979,6 +984,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
                             : gs.predictor == Predictor::spread  ? "spread"
                             : gs.predictor == Predictor::raw     ? "raw"
                                                                  : "parallelograms";
+  if (gs.tangent) info.geometry_predictor += "+tangent";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();

@@ -63,7 +63,7 @@ Status corrupt_at(size_t at, uint16_t id, const std::string& what) {
 ContainerWriter::ContainerWriter(const Header& header) {
   ByteWriter w(out_);
   w.bytes(std::string_view(kMagic, 4));
-  w.u16(kFormatVersion);
+  w.u16(header.version);
   w.u16(0);  // flags
   std::string fields;
   ByteWriter fw(fields);

@@ -55,6 +55,7 @@ constexpr int kAlphaShift = 12;
 constexpr int32_t kAlphaOne = 1 << kAlphaShift;
 // Meshes up to this many vertices also try the default weights and no prediction.
 constexpr uint32_t kSmallMesh = 4096;
+constexpr int32_t kMaxBeta = 2 * kAlphaOne;  // the tangent step's weights: 0 .. 2.0
 
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
@@ -128,6 +129,14 @@ struct Coder {
   // (4096 = parallelograms only), fitted per mesh by least squares.
   int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
   bool spread_ctx = false;  // predictor spread: contexts from the parallelograms' spread
+  // Tangent step (version 5, kTangentFlag): a vertex with a local normal codes
+  // the two axes across the normal first, then the axis nearest it, predicted
+  // through the tangent plane from the first two residuals with the weight
+  // beta[set] (4.12; set 0: surface vertices, 1: vertices with an anchor).
+  // Residual models are then chosen by coding position instead of axis.
+  bool tangent = false;
+  int32_t beta[2] = {kAlphaOne, kAlphaOne};
+  std::vector<std::pair<int64_t, int64_t>> tan_samples[2];  // encoder's fit: (correction at weight 1, x - p)
   bool collect = false;
   std::vector<std::pair<int64_t, int64_t>> samples[3];  // encoder's fit: (P - N, x - N) per coordinate
   std::vector<uint32_t> nearest[3];  // per axis, per grid value: nearest plane (when qmax < 2^18)
@@ -158,16 +167,39 @@ struct Coder {
 
   // spread: per axis the spread of the parallelogram predictions (>= 0),
   // the context instead of the activity; null to use the activity.
+  // normal: for the tangent step (scaled below 2^16 by tangent_normal), or
+  // null; tan_set: which beta.
   template <class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
-              const int64_t* spread = nullptr) {
+              const int64_t* spread = nullptr, const int64_t* normal = nullptr, int tan_set = 0) {
     uint64_t sum = 0, top = 0;
     int on_count = 0;
-    for (int a = 0; a < 3; ++a) {
+    int order[3] = {0, 1, 2};
+    int kn = -1;  // the axis nearest the normal, coded last
+    if (normal) {
+      kn = 0;
+      for (int a = 1; a < 3; ++a)
+        if (std::abs(normal[a]) > std::abs(normal[kn])) kn = a;
+      if (normal[kn] == 0) kn = -1;
+      else order[0] = kn == 0 ? 1 : 0, order[1] = kn == 2 ? 1 : 2, order[2] = kn;
+    }
+    int64_t res[3] = {0, 0, 0};  // x minus the clamped prediction, per axis coded so far
+    for (int i = 0; i < 3; ++i) {
+      const int a = order[i];
       int ctx = spread ? bit_length(static_cast<uint64_t>(spread[a]))
-                       : a == 0 ? activity : (activity + bit_length(top) + 1) / 2;
+                       : i == 0 ? activity : (activity + bit_length(top) + 1) / 2;
       ctx = std::min(ctx, kActivity - 1);
-      const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
+      int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
+      if (a == kn) {
+        // Through the tangent plane: n . (x - p) = 0 solved for this axis.
+        const int64_t sgn = normal[kn] < 0 ? -1 : 1;
+        const int64_t num = -sgn * (normal[order[0]] * res[order[0]] + normal[order[1]] * res[order[1]]);
+        const int64_t den = sgn * normal[kn];
+        if constexpr (Sink::kEncoder)
+          if (collect)
+            tan_samples[tan_set].push_back({div_round(num, den), int64_t{q[3 * static_cast<size_t>(v) + a]} - p});
+        p = std::clamp<int64_t>(pred[a] + div_round(beta[tan_set] * num, int64_t{kAlphaOne} * den), 0, qmax);
+      }
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
       const std::vector<uint32_t>& L = lattice.values[a];
       bool coded = false;
@@ -191,17 +223,54 @@ struct Coder {
         }
       }
       if (!coded) {
-        int64_t r = s.sint(models->m[a][cls][ctx], static_cast<int64_t>(x) - p);
+        int64_t r = s.sint(models->m[i][cls][ctx], static_cast<int64_t>(x) - p);
         if (p + r < 0 || p + r > qmax) return false;
         x = static_cast<uint32_t>(p + r);
       }
       const int64_t r = static_cast<int64_t>(x) - p;
+      res[a] = static_cast<int64_t>(x) - std::clamp<int64_t>(pred[a], 0, qmax);
       uint64_t ar = static_cast<uint64_t>(r < 0 ? -r : r);
       sum += ar;
       top = std::max(top, ar);
     }
     act[v] = static_cast<uint8_t>(std::min(bit_length(sum), 254));
     return true;
+  }
+};
+
+// The tangent step's normal at a centre c (a prediction, or an anchor):
+// the sum over triangles (c, u, w) of cross(u - c, w - c), then scaled so
+// that its largest coordinate is below 2^16. Unusable (no tangent step) if
+// there are no triangles, more than 4096, or a coordinate difference of
+// 2^20 or more (which keeps every product and sum in 64 bits).
+struct NormalSum {
+  static constexpr int kMaxTriangles = 4096;
+  static constexpr int64_t kMaxDiff = int64_t{1} << 20;
+  int64_t n[3] = {0, 0, 0};
+  int count = 0;
+  bool ok = true;
+  void add(const uint32_t* u, const uint32_t* w, const int64_t c[3]) {
+    if (!ok || ++count > kMaxTriangles) {
+      ok = false;
+      return;
+    }
+    int64_t d1[3], d2[3];
+    for (int a = 0; a < 3; ++a) {
+      d1[a] = int64_t{u[a]} - c[a];
+      d2[a] = int64_t{w[a]} - c[a];
+      if (std::abs(d1[a]) >= kMaxDiff || std::abs(d2[a]) >= kMaxDiff) ok = false;
+    }
+    if (!ok) return;
+    n[0] += d1[1] * d2[2] - d1[2] * d2[1];
+    n[1] += d1[2] * d2[0] - d1[0] * d2[2];
+    n[2] += d1[0] * d2[1] - d1[1] * d2[0];
+  }
+  const int64_t* finish() {
+    if (!ok || count == 0) return nullptr;
+    const int64_t m = std::max({std::abs(n[0]), std::abs(n[1]), std::abs(n[2])});
+    const int sh = std::max(0, bit_length(static_cast<uint64_t>(m)) - 16);
+    for (int64_t& x : n) x = x < 0 ? -((-x) >> sh) : x >> sh;
+    return n;
   }
 };
 
@@ -235,6 +304,9 @@ struct SurfaceCoder {
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, pred[3];
     int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // per axis, the smallest and largest parallelogram
     int npara = 0, nnb = 0, actsum = 0;
+    constexpr int kPairs = 16;  // triangles with u and w decoded, kept for the tangent step's normal
+    uint32_t pu[kPairs], pw[kPairs];
+    int npair = 0;
     auto neighbour = [&](uint32_t u) {
       for (int a = 0; a < 3; ++a) nb[a] += at(u)[a];
       ++nnb;
@@ -246,6 +318,8 @@ struct SurfaceCoder {
       neighbour(u);
       uint32_t w = known(he_prev(h));
       if (w == kNone) return;
+      if (npair < kPairs) pu[npair] = u, pw[npair] = w;
+      ++npair;
       uint32_t o = known(he_prev(g.twin[he_next(h)]));
       if (o == kNone) return;
       for (int a = 0; a < 3; ++a) {
@@ -256,15 +330,17 @@ struct SurfaceCoder {
       }
       ++npara;
     };
-    if (multi) {
+    auto walk = [&](auto&& f) {
+      if (!multi) return f(h0);
       uint32_t h = h0;
       size_t guard = 0;
       do {
-        visit(h);
+        f(h);
         h = he_next(g.twin[h]);
       } while (h != h0 && ++guard < g.tri.size());
-    } else {
-      visit(h0);
+    };
+    walk(visit);
+    if (!multi) {
       uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
       if (w != kNone && npara == 0) neighbour(w);
     }
@@ -287,11 +363,25 @@ struct SurfaceCoder {
     }
     int64_t spread[3];
     for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+    const int64_t* normal = nullptr;
+    NormalSum ns;
+    if (c.tangent && npara > 0) {
+      if (npair <= kPairs) {
+        for (int i = 0; i < npair; ++i) ns.add(at(pu[i]), at(pw[i]), pred);
+      } else {  // a wide fan: walk it again
+        walk([&](uint32_t h) {
+          uint32_t u = known(he_next(h)), w = known(he_prev(h));
+          if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
+        });
+      }
+      normal = ns.finish();
+    }
     return point(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
-                 c.spread_ctx && npara >= 2 ? spread : nullptr);
+                 c.spread_ctx && npara >= 2 ? spread : nullptr, normal);
   }
-  bool point(uint32_t v, const int64_t pred[3], int cls, int activity, const int64_t* spread = nullptr) {
-    if (!c.vertex(s, q, v, pred, cls, activity, spread)) return false;
+  bool point(uint32_t v, const int64_t pred[3], int cls, int activity, const int64_t* spread = nullptr,
+             const int64_t* normal = nullptr, int tan_set = 0) {
+    if (!c.vertex(s, q, v, pred, cls, activity, spread, normal, tan_set)) return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = c.act[v];
     return true;
@@ -301,6 +391,7 @@ struct SurfaceCoder {
   // without one from the previous point.
   bool isolated() {
     uint32_t prev_anchor = 0;
+    std::vector<uint32_t> first_he;  // per output vertex, its first half-edge (tangent step only)
     for (uint32_t v = 0; v < g.vertex_count; ++v) {
       if (c.act[v] != kUnknown) continue;
       uint32_t anchor = kNone;
@@ -318,8 +409,27 @@ struct SurfaceCoder {
         for (int a = 0; a < 3; ++a) pred[a] = at(anchor)[a];
       } else {
         for (int a = 0; a < 3; ++a) pred[a] = last[a];
+        anchor = kNone;
       }
-      if (!point(v, pred, 0, last_act)) return false;
+      // The tangent step about the anchor's first fan (every corner but
+      // virtual ones is decoded by now).
+      NormalSum ns;
+      if (c.tangent && anchor != kNone) {
+        if (first_he.empty()) {
+          first_he.assign(g.vertex_count, kNone);
+          for (uint32_t h = static_cast<uint32_t>(cv.size()); h-- > 0;)
+            if (cv[h] != kNone) first_he[cv[h]] = h;
+        }
+        const uint32_t h0 = first_he[anchor];  // kNone: an anchor on no triangle (only in a forged file)
+        uint32_t h = h0;
+        size_t guard = 0;
+        if (h0 != kNone) do {
+            uint32_t u = known(he_next(h)), w = known(he_prev(h));
+            if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
+            h = he_next(g.twin[h]);
+          } while (h != h0 && ++guard < g.tri.size());
+      }
+      if (!point(v, pred, 0, last_act, nullptr, ns.finish(), 1)) return false;
       if ((v & 4095) == 0 && s.truncated()) return false;
     }
     return true;
@@ -565,6 +675,27 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
   }
 }
 
+// The tangent step's weights (surface vertices, vertices with an anchor)
+// for a predictor, lattice and parallelogram weights, by fit_alpha's size
+// estimate (0 .. 1.5).
+void fit_betas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+               const Lattice& lattice, const int32_t* weights, int32_t beta[2]) {
+  Coder fit(g.vertex_count, bits);
+  fit.collect = true;
+  fit.tangent = true;
+  fit.lattice = lattice;
+  fit.build_nearest();
+  if (weights)
+    for (int k = 0; k < 3; ++k) fit.alpha[k] = weights[k];
+  CollectSink cs;
+  std::vector<uint32_t> work = q;
+  if (pred == Predictor::parallelograms || pred == Predictor::spread)
+    code_greedy(g, fit, cs, work);
+  else
+    code_march_order(g, false, fit, cs, work);
+  for (int i = 0; i < 2; ++i) beta[i] = fit.tan_samples[i].empty() ? 0 : fit_alpha(fit.tan_samples[i]);
+}
+
 // Predictor raw (version 4): the lattice planes, then every coordinate of
 // every vertex in output order as equiprobable bits: the index of its plane
 // when its axis has planes (every value of the axis is one), else its grid
@@ -628,14 +759,17 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
 }
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int K, const Lattice& lattice, const int32_t* weights) {
+                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent) {
   if (pred == Predictor::raw) return encode_geometry_raw(g, q, bits, covers(lattice, q, g.vertex_count) ? lattice : Lattice());
   std::string head;
   ByteWriter w(head);
   const bool default_weights =
       pred != Predictor::ancestors && (!weights || (weights[0] == kAlphaOne && weights[1] == kAlphaOne &&
                                                     weights[2] == kAlphaOne));
-  w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0)));
+  const bool surface = pred == Predictor::parallelograms || pred == Predictor::gate || pred == Predictor::spread;
+  if (!surface) tangent = nullptr;
+  w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0) |
+                            (tangent ? kTangentFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (pred == Predictor::ancestors) {
     fit_lambda(g, q, K, lambda);
@@ -649,6 +783,13 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
       c.alpha[k] = weights[k];
       w.u16(static_cast<uint16_t>(static_cast<int16_t>(c.alpha[k])));
     }
+  if (tangent) {
+    c.tangent = true;
+    for (int i = 0; i < 2; ++i) {
+      c.beta[i] = std::clamp<int32_t>(tangent[i], 0, kMaxBeta);
+      w.u16(static_cast<uint16_t>(c.beta[i]));
+    }
+  }
   EncodeSink s;
   c.lattice = lattice;
   code_lattice(s, c);
@@ -747,7 +888,7 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 }
 
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats) {
+                            const Lattice* candidate, GeometryStats* stats, bool tangent) {
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   int32_t lsq[3], est[3];
@@ -756,13 +897,15 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est);
   // `lattice` may be st.lattice itself (the assignment below is then a
   // self-assignment, which std::vector handles).
-  auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w) {
-    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w);
+  int32_t beta[2];
+  auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr) {
+    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
     st.ancestors = K;
     st.lattice = lattice;
+    st.tangent = tan != nullptr;
     weights = w;
     return true;
   };
@@ -818,6 +961,12 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     }
     consider(Predictor::raw, 0, Lattice(), nullptr);
   }
+  // The tangent step (version 5) on whatever surface predictor won.
+  if (tangent && level >= 3 && (st.predictor == Predictor::parallelograms || st.predictor == Predictor::gate ||
+                     st.predictor == Predictor::spread)) {
+    fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
+    consider(st.predictor, 0, st.lattice, weights, beta);
+  }
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
   return best;
@@ -832,6 +981,12 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (!r.u8(kind)) return corrupt("empty section");
   const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
   bool default_weights = false;
+  if (version >= 5 && (kind & kTangentFlag)) {
+    kind = static_cast<uint8_t>(kind & ~kTangentFlag);
+    st.tangent = true;
+    const uint8_t base = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
+    if (base < 1 || base > 3) return corrupt("predictor " + std::to_string(base) + " has no tangent step");
+  }
   if (version >= 4 && (kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
     kind = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
     default_weights = true;
@@ -872,8 +1027,17 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       if (!r.u16(x)) return corrupt("truncated predictor header");
       alpha[k] = static_cast<int16_t>(x);
     }
-  const size_t at = r.offset();
   Coder c(g.vertex_count, bits);
+  if (st.tangent) {
+    c.tangent = true;
+    for (int i = 0; i < 2; ++i) {
+      uint16_t x;
+      if (!r.u16(x)) return corrupt("truncated predictor header");
+      if (x > kMaxBeta) return corrupt("tangent weight " + std::to_string(x) + " out of range 0..8192");
+      c.beta[i] = x;
+    }
+  }
+  const size_t at = r.offset();
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   c.spread_ctx = st.predictor == Predictor::spread;
   DecodeSink s;

@@ -33,6 +33,10 @@ enum class Predictor : uint8_t {
 // Version 4: the predictor byte of 1, 2 or 3 with this bit set says the
 // parallelogram weights are all 1.0 and not stored (6 bytes less).
 constexpr uint8_t kDefaultWeightsFlag = 0x80;
+// Version 5: the predictor byte of 1, 2 or 3 (with or without 0x80) with this
+// bit set says the tangent step is on; its two weights follow the
+// parallelogram weights.
+constexpr uint8_t kTangentFlag = 0x40;
 
 // Per axis, the sorted coordinate values many vertices share (the voxel
 // planes of a marching-cubes surface, a CAD grid); empty when not used.
@@ -43,6 +47,7 @@ struct Lattice {
 struct GeometryStats {
   Predictor predictor = Predictor::parallelograms;
   int ancestors = 0;  // K for the ancestor predictor
+  bool tangent = false;  // version 5: the tangent step
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -60,16 +65,19 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 
 // q: 3 quantized coordinates per output vertex. The encoder picks the
 // predictor by level, and the lattice (if a candidate is given) by size.
+// tangent: the tangent step may be tried (version 5).
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats = nullptr);
+                            const Lattice* candidate, GeometryStats* stats = nullptr, bool tangent = true);
 // One predictor, lattice and set of parallelogram weights (per class of 1,
 // 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
-// experiments).
+// experiments). tangent: the tangent step's two weights (4.12, surface
+// vertices and vertices with an anchor; version 5), null for none.
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int ancestors, const Lattice& lattice, const int32_t* weights = nullptr);
+                               int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
+                               const int32_t* tangent = nullptr);
 // `version`: the file's format version (3 knows neither the raw predictor
 // nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr, int version = 4);
+                       GeometryStats* stats = nullptr, int version = 5);
 
 }  // namespace tsm

@@ -35,6 +35,10 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
+  // The format version to write: 0 = the newest (5); 4 writes files that
+  // decoders of version 4 read (without version 5's tangent step, so
+  // usually a little larger).
+  int format_version = 0;
 };
 
 struct DecodeOptions {
