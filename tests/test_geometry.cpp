@@ -109,8 +109,9 @@ Prepared prepare(const Mesh& m, int bits) {
   return p;
 }
 
-TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
-  std::vector<std::pair<std::string, Mesh>> meshes = {
+// The families the predictor round trips run on.
+std::vector<std::pair<std::string, Mesh>> families() {
+  return {
       {"icosphere(3)", tsm_test::icosphere(3)},
       {"genus_surface(2)", tsm_test::genus_surface(2)},
       {"grid_with_holes(10,3)", tsm_test::grid_with_holes(10, 3)},
@@ -121,8 +122,12 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
       {"voxel_sphere", voxel_sphere(3, 0.05f)},
       {"sphere_with_strays", sphere_with_strays(2, 30)},
   };
+}
+
+TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
+  const std::vector<std::pair<std::string, Mesh>> meshes = families();
   using tsm::Predictor;
-  for (auto& [name, m] : meshes) {
+  for (const auto& [name, m] : meshes) {
     for (int bits : {4, 11, 20}) {
       Prepared p = prepare(m, bits);
       tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
@@ -150,18 +155,10 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
 // Version 5's tangent step (FORMAT.md §8.5.3): with any weights, on every
 // surface predictor, with and without planes, the positions come back.
 TEST(Geometry, TangentStepRoundTripsWithAnyWeights) {
-  std::vector<std::pair<std::string, Mesh>> meshes = {
-      {"icosphere(3)", tsm_test::icosphere(3)},
-      {"genus_surface(2)", tsm_test::genus_surface(2)},
-      {"grid_with_holes(10,3)", tsm_test::grid_with_holes(10, 3)},
-      {"moebius(12)", tsm_test::moebius(12)},
-      {"book(4)", tsm_test::book(4)},
-      {"random_soup(200,300)", tsm_test::random_soup(200, 300, 3)},
-      {"voxel_sphere", voxel_sphere(3, 0.05f)},
-  };
+  const std::vector<std::pair<std::string, Mesh>> meshes = families();
   using tsm::Predictor;
   const int32_t weights[][2] = {{0, 0}, {4096, 4096}, {8192, 1024}};
-  for (auto& [name, m] : meshes)
+  for (const auto& [name, m] : meshes)
     for (int bits : {4, 11, 20}) {
       Prepared p = prepare(m, bits);
       tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));

@@ -651,11 +651,9 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
   return best;
 }
 
-// The parallelogram weights for a predictor: fitted per class by least
-// squares and by the size estimate (fit_alpha); the caller codes both.
-void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                int32_t lsq[3], int32_t est[3]) {
-  Coder fit(g.vertex_count, bits);
+// A statistics pass in a surface predictor's order: nothing coded, the
+// fitting samples collected in `fit`.
+void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predictor pred, Coder& fit) {
   fit.collect = true;
   CollectSink cs;
   std::vector<uint32_t> work = q;
@@ -663,6 +661,14 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
     code_greedy(g, fit, cs, work);
   else
     code_march_order(g, false, fit, cs, work);
+}
+
+// The parallelogram weights for a predictor: fitted per class by least
+// squares and by the size estimate (fit_alpha); the caller codes both.
+void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                int32_t lsq[3], int32_t est[3]) {
+  Coder fit(g.vertex_count, bits);
+  collect_pass(g, q, pred, fit);
   for (int k = 0; k < 3; ++k) {
     est[k] = fit_alpha(fit.samples[k]);
     double num = 0, den = 0;
@@ -681,18 +687,12 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
 void fit_betas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                const Lattice& lattice, const int32_t* weights, int32_t beta[2]) {
   Coder fit(g.vertex_count, bits);
-  fit.collect = true;
   fit.tangent = true;
   fit.lattice = lattice;
   fit.build_nearest();
   if (weights)
     for (int k = 0; k < 3; ++k) fit.alpha[k] = weights[k];
-  CollectSink cs;
-  std::vector<uint32_t> work = q;
-  if (pred == Predictor::parallelograms || pred == Predictor::spread)
-    code_greedy(g, fit, cs, work);
-  else
-    code_march_order(g, false, fit, cs, work);
+  collect_pass(g, q, pred, fit);
   for (int i = 0; i < 2; ++i) beta[i] = fit.tan_samples[i].empty() ? 0 : fit_alpha(fit.tan_samples[i]);
 }
 
