@@ -26,6 +26,12 @@ const char* version_string() { return TSM_VERSION; }
 
 namespace {
 
+// The format version a file is written in (EncodeOptions::format_version,
+// 0 = the newest; validated by encode()).
+uint16_t written_version(const EncodeOptions& options) {
+  return static_cast<uint16_t>(options.format_version ? options.format_version : kFormatVersion);
+}
+
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
 
 double grid_step(const Header& h) {
@@ -530,8 +536,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr,
-                                 options.format_version == 0 || options.format_version >= 5);
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options) >= 5);
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -857,7 +862,7 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
                   "vertices first");
 
   Header h;
-  h.version = static_cast<uint16_t>(options.format_version ? options.format_version : kFormatVersion);
+  h.version = written_version(options);
   h.vertex_count = mesh.vertex_count();
   h.face_count = mesh.face_count();
   h.corner_count = mesh.corner_count();

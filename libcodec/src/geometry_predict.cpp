@@ -60,6 +60,12 @@ constexpr int32_t kMaxBeta = 2 * kAlphaOne;  // the tangent step's weights: 0 ..
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
 
+// Predictors 1, 2 and 3, which predict from the triangles around a vertex
+// (parallelogram weights, the tangent step).
+bool surface_predictor(Predictor p) {
+  return p == Predictor::parallelograms || p == Predictor::gate || p == Predictor::spread;
+}
+
 int64_t floor_shift(int64_t x, int s) { return x >= 0 ? x >> s : -((-x + (int64_t{1} << s) - 1) >> s); }
 
 int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
@@ -189,7 +195,8 @@ struct Coder {
       int ctx = spread ? bit_length(static_cast<uint64_t>(spread[a]))
                        : i == 0 ? activity : (activity + bit_length(top) + 1) / 2;
       ctx = std::min(ctx, kActivity - 1);
-      int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
+      const int64_t p0 = std::clamp<int64_t>(pred[a], 0, qmax);  // clamped, before the tangent step
+      int64_t p = p0;
       if (a == kn) {
         // Through the tangent plane: n . (x - p) = 0 solved for this axis.
         const int64_t sgn = normal[kn] < 0 ? -1 : 1;
@@ -197,7 +204,7 @@ struct Coder {
         const int64_t den = sgn * normal[kn];
         if constexpr (Sink::kEncoder)
           if (collect)
-            tan_samples[tan_set].push_back({div_round(num, den), int64_t{q[3 * static_cast<size_t>(v) + a]} - p});
+            tan_samples[tan_set].push_back({div_round(num, den), int64_t{q[3 * static_cast<size_t>(v) + a]} - p0});
         p = std::clamp<int64_t>(pred[a] + div_round(beta[tan_set] * num, int64_t{kAlphaOne} * den), 0, qmax);
       }
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
@@ -228,7 +235,7 @@ struct Coder {
         x = static_cast<uint32_t>(p + r);
       }
       const int64_t r = static_cast<int64_t>(x) - p;
-      res[a] = static_cast<int64_t>(x) - std::clamp<int64_t>(pred[a], 0, qmax);
+      res[a] = static_cast<int64_t>(x) - p0;
       uint64_t ar = static_cast<uint64_t>(r < 0 ? -r : r);
       sum += ar;
       top = std::max(top, ar);
@@ -296,6 +303,28 @@ struct SurfaceCoder {
     return v != kNone && c.act[v] != kUnknown ? v : kNone;
   }
   const uint32_t* at(uint32_t v) const { return &q[3 * static_cast<size_t>(v)]; }
+  // Calls f(h) for each half-edge h of the fan of h0 (leaving the same
+  // position), h0 first.
+  template <class F>
+  void fan(uint32_t h0, F&& f) const {
+    uint32_t h = h0;
+    size_t guard = 0;
+    do {
+      f(h);
+      h = he_next(g.twin[h]);
+    } while (h != h0 && ++guard < g.tri.size());
+  }
+  // Per output vertex, its smallest half-edge (kNone for one on no
+  // triangle); built on first use.
+  const std::vector<uint32_t>& first_half_edges() {
+    if (first_he.empty()) {
+      first_he.assign(g.vertex_count, kNone);
+      for (uint32_t h = static_cast<uint32_t>(cv.size()); h-- > 0;)
+        if (cv[h] != kNone) first_he[cv[h]] = h;
+    }
+    return first_he;
+  }
+  std::vector<uint32_t> first_he;
 
   // Codes the vertex at the origin of half-edge h0 (undecoded, not virtual);
   // multi: every triangle around it, else only h0's triangle.
@@ -331,13 +360,10 @@ struct SurfaceCoder {
       ++npara;
     };
     auto walk = [&](auto&& f) {
-      if (!multi) return f(h0);
-      uint32_t h = h0;
-      size_t guard = 0;
-      do {
-        f(h);
-        h = he_next(g.twin[h]);
-      } while (h != h0 && ++guard < g.tri.size());
+      if (multi)
+        fan(h0, f);
+      else
+        f(h0);
     };
     walk(visit);
     if (!multi) {
@@ -391,7 +417,6 @@ struct SurfaceCoder {
   // without one from the previous point.
   bool isolated() {
     uint32_t prev_anchor = 0;
-    std::vector<uint32_t> first_he;  // per output vertex, its first half-edge (tangent step only)
     for (uint32_t v = 0; v < g.vertex_count; ++v) {
       if (c.act[v] != kUnknown) continue;
       uint32_t anchor = kNone;
@@ -409,25 +434,17 @@ struct SurfaceCoder {
         for (int a = 0; a < 3; ++a) pred[a] = at(anchor)[a];
       } else {
         for (int a = 0; a < 3; ++a) pred[a] = last[a];
-        anchor = kNone;
       }
       // The tangent step about the anchor's first fan (every corner but
       // virtual ones is decoded by now).
       NormalSum ns;
       if (c.tangent && anchor != kNone) {
-        if (first_he.empty()) {
-          first_he.assign(g.vertex_count, kNone);
-          for (uint32_t h = static_cast<uint32_t>(cv.size()); h-- > 0;)
-            if (cv[h] != kNone) first_he[cv[h]] = h;
-        }
-        const uint32_t h0 = first_he[anchor];  // kNone: an anchor on no triangle (only in a forged file)
-        uint32_t h = h0;
-        size_t guard = 0;
-        if (h0 != kNone) do {
+        const uint32_t h0 = first_half_edges()[anchor];  // kNone: an anchor on no triangle (only in a forged file)
+        if (h0 != kNone)
+          fan(h0, [&](uint32_t h) {
             uint32_t u = known(he_next(h)), w = known(he_prev(h));
             if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
-            h = he_next(g.twin[h]);
-          } while (h != h0 && ++guard < g.tri.size());
+          });
       }
       if (!point(v, pred, 0, last_act, nullptr, ns.finish(), 1)) return false;
       if ((v & 4095) == 0 && s.truncated()) return false;
@@ -458,11 +475,7 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   SurfaceCoder<Sink> sc(g, c, s, q);
   const uint32_t n = g.vertex_count;
   const uint32_t H = static_cast<uint32_t>(g.tri.size());
-  std::vector<uint32_t> first_he(n, kNone);
-  for (uint32_t h = 0; h < H; ++h) {
-    uint32_t v = sc.cv[h];
-    if (v != kNone && first_he[v] == kNone) first_he[v] = h;
-  }
+  const std::vector<uint32_t>& first_he = sc.first_half_edges();
   std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
   constexpr int kBuckets = 16;
   std::vector<uint32_t> bucket[kBuckets];
@@ -476,9 +489,7 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
     }
   };
   auto decoded = [&](uint32_t v) {  // update counts around the vertex just coded
-    uint32_t h0 = first_he[v], h = h0;
-    size_t guard = 0;
-    do {
+    sc.fan(first_he[v], [&](uint32_t h) {
       const uint32_t hn = he_next(h), hp = he_prev(h);
       const uint32_t xu = sc.cv[hn], xw = sc.cv[hp];
       const uint32_t u = sc.known(hn), w = sc.known(hp);
@@ -505,8 +516,7 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
           bump(x);
         }
       }
-      h = he_next(g.twin[h]);
-    } while (h != h0 && ++guard < H);
+    });
   };
   uint32_t scan = 0;
   for (;;) {
@@ -766,8 +776,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   const bool default_weights =
       pred != Predictor::ancestors && (!weights || (weights[0] == kAlphaOne && weights[1] == kAlphaOne &&
                                                     weights[2] == kAlphaOne));
-  const bool surface = pred == Predictor::parallelograms || pred == Predictor::gate || pred == Predictor::spread;
-  if (!surface) tangent = nullptr;
+  if (!surface_predictor(pred)) tangent = nullptr;
   w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0) |
                             (tangent ? kTangentFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
@@ -962,8 +971,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     consider(Predictor::raw, 0, Lattice(), nullptr);
   }
   // The tangent step (version 5) on whatever surface predictor won.
-  if (tangent && level >= 3 && (st.predictor == Predictor::parallelograms || st.predictor == Predictor::gate ||
-                     st.predictor == Predictor::spread)) {
+  if (tangent && level >= 3 && surface_predictor(st.predictor)) {
     fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
     consider(st.predictor, 0, st.lattice, weights, beta);
   }
@@ -985,7 +993,8 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     kind = static_cast<uint8_t>(kind & ~kTangentFlag);
     st.tangent = true;
     const uint8_t base = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
-    if (base < 1 || base > 3) return corrupt("predictor " + std::to_string(base) + " has no tangent step");
+    if (!surface_predictor(static_cast<Predictor>(base)))
+      return corrupt("predictor " + std::to_string(base) + " has no tangent step");
   }
   if (version >= 4 && (kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
     kind = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
