@@ -1182,15 +1182,21 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         normal = tangent_normal(pred, T) if tangent and npara > 0 else None
         return pred, cls, activity, spread, normal        # set 0
 
-    # §8.5.7
-    def anchor_normal(A):                                    # §8.5.7, version 5
-        if not first_he_any:
-            first_he_any.extend([NONE] * vc)
+    # first_he[v] = the smallest h with id(tri[h]) == v (§8.5.6, §8.5.7), built once
+    first_he_cache = []
+
+    def first_half_edges():
+        if not first_he_cache:
+            first_he_cache.extend([NONE] * vc)
             for h in range(H - 1, -1, -1):
                 x = ids[tri[h]]
                 if x != NONE:
-                    first_he_any[x] = h
-        h0 = first_he_any[A]
+                    first_he_cache[x] = h
+        return first_he_cache
+
+    # §8.5.7
+    def anchor_normal(A):                                    # §8.5.7, version 5
+        h0 = first_half_edges()[A]
         if h0 == NONE:
             return None
         T = []
@@ -1200,8 +1206,6 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             if u != NONE and w != NONE:
                 T.append((u, w))
         return tangent_normal(q[A], T)
-
-    first_he_any = []
 
     def on_no_triangle():
         prev_anchor = 0
@@ -1237,11 +1241,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                 reject('geometry: truncated')
         on_no_triangle()
     elif predictor in (1, 3):                                # §8.5.6
-        first_he = [NONE] * vc
-        for h in range(H - 1, -1, -1):
-            v = ids[tri[h]]
-            if v != NONE:
-                first_he[v] = h
+        first_he = first_half_edges()
         npara = [0] * vc
         nnb = [0] * vc
         prio = [0] * vc
