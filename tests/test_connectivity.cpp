@@ -106,12 +106,13 @@ std::string encode_at(const Mesh& m, int q, int level) {
 // decoded mesh keeps). The flat grid has many vertices on each extreme, so
 // its rules tie and are left out.
 TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
+  // Above 1,024 faces (a smaller part is searched from level 3 on, below).
   const std::vector<std::pair<std::string, Mesh>> meshes = {
       {"icosphere", renumbered(icosphere(3), 1)},
-      {"genus 2", renumbered(genus_surface(2, 3), 2)},
-      {"grid with holes", renumbered(grid_with_holes(20, 3), 3)},
-      {"strip", renumbered(strip(60), 4)},
-      {"two spheres", renumbered(copies(icosphere(2), 2), 5)},
+      {"genus 2", renumbered(genus_surface(2, 4), 2)},
+      {"grid with holes", renumbered(grid_with_holes(30, 3), 3)},
+      {"strip", renumbered(strip(1100), 4)},
+      {"two spheres", renumbered(copies(icosphere(3), 2), 5)},
   };
   size_t smaller = 0;
   for (const auto& [what, m] : meshes)
@@ -131,6 +132,35 @@ TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
     }
   // The search finds something on most of them.
   EXPECT_GE(smaller, 5u);
+}
+
+// A part of at most 1,024 faces gets level 9's root search from level 3 on:
+// at the default level as small as -l 9, and a decoded mesh re-encodes to
+// the same bytes.
+TEST(Connectivity, SmallPartsSearchRootsAtTheDefaultLevel) {
+  const std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"icosphere", renumbered(icosphere(2), 1)},
+      {"genus 2", renumbered(genus_surface(2, 3), 2)},
+      {"grid with holes", renumbered(grid_with_holes(20, 3), 3)},
+      {"strip", renumbered(strip(60), 4)},
+      {"two spheres", renumbered(copies(icosphere(1), 2), 5)},
+  };
+  for (const auto& [what, m] : meshes) {
+    ASSERT_LE(m.face_count(), 1024u) << what;
+    for (int q : {8, 12}) {
+      const std::string l6 = encode_at(m, q, 6);
+      // Levels 3-6 run the same geometry trials, and on these meshes level
+      // 7-9's further trials find nothing: the same size (the header's level
+      // byte differs). Without the search, level 6 was larger on some.
+      EXPECT_EQ(l6.size(), encode_at(m, q, 9).size()) << what << " q " << q;
+      EXPECT_EQ(l6.size(), encode_at(m, q, 3).size()) << what << " q " << q;
+      Mesh back;
+      ASSERT_TRUE(decode(l6, back).ok()) << what;
+      CompareResult r = compare_meshes(m, back, q);
+      EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+      EXPECT_TRUE(encode_at(back, q, 6) == l6) << what << " q " << q << ": re-encoding differs";
+    }
+  }
 }
 
 TEST(Connectivity, TwoToTenFacesOnOneEdge) {
