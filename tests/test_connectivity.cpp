@@ -106,7 +106,7 @@ std::string encode_at(const Mesh& m, int q, int level) {
 // decoded mesh keeps). The flat grid has many vertices on each extreme, so
 // its rules tie and are left out.
 TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
-  // Above 1,024 faces (a smaller part is searched from level 3 on, below).
+  // Above 1,024 faces (a smaller mesh is searched from level 3 on, below).
   const std::vector<std::pair<std::string, Mesh>> meshes = {
       {"icosphere", renumbered(icosphere(3), 1)},
       {"genus 2", renumbered(genus_surface(2, 4), 2)},
@@ -134,9 +134,9 @@ TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
   EXPECT_GE(smaller, 5u);
 }
 
-// A part of at most 1,024 faces gets level 9's root search from level 3 on:
-// at the default level as small as -l 9, and a decoded mesh re-encodes to
-// the same bytes.
+// A mesh of at most 1,024 faces coded whole gets level 9's root search from
+// level 3 on: at the default level as small as -l 9, and a decoded mesh
+// re-encodes to the same bytes. Not in segments (encode time).
 TEST(Connectivity, SmallPartsSearchRootsAtTheDefaultLevel) {
   const std::vector<std::pair<std::string, Mesh>> meshes = {
       {"icosphere", renumbered(icosphere(2), 1)},
@@ -161,6 +161,16 @@ TEST(Connectivity, SmallPartsSearchRootsAtTheDefaultLevel) {
       EXPECT_TRUE(encode_at(back, q, 6) == l6) << what << " q " << q << ": re-encoding differs";
     }
   }
+  // In segments the default level keeps its one coding per segment.
+  EncodeOptions eo;
+  eo.quantization_bits = 12;
+  eo.segment_faces = 100;
+  std::string seg6, seg9;
+  const Mesh sphere = renumbered(icosphere(2), 6);
+  ASSERT_TRUE(encode(sphere, eo, seg6).ok());
+  eo.level = 9;
+  ASSERT_TRUE(encode(sphere, eo, seg9).ok());
+  EXPECT_GT(seg6.size(), seg9.size());  // 830 vs 811 bytes when written
 }
 
 TEST(Connectivity, TwoToTenFacesOnOneEdge) {

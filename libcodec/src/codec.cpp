@@ -572,11 +572,13 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
 // follow ids), and parts with stitches (their canonical rounds re-code the
 // decoded mesh; they keep the smallest-id spiral).
 constexpr int kRootSearchLevel = 7;
-// A small part (at most kSmallSearchFaces faces) gets level 9's search from
-// level 3 on: 14 codings of a few hundred faces take milliseconds and save
-// 1-8% on such meshes (corpus edge files: cube_att.ply 97 -> 89 bytes at
-// q = 11). The test is on the part's own face count, which a decoded mesh
-// has too, so re-encoding still gives the same bytes.
+// A small mesh coded whole (at most kSmallSearchFaces faces, one segment)
+// gets level 9's search from level 3 on: 14 codings of a few hundred faces
+// take milliseconds and save 1-8% on such meshes (corpus edge files:
+// cube_att.ply 97 -> 89 bytes at q = 11). The test is on the mesh's own face
+// count, which a decoded mesh has too, so re-encoding gives the same bytes.
+// Not for segments: a mesh cut into 1,000-face segments would take about 6x
+// as long to encode (the bunny: 0.5 -> 2.8 s) for 0.7%.
 constexpr size_t kSmallSearchFaces = 1024;
 constexpr int kSmallSearchLevel = 3;
 
@@ -589,7 +591,7 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
                    const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
   bool usable = true, stitched = false;
   TriedCodings tried;
-  const bool small = options.level >= kSmallSearchLevel && mesh.face_count() <= kSmallSearchFaces;
+  const bool small = options.level >= kSmallSearchLevel && is_ref.empty() && mesh.face_count() <= kSmallSearchFaces;
   const bool search = options.level >= kRootSearchLevel || small;
   TSM_RETURN_IF_ERROR(encode_part_from(mesh, qin, is_ref, headers, options, TreeChoice(), out, usable, stitched,
                                        search ? &tried : nullptr));
