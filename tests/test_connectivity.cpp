@@ -97,6 +97,18 @@ std::string encode_at(const Mesh& m, int q, int level) {
   return bytes;
 }
 
+// Five renumbered generated meshes for the root search: at most 1,024 faces
+// (`small`, searched from level 3 on) or above (searched from level 7 on).
+std::vector<std::pair<std::string, Mesh>> root_search_meshes(bool small) {
+  return {
+      {"icosphere", renumbered(icosphere(small ? 2 : 3), 1)},
+      {"genus 2", renumbered(genus_surface(2, small ? 3 : 4), 2)},
+      {"grid with holes", renumbered(grid_with_holes(small ? 20 : 30, 3), 3)},
+      {"strip", renumbered(strip(small ? 60 : 1100), 4)},
+      {"two spheres", renumbered(copies(icosphere(small ? 1 : 3), 2), 5)},
+  };
+}
+
 }  // namespace
 
 // Levels 7-9 also start the vertex trees at vertices of extreme position
@@ -106,14 +118,7 @@ std::string encode_at(const Mesh& m, int q, int level) {
 // decoded mesh keeps). The flat grid has many vertices on each extreme, so
 // its rules tie and are left out.
 TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
-  // Above 1,024 faces (a smaller mesh is searched from level 3 on, below).
-  const std::vector<std::pair<std::string, Mesh>> meshes = {
-      {"icosphere", renumbered(icosphere(3), 1)},
-      {"genus 2", renumbered(genus_surface(2, 4), 2)},
-      {"grid with holes", renumbered(grid_with_holes(30, 3), 3)},
-      {"strip", renumbered(strip(1100), 4)},
-      {"two spheres", renumbered(copies(icosphere(3), 2), 5)},
-  };
+  const std::vector<std::pair<std::string, Mesh>> meshes = root_search_meshes(false);
   size_t smaller = 0;
   for (const auto& [what, m] : meshes)
     for (int q : {8, 12}) {
@@ -138,13 +143,7 @@ TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
 // level 3 on: at the default level as small as -l 9, and a decoded mesh
 // re-encodes to the same bytes. Not in segments (encode time).
 TEST(Connectivity, SmallPartsSearchRootsAtTheDefaultLevel) {
-  const std::vector<std::pair<std::string, Mesh>> meshes = {
-      {"icosphere", renumbered(icosphere(2), 1)},
-      {"genus 2", renumbered(genus_surface(2, 3), 2)},
-      {"grid with holes", renumbered(grid_with_holes(20, 3), 3)},
-      {"strip", renumbered(strip(60), 4)},
-      {"two spheres", renumbered(copies(icosphere(1), 2), 5)},
-  };
+  const std::vector<std::pair<std::string, Mesh>> meshes = root_search_meshes(true);
   for (const auto& [what, m] : meshes) {
     ASSERT_LE(m.face_count(), 1024u) << what;
     for (int q : {8, 12}) {
