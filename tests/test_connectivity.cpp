@@ -2,7 +2,9 @@
 // mesh a user can hand us (issue: connectivity), through the public API.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <numeric>
 #include <random>
 
 #include "connectivity.hpp"
@@ -387,4 +389,186 @@ TEST(Connectivity, VirtualVertexNeverInsideTheVertexTree) {
   const uint32_t quad[] = {3, 1, 0, 4};
   m.add_face(quad, 4);
   expect_round_trip(m, "quad corner reached only through its diagonal or a virtual vertex", 14);
+}
+
+namespace {
+
+// The decoder's bounding loop as first written (sessions 1-11): explicit
+// slot lists per vertex (tree slots, each followed by the jump ends of its
+// corner), walked by "arrive by a slot's reverse, leave by the next slot
+// clockwise". Kept here as the oracle for decoder_loop, which now derives
+// the same walk from the tree tour.
+bool slot_walk(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
+               std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin) {
+  const uint32_t n = static_cast<uint32_t>(parent.size());
+  loop.clear();
+  loop_twin.clear();
+  if (n < 2) return true;
+  // Tree slots per vertex in clockwise order: parent first, then children in
+  // pre-order (= clockwise) order. slot_start[v] .. slot_start[v+1].
+  std::vector<uint32_t> degree(n, 0);
+  for (uint32_t v = 1; v < n; ++v) {
+    if (parent[v] >= v) return false;
+    degree[v]++;
+    degree[parent[v]]++;
+  }
+  // Corner after tree slot s of vertex v, numbered by tour position.
+  const uint32_t tour = 2 * (n - 1);
+  std::vector<uint32_t> tree_start(n + 1, 0);
+  for (uint32_t v = 0; v < n; ++v) tree_start[v + 1] = tree_start[v] + degree[v];
+  std::vector<uint32_t> tree_to(tree_start[n]);  // neighbour of each tree slot
+  std::vector<uint32_t> fill(tree_start.begin(), tree_start.end() - 1);
+  for (uint32_t v = 1; v < n; ++v) tree_to[fill[v]++] = parent[v];  // parent slot first
+  for (uint32_t v = 1; v < n; ++v) tree_to[fill[parent[v]]++] = v;
+  // The tree slot at w pointing back to its neighbour v: the parent slot (0)
+  // if v is w's parent, else v's child slot (children sorted by position).
+  auto slot_back = [&](uint32_t v, uint32_t w) -> uint32_t {
+    if (w != 0 && parent[w] == v) return 0;
+    uint32_t lo = tree_start[w] + (w != 0 ? 1 : 0), hi = tree_start[w + 1];
+    auto it = std::lower_bound(tree_to.begin() + lo, tree_to.begin() + hi, v);
+    if (it == tree_to.begin() + hi || *it != v) return kNone;
+    return static_cast<uint32_t>(it - tree_to.begin()) - tree_start[w];
+  };
+  // Tree tour: position q arrives at vertex corner_v[q] after slot corner_s[q].
+  std::vector<uint32_t> corner_v(tour), corner_s(tour);
+  {
+    uint32_t v = 0, s = 0;  // leaving the root by slot 0 (first child)
+    for (uint32_t step = 0; step < tour; ++step) {
+      uint32_t w = tree_to[tree_start[v] + s];
+      uint32_t back = slot_back(v, w);
+      if (back == kNone) return false;
+      uint32_t q = (step + 1) % tour;
+      corner_v[q] = w;
+      corner_s[q] = back;
+      v = w;
+      s = (back + 1) % degree[w];
+    }
+  }
+  // Full slot arrays: each tree slot followed by the jump ends of its corner.
+  const uint32_t nj = static_cast<uint32_t>(jumps.size());
+  std::vector<uint32_t> extra(n, 0);
+  for (uint32_t i = 0; i < nj; ++i) {
+    const JumpEndpoint& j = jumps[i];
+    if (j.corner >= tour || j.partner >= nj || j.partner == i || jumps[j.partner].partner != i) return false;
+    if (i > 0 && (jumps[i - 1].corner > j.corner)) return false;
+    extra[corner_v[j.corner]]++;
+  }
+  std::vector<uint32_t> start(n + 1, 0);
+  for (uint32_t v = 0; v < n; ++v) start[v + 1] = start[v] + degree[v] + extra[v];
+  std::vector<uint32_t> to(start[n]), back(start[n], kNone);
+  std::vector<uint32_t> tree_slot_pos(tree_start[n]), jump_slot_pos(nj);
+  {
+    // Jump ends grouped per (vertex, tree slot), in list order.
+    std::vector<uint32_t> count(tree_start[n] + 1, 0);
+    for (uint32_t i = 0; i < nj; ++i) count[tree_start[corner_v[jumps[i].corner]] + corner_s[jumps[i].corner] + 1]++;
+    for (uint32_t v = 0; v < n; ++v) {
+      uint32_t at = start[v];
+      for (uint32_t s = 0; s < degree[v]; ++s) {
+        tree_slot_pos[tree_start[v] + s] = at;
+        to[at] = tree_to[tree_start[v] + s];
+        at += 1 + count[tree_start[v] + s + 1];
+      }
+    }
+    std::vector<uint32_t> used(tree_start[n], 0);
+    for (uint32_t i = 0; i < nj; ++i) {
+      uint32_t v = corner_v[jumps[i].corner], ts = tree_start[v] + corner_s[jumps[i].corner];
+      jump_slot_pos[i] = tree_slot_pos[ts] + 1 + used[ts]++;
+    }
+    for (uint32_t i = 0; i < nj; ++i) {
+      to[jump_slot_pos[i]] = corner_v[jumps[jumps[i].partner].corner];
+      back[jump_slot_pos[i]] = jump_slot_pos[jumps[i].partner];
+    }
+    for (uint32_t v = 0; v < n; ++v)
+      for (uint32_t s = 0; s < degree[v]; ++s) {
+        uint32_t w = tree_to[tree_start[v] + s];
+        uint32_t ws = slot_back(v, w);
+        if (ws == kNone) return false;
+        back[tree_slot_pos[tree_start[v] + s]] = tree_slot_pos[tree_start[w] + ws];
+      }
+  }
+  // Walk: arrive by a slot's reverse, leave by the next slot clockwise.
+  const uint32_t total = start[n];
+  std::vector<uint32_t> owner(total);
+  for (uint32_t v = 0; v < n; ++v)
+    for (uint32_t s = start[v]; s < start[v + 1]; ++s) owner[s] = v;
+  // Loop position p leaves by slot s; the same edge walked the other way is
+  // the position that leaves by back[s] (its twin on the cut surface).
+  loop.reserve(total);
+  std::vector<uint32_t> left_at(total, kNone), slot_of;
+  slot_of.reserve(total);
+  uint32_t s = start[0];
+  do {
+    if (loop.size() >= total || left_at[s] != kNone) return false;
+    left_at[s] = static_cast<uint32_t>(loop.size());
+    slot_of.push_back(s);
+    loop.push_back(owner[s]);
+    uint32_t r = back[s];
+    uint32_t w = owner[r];
+    s = r + 1 == start[w + 1] ? start[w] : r + 1;
+  } while (s != start[0]);
+  if (loop.size() != total) return false;
+  loop_twin.resize(total);
+  for (uint32_t p = 0; p < total; ++p) {
+    loop_twin[p] = left_at[back[slot_of[p]]];
+    if (loop_twin[p] == kNone) return false;
+  }
+  return true;
+}
+
+// A random pre-order tree: each vertex hangs below one on the path from the
+// root to the vertex before it (shape 0 random, 1 chain-like, 2 star-like,
+// 3 deep with short branches).
+std::vector<uint32_t> random_preorder_tree(std::mt19937& rng, uint32_t n, int shape) {
+  std::vector<uint32_t> parent(n, kNone), path{0};
+  for (uint32_t v = 1; v < n; ++v) {
+    size_t keep = path.size();
+    if (shape == 0) keep = 1 + rng() % path.size();
+    if (shape == 1) keep = rng() % 8 ? path.size() : 1 + rng() % path.size();
+    if (shape == 2) keep = rng() % 8 ? 1 : path.size();
+    if (shape == 3 && rng() % 3 == 0) keep = path.size() - std::min<size_t>(path.size() - 1, 1 + rng() % 3);
+    path.resize(keep);
+    parent[v] = path.back();
+    path.push_back(v);
+  }
+  return parent;
+}
+
+}  // namespace
+
+// decoder_loop gives the loop and twins of the slot walk: on random
+// pre-order trees alone (the one-pass tour), and with random jump edge ends
+// (sorted corners, random pairings: some make one loop, most do not, and both
+// must agree on which). The tour refuses a parent array that is not a
+// pre-order, which the runs never give.
+TEST(Connectivity, DecoderLoopIsTheSlotWalk) {
+  std::mt19937 rng(7);
+  int one_loop_with_jumps = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const uint32_t n = 2 + static_cast<uint32_t>(rng() % (trial % 3 ? 10 : 2000));
+    const std::vector<uint32_t> parent = random_preorder_tree(rng, n, trial % 4);
+    std::vector<JumpEndpoint> jumps(trial < 400 ? 0 : 2 * (1 + rng() % 3));
+    for (JumpEndpoint& j : jumps) j = {static_cast<uint32_t>(rng() % (2 * (n - 1))), 0, kNone};
+    std::sort(jumps.begin(), jumps.end(), [](const JumpEndpoint& a, const JumpEndpoint& b) { return a.corner < b.corner; });
+    std::vector<uint32_t> free(jumps.size());
+    std::iota(free.begin(), free.end(), 0u);
+    std::shuffle(free.begin(), free.end(), rng);
+    for (size_t i = 0; i < free.size(); i += 2) jumps[free[i]].partner = free[i + 1], jumps[free[i + 1]].partner = free[i];
+    std::vector<uint32_t> l1, t1, l2, t2;
+    const bool ok1 = decoder_loop(parent, jumps, l1, t1), ok2 = slot_walk(parent, jumps, l2, t2);
+    ASSERT_EQ(ok1, ok2) << "trial " << trial;
+    if (jumps.empty()) {
+      ASSERT_TRUE(ok1) << "trial " << trial;
+    }
+    if (!ok1) continue;
+    one_loop_with_jumps += !jumps.empty();
+    ASSERT_EQ(l1.size(), 2 * (size_t{n} - 1) + jumps.size());
+    EXPECT_EQ(l1, l2) << "trial " << trial << ", " << n << " vertices";
+    EXPECT_EQ(t1, t2) << "trial " << trial << ", " << n << " vertices";
+  }
+  EXPECT_GE(one_loop_with_jumps, 100);
+  // Vertex 3 hangs below 1, which is off the path 0-2 (not a pre-order).
+  std::vector<uint32_t> loop, twin;
+  EXPECT_FALSE(decoder_loop({kNone, 0, 0, 1}, {}, loop, twin));
+  EXPECT_TRUE(slot_walk({kNone, 0, 0, 1}, {}, loop, twin));
+  EXPECT_FALSE(decoder_loop({kNone, 0, 2}, {}, loop, twin));
 }

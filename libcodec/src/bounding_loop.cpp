@@ -106,119 +106,92 @@ ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
   return out;
 }
 
+// The loop of a tree without jump edges is its Euler tour: the walk below
+// reduced to one pass over the path from the root. Vertices come in pre-order
+// (the runs give no other), so each vertex hangs below a vertex on the path
+// to the one before it: go up to its parent, then down to it. Each edge is
+// walked down once and up once, and the two positions are twins. Returns
+// false on a parent array that is not a pre-order.
+bool tree_tour(const std::vector<uint32_t>& parent, std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin) {
+  const uint32_t n = static_cast<uint32_t>(parent.size());
+  loop.resize(2 * (static_cast<size_t>(n) - 1));
+  loop_twin.resize(loop.size());
+  struct Step {
+    uint32_t vertex, down;  // a vertex on the path and the loop position of the edge down to it
+  };
+  std::vector<Step> path;
+  path.push_back({0, kNone});
+  uint32_t p = 0;
+  auto up = [&] {
+    const Step s = path.back();
+    path.pop_back();
+    loop[p] = s.vertex;
+    loop_twin[p] = s.down;
+    loop_twin[s.down] = p;
+    ++p;
+  };
+  for (uint32_t v = 1; v < n; ++v) {
+    const uint32_t par = parent[v];
+    if (par >= v) return false;
+    while (path.back().vertex != par) {
+      if (path.size() == 1) return false;
+      up();
+    }
+    loop[p] = par;
+    path.push_back({v, p++});
+  }
+  while (path.size() > 1) up();
+  return true;
+}
+
 bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
                   std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin) {
-  const uint32_t n = static_cast<uint32_t>(parent.size());
   loop.clear();
   loop_twin.clear();
-  if (n < 2) return true;
-  // Tree slots per vertex in clockwise order: parent first, then children in
-  // pre-order (= clockwise) order. slot_start[v] .. slot_start[v+1].
-  std::vector<uint32_t> degree(n, 0);
-  for (uint32_t v = 1; v < n; ++v) {
-    if (parent[v] >= v) return false;
-    degree[v]++;
-    degree[parent[v]]++;
-  }
-  // Corner after tree slot s of vertex v, numbered by tour position.
-  const uint32_t tour = 2 * (n - 1);
-  std::vector<uint32_t> tree_start(n + 1, 0);
-  for (uint32_t v = 0; v < n; ++v) tree_start[v + 1] = tree_start[v] + degree[v];
-  std::vector<uint32_t> tree_to(tree_start[n]);  // neighbour of each tree slot
-  std::vector<uint32_t> fill(tree_start.begin(), tree_start.end() - 1);
-  for (uint32_t v = 1; v < n; ++v) tree_to[fill[v]++] = parent[v];  // parent slot first
-  for (uint32_t v = 1; v < n; ++v) tree_to[fill[parent[v]]++] = v;
-  // The tree slot at w pointing back to its neighbour v: the parent slot (0)
-  // if v is w's parent, else v's child slot (children sorted by position).
-  auto slot_back = [&](uint32_t v, uint32_t w) -> uint32_t {
-    if (w != 0 && parent[w] == v) return 0;
-    uint32_t lo = tree_start[w] + (w != 0 ? 1 : 0), hi = tree_start[w + 1];
-    auto it = std::lower_bound(tree_to.begin() + lo, tree_to.begin() + hi, v);
-    if (it == tree_to.begin() + hi || *it != v) return kNone;
-    return static_cast<uint32_t>(it - tree_to.begin()) - tree_start[w];
-  };
-  // Tree tour: position q arrives at vertex corner_v[q] after slot corner_s[q].
-  std::vector<uint32_t> corner_v(tour), corner_s(tour);
-  {
-    uint32_t v = 0, s = 0;  // leaving the root by slot 0 (first child)
-    for (uint32_t step = 0; step < tour; ++step) {
-      uint32_t w = tree_to[tree_start[v] + s];
-      uint32_t back = slot_back(v, w);
-      if (back == kNone) return false;
-      uint32_t q = (step + 1) % tour;
-      corner_v[q] = w;
-      corner_s[q] = back;
-      v = w;
-      s = (back + 1) % degree[w];
-    }
-  }
-  // Full slot arrays: each tree slot followed by the jump ends of its corner.
-  const uint32_t nj = static_cast<uint32_t>(jumps.size());
-  std::vector<uint32_t> extra(n, 0);
+  if (parent.size() < 2) return true;
+  if (jumps.empty()) return tree_tour(parent, loop, loop_twin);
+  std::vector<uint32_t> tour, tour_twin;
+  if (!tree_tour(parent, tour, tour_twin)) return false;
+  const uint32_t T = static_cast<uint32_t>(tour.size()), nj = static_cast<uint32_t>(jumps.size());
+  // Slots: tour departure p (0 .. T-1) leaves tour[p] by a tree edge; slot
+  // T + i is jump end i. Around a vertex, the jump ends of tour corner c
+  // (arriving at tour[c] by departure c - 1) come, in list order, between
+  // that arrival and departure c.
+  std::vector<uint32_t> first_jump(T, kNone);
   for (uint32_t i = 0; i < nj; ++i) {
     const JumpEndpoint& j = jumps[i];
-    if (j.corner >= tour || j.partner >= nj || j.partner == i || jumps[j.partner].partner != i) return false;
-    if (i > 0 && (jumps[i - 1].corner > j.corner)) return false;
-    extra[corner_v[j.corner]]++;
+    if (j.corner >= T || j.partner >= nj || j.partner == i || jumps[j.partner].partner != i) return false;
+    if (i > 0 && jumps[i - 1].corner > j.corner) return false;
+    if (first_jump[j.corner] == kNone) first_jump[j.corner] = i;
   }
-  std::vector<uint32_t> start(n + 1, 0);
-  for (uint32_t v = 0; v < n; ++v) start[v + 1] = start[v] + degree[v] + extra[v];
-  std::vector<uint32_t> to(start[n]), back(start[n], kNone);
-  std::vector<uint32_t> tree_slot_pos(tree_start[n]), jump_slot_pos(nj);
-  {
-    // Jump ends grouped per (vertex, tree slot), in list order.
-    std::vector<uint32_t> count(tree_start[n] + 1, 0);
-    for (uint32_t i = 0; i < nj; ++i) count[tree_start[corner_v[jumps[i].corner]] + corner_s[jumps[i].corner] + 1]++;
-    for (uint32_t v = 0; v < n; ++v) {
-      uint32_t at = start[v];
-      for (uint32_t s = 0; s < degree[v]; ++s) {
-        tree_slot_pos[tree_start[v] + s] = at;
-        to[at] = tree_to[tree_start[v] + s];
-        at += 1 + count[tree_start[v] + s + 1];
-      }
-    }
-    std::vector<uint32_t> used(tree_start[n], 0);
-    for (uint32_t i = 0; i < nj; ++i) {
-      uint32_t v = corner_v[jumps[i].corner], ts = tree_start[v] + corner_s[jumps[i].corner];
-      jump_slot_pos[i] = tree_slot_pos[ts] + 1 + used[ts]++;
-    }
-    for (uint32_t i = 0; i < nj; ++i) {
-      to[jump_slot_pos[i]] = corner_v[jumps[jumps[i].partner].corner];
-      back[jump_slot_pos[i]] = jump_slot_pos[jumps[i].partner];
-    }
-    for (uint32_t v = 0; v < n; ++v)
-      for (uint32_t s = 0; s < degree[v]; ++s) {
-        uint32_t w = tree_to[tree_start[v] + s];
-        uint32_t ws = slot_back(v, w);
-        if (ws == kNone) return false;
-        back[tree_slot_pos[tree_start[v] + s]] = tree_slot_pos[tree_start[w] + ws];
-      }
-  }
-  // Walk: arrive by a slot's reverse, leave by the next slot clockwise.
-  const uint32_t total = start[n];
-  std::vector<uint32_t> owner(total);
-  for (uint32_t v = 0; v < n; ++v)
-    for (uint32_t s = start[v]; s < start[v + 1]; ++s) owner[s] = v;
-  // Loop position p leaves by slot s; the same edge walked the other way is
-  // the position that leaves by back[s] (its twin on the cut surface).
-  loop.reserve(total);
+  // Walk: leave by a slot, arrive by its reverse, leave by the next slot
+  // clockwise: after a tree edge into corner c, c's first jump end or
+  // departure c; after jump end i, the next end at its corner or the
+  // departure there.
+  const uint32_t total = T + nj;
   std::vector<uint32_t> left_at(total, kNone), slot_of;
   slot_of.reserve(total);
-  uint32_t s = start[0];
+  loop.reserve(total);
+  uint32_t s = 0;
   do {
     if (loop.size() >= total || left_at[s] != kNone) return false;
     left_at[s] = static_cast<uint32_t>(loop.size());
     slot_of.push_back(s);
-    loop.push_back(owner[s]);
-    uint32_t r = back[s];
-    uint32_t w = owner[r];
-    s = r + 1 == start[w + 1] ? start[w] : r + 1;
-  } while (s != start[0]);
+    if (s < T) {
+      loop.push_back(tour[s]);
+      const uint32_t c = s + 1 == T ? 0 : s + 1;
+      s = first_jump[c] != kNone ? T + first_jump[c] : c;
+    } else {
+      const uint32_t i = s - T, k = jumps[i].partner, c = jumps[k].corner;
+      loop.push_back(tour[jumps[i].corner]);
+      s = k + 1 < nj && jumps[k + 1].corner == c ? T + k + 1 : c;
+    }
+  } while (s != 0);
   if (loop.size() != total) return false;
   loop_twin.resize(total);
   for (uint32_t p = 0; p < total; ++p) {
-    loop_twin[p] = left_at[back[slot_of[p]]];
-    if (loop_twin[p] == kNone) return false;
+    const uint32_t x = slot_of[p];
+    loop_twin[p] = left_at[x < T ? tour_twin[x] : T + jumps[x - T].partner];
   }
   return true;
 }

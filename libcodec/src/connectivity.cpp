@@ -289,6 +289,13 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   twin.clear();
   std::vector<uint8_t> tslot;
   std::vector<std::pair<uint32_t, uint32_t>> stack;  // branching node, runs started at it so far
+  // The header's counts are within the streams' budget (check_budget): the
+  // common case (one surface, triangles) then grows no array while decoding.
+  parent.reserve(vertex_count + 1);
+  tri_vertex.reserve(corner_count);
+  tri_parent.reserve(corner_count / 3);
+  tri_slot.reserve(corner_count / 3);
+  tri_glued.reserve(corner_count / 3);
   int prev_leaf = 1;
   for (uint32_t c = 0; c < C; ++c) {
     const uint32_t start = static_cast<uint32_t>(parent.size());
@@ -388,23 +395,25 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
         if (loop_he[edge_loop[h]] != kNone) return corrupt("a loop edge belongs to two triangles");
         loop_he[edge_loop[h]] = 3 * base + h;
       }
-    for (uint32_t h = 0; h < 3 * T; ++h) {
-      if (edge_loop[h] != kNone) twin[3 * size_t{base} + h] = loop_he[loop_twin[edge_loop[h]]];
-      if (h % 3 == 0 && h > 0) {
-        uint32_t par = 3 * (base + tparent[h / 3]) + tslot[h / 3];
-        twin[3 * size_t{base} + h] = par;
-        twin[par] = 3 * base + h;
-      }
+    uint32_t* tw = twin.data() + 3 * size_t{base};
+    for (uint32_t h = 0; h < 3 * T; ++h)
+      if (edge_loop[h] != kNone) tw[h] = loop_he[loop_twin[edge_loop[h]]];
+    for (uint32_t k = 1; k < T; ++k) {  // the edge a triangle is entered by (its slot 0) is its parent's slot
+      const uint32_t par = 3 * (base + tparent[k]) + tslot[k];
+      tw[3 * k] = par;
+      twin[par] = 3 * (base + k);
     }
+    tri_vertex.resize(3 * (size_t{base} + T));
+    tri_parent.resize(size_t{base} + T);
+    tri_slot.resize(size_t{base} + T);
+    tri_glued.resize(size_t{base} + T, 0);
+    uint32_t* tv = tri_vertex.data() + 3 * size_t{base};
+    for (uint32_t h = 0; h < 3 * T; ++h) tv[h] = start + loop[tri_pos[h]];
     for (uint32_t k = 0; k < T; ++k) {
-      for (int i = 0; i < 3; ++i) tri_vertex.push_back(start + loop[tri_pos[3 * k + i]]);
-      tri_parent.push_back(tparent[k] == kNone ? kNone : base + tparent[k]);
-      tri_slot.push_back(tslot[k]);
-      uint8_t glued = 0;
-      if (polygons && k > 0) {
-        glued = static_cast<uint8_t>(dt.bit(tm.diagonal[tri_glued.empty() || k == 1 ? 0 : tri_glued.back()]));
-      }
-      tri_glued.push_back(glued);
+      tri_parent[base + k] = tparent[k] == kNone ? kNone : base + tparent[k];
+      tri_slot[base + k] = tslot[k];
+      if (polygons && k > 0)
+        tri_glued[base + k] = static_cast<uint8_t>(dt.bit(tm.diagonal[k == 1 ? 0 : tri_glued[base + k - 1]]));
     }
     if (tri_vertex.size() > 3 * (corner_count + max_positions)) return corrupt("more triangles than the header allows");
   }
@@ -464,6 +473,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   out.face_offsets.assign(1, 0);
   out.indices.clear();
   const uint32_t NT = static_cast<uint32_t>(tri_parent.size());
+  out.face_offsets.reserve(std::min<uint64_t>(face_count, NT) + 1);
+  out.indices.reserve(std::min<uint64_t>(corner_count, 3 * uint64_t{NT}));
   std::vector<uint32_t> node_vertex, node_next, edge_node;
   std::vector<uint32_t> group_root(NT, kNone), root_node(NT, kNone);
   if (polygons) {

@@ -181,6 +181,9 @@ ComponentLoop encoder_loop(const CutMesh& m, const VertexForest& f, uint32_t c,
 // false on inconsistent input.
 bool decoder_loop(const std::vector<uint32_t>& parent, const std::vector<JumpEndpoint>& jumps,
                   std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin);
+// The tree's Euler tour alone (vertices in pre-order; the loop without jump
+// edges), the first step of decoder_loop.
+bool tree_tour(const std::vector<uint32_t>& parent, std::vector<uint32_t>& loop, std::vector<uint32_t>& loop_twin);
 
 // Stage 4: the triangle tree (seed 004 §4).
 struct TriangleRuns {
