@@ -476,8 +476,10 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   out.face_offsets.reserve(std::min<uint64_t>(face_count, NT) + 1);
   out.indices.reserve(std::min<uint64_t>(corner_count, 3 * uint64_t{NT}));
   std::vector<uint32_t> node_vertex, node_next, edge_node;
-  std::vector<uint32_t> group_root(NT, kNone), root_node(NT, kNone);
+  std::vector<uint32_t> group_root, root_node;
   if (polygons) {
+    group_root.assign(NT, kNone);
+    root_node.assign(NT, kNone);
     node_vertex.reserve(3 * static_cast<size_t>(NT));
     edge_node.assign(3 * static_cast<size_t>(NT), kNone);
   }
