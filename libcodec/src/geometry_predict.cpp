@@ -325,6 +325,12 @@ struct SurfaceCoder {
     return first_he;
   }
   std::vector<uint32_t> first_he;
+  // The tangent step's normal: adds half-edge h's triangle (centre, u, w)
+  // if its two other corners u, w are decoded.
+  void add_normal_triangle(NormalSum& ns, uint32_t h, const int64_t centre[3]) const {
+    const uint32_t u = known(he_next(h)), w = known(he_prev(h));
+    if (u != kNone && w != kNone) ns.add(at(u), at(w), centre);
+  }
 
   // Codes the vertex at the origin of half-edge h0 (undecoded, not virtual);
   // multi: every triangle around it, else only h0's triangle.
@@ -395,10 +401,7 @@ struct SurfaceCoder {
       if (npair <= kPairs) {
         for (int i = 0; i < npair; ++i) ns.add(at(pu[i]), at(pw[i]), pred);
       } else {  // a wide fan: walk it again
-        walk([&](uint32_t h) {
-          uint32_t u = known(he_next(h)), w = known(he_prev(h));
-          if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
-        });
+        walk([&](uint32_t h) { add_normal_triangle(ns, h, pred); });
       }
       normal = ns.finish();
     }
@@ -441,10 +444,7 @@ struct SurfaceCoder {
       if (c.tangent && anchor != kNone) {
         const uint32_t h0 = first_half_edges()[anchor];  // kNone: an anchor on no triangle (only in a forged file)
         if (h0 != kNone)
-          fan(h0, [&](uint32_t h) {
-            uint32_t u = known(he_next(h)), w = known(he_prev(h));
-            if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
-          });
+          fan(h0, [&](uint32_t h) { add_normal_triangle(ns, h, pred); });
       }
       if (!point(v, pred, 0, last_act, nullptr, ns.finish(), 1)) return false;
       if ((v & 4095) == 0 && s.truncated()) return false;
@@ -1042,7 +1042,8 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     for (int i = 0; i < 2; ++i) {
       uint16_t x;
       if (!r.u16(x)) return corrupt("truncated predictor header");
-      if (x > kMaxBeta) return corrupt("tangent weight " + std::to_string(x) + " out of range 0..8192");
+      if (x > kMaxBeta)
+        return corrupt("tangent weight " + std::to_string(x) + " out of range 0.." + std::to_string(kMaxBeta));
       c.beta[i] = x;
     }
   }
