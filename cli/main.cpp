@@ -74,9 +74,10 @@ int main(int argc, char** argv) {
                   "0 = default (262144)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   enc->add_option("--format-version", ea.format_version,
-                  "Write this format version: 5 (the newest), or 4 for decoders of version 4 (no tangent step; "
-                  "usually slightly larger)")
-      ->check(CLI::Range(4, 5));
+                  "Write this format version: 6 (the newest), 5 for decoders of version 5 (no residual mixing, "
+                  "which only levels 7-9 use), or 4 for decoders of version 4 (no tangent step either; usually "
+                  "slightly larger)")
+      ->check(CLI::Range(4, 6));
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));

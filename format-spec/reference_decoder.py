@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3, 4 and 5), written from
+"""An independent decoder for .tsm files (format versions 3 to 6), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5):
+    if version not in (3, 4, 5, 6):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -277,6 +277,19 @@ class RangeDecoder:
         self.normalize()
         return b
 
+    def bit_fixed(self, p):
+        """A decision with probability p of a 0 bit, nothing adapted (§8.1.1)."""
+        bound = (self.range >> 15) * p
+        if self.code < bound:
+            self.range = bound
+            b = 0
+        else:
+            self.code -= bound
+            self.range -= bound
+            b = 1
+        self.normalize()
+        return b
+
     def direct(self, n):
         v = 0
         for _ in range(n):
@@ -298,6 +311,80 @@ SHIFT = [min(7, (n + 2).bit_length() - 1) for n in range(129)]
 
 def probs(n):
     return [16384] * n           # p = 16384, count 0
+
+
+def adapt(probs, i, b):
+    p = probs[i] & 0xFFFF
+    n = probs[i] >> 16
+    s = SHIFT[n]
+    p = min(p + ((32768 - p) >> s), 32704) if b == 0 else max(p - (p >> s), 64)
+    probs[i] = p | (min(n + 1, 128) << 16)
+
+
+# §8.1.1 (version 6) logistic mixing
+SQUASH_T = [1, 2, 4, 6, 10, 17, 27, 45, 74, 120, 194, 311, 488, 747, 1102, 1546, 2048, 2550, 2994, 3349,
+            3608, 3785, 3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095]
+
+
+def squash(t):
+    t = min(max(t, -2047), 2047)
+    j, w = (t + 2048) >> 7, (t + 2048) & 127
+    return (SQUASH_T[j] * (128 - w) + SQUASH_T[j + 1] * w + 64) >> 7
+
+
+def _stretch_table():
+    st = []
+    for t in range(-2047, 2048):
+        while len(st) <= squash(t):
+            st.append(t)
+    return st + [2047] * (4096 - len(st))
+
+
+STRETCH = _stretch_table()
+
+
+def mixed_bit(d, pa, ia, pb, ib, w):
+    """One decision from models pa[ia] and pb[ib] mixed with weights w (§8.1.1)."""
+    x = (STRETCH[(pa[ia] & 0xFFFF) >> 3], STRETCH[(pb[ib] & 0xFFFF) >> 3], 256)
+    t = (w[0] * x[0] + w[1] * x[1] + w[2] * x[2]) >> 16      # floor
+    p = squash(t)
+    b = d.bit_fixed(min(max(p << 3, 64), 32704))
+    adapt(pa, ia, b)
+    adapt(pb, ib, b)
+    err = (0 if b else 4095) - p
+    for k in range(3):
+        w[k] = min(max(w[k] + ((x[k] * err) >> 9), -(1 << 22)), 1 << 22)
+    return b
+
+
+def mix_weights():
+    return [[32768, 32768, 0] for _ in range(14)]
+
+
+def decode_mixed_sint(d, A, B, W):
+    """A signed integer as SIntModel(6) codes it, each decision mixed from A and B (§8.1.1)."""
+    if mixed_bit(d, A.p, 0, B.p, 0, W[0]) == 0:
+        return 0
+    neg = mixed_bit(d, A.p, 1, B.p, 1, W[1])
+    node = 1
+    for k in range(6):
+        node = (node << 1) | mixed_bit(d, A.magnitude.length.p, node, B.magnitude.length.p, node, W[2 + k])
+    n = node - 64
+    if n > 32:
+        return -0x7FFFFFFF if neg else 0x7FFFFFFF
+    x = 1
+    ctx = 1
+    top = min(n, 6)
+    ma, mb = A.magnitude.mantissa[n], B.magnitude.mantissa[n]
+    for k in range(top):
+        b = mixed_bit(d, ma, ctx, mb, ctx, W[8 + k])
+        ctx = (ctx << 1) | b
+        x = (x << 1) | b
+    rest = n - top
+    if rest > 0:
+        x = (x << rest) | d.direct(rest)
+    m = min(x, 0x7FFFFFFF)
+    return -m if neg else m
 
 
 class BitTree:
@@ -957,6 +1044,12 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     predictor = payload[0]
     default_weights = False
     tangent = False
+    mix = False
+    if version >= 6 and predictor & 0x20:                           # §8.5.1, version 6
+        predictor &= 0xDF
+        mix = True
+        if (predictor & 0x3F) > 3:
+            reject('geometry: predictor without residual models to mix')
     if version >= 5 and predictor in (0x41, 0x42, 0x43, 0xC1, 0xC2, 0xC3):   # §8.5.1, version 5
         predictor &= 0xBF
         tangent = True
@@ -1006,10 +1099,13 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     index = [[[SIntModel(6) for _ in range(14)] for _ in range(3)] for _ in range(3)]
     has_anchor = probs(1)
     anchor_gap = UIntModel(2)
+    if mix:                                                          # version 6
+        residual2 = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
+        mixw = [[mix_weights() for _ in range(8)] for _ in range(3)]
     lattice = decode_lattice(d, qmax, vc)
     q = [[0, 0, 0] for _ in range(vc)]
     act = [UNKNOWN] * vc
-    st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0}
+    st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0, 'prev_act': 0}
     stats = {'no_triangle': 0, 'anchored': 0, 'on_plane': 0}
 
     def nearest(L, p):
@@ -1069,7 +1165,13 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                     stats['on_plane'] += 1
                     n_on += 1
                     coded = True
-            if not coded:
+            if not coded and mix:                            # version 6: two models mixed
+                ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
+                r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
+                x = p + r
+                if x < 0 or x > qmax:
+                    reject('geometry: coordinate outside the grid')
+            elif not coded:
                 r = residual[i][cls][ctx].decode(d)          # by coding position i (= a without a normal)
                 x = p + r
                 if x < 0 or x > qmax:
@@ -1080,6 +1182,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             sm += e
             top = max(top, e)
         act[v] = min(bit_length(sm), 254)
+        st['prev_act'] = act[v]
         if trace is not None:
             trace.append('v%d pred=%s cls=%d act_in=%d%s -> q=%s act=%d' % (
                 v, list(pred), cls, activity,

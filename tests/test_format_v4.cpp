@@ -187,8 +187,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 6 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 6, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 7 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 7, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -314,3 +314,50 @@ TEST(FormatV4, ShortFlushLeavesAtMostEightBytesOut) {
 }
 
 }  // namespace
+
+// Version 6 adds residual mixing (FORMAT.md §8.1.1), tried from level 7
+// (kMixLevel): the encoder writes version 6 only into files that use it,
+// otherwise version 5, unless a version is asked for; a mixed file decodes
+// exactly, re-encodes to its own bytes, and is refused as version 5.
+TEST(FormatV6, MixingFromLevel7AndVersion6OnlyWhereUsed) {
+  Mesh noisy = tsm_test::icosphere(4);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> jitter(-0.003f, 0.003f);
+  for (float& x : noisy.positions) x += jitter(rng);
+  auto encode_v = [&](const Mesh& m, int level, int version) {
+    std::string out;
+    tsm::EncodeOptions o;
+    o.quantization_bits = 14;
+    o.level = level;
+    o.format_version = version;
+    EXPECT_TRUE(tsm::encode(m, o, out).ok());
+    return out;
+  };
+  auto version_of = [](const std::string& bytes) {
+    tsm::FileInfo fi;
+    EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+    return fi.format_version;
+  };
+  auto mixed = [](const std::string& bytes) { return predictor_of(bytes).find("+mix") != std::string::npos; };
+  const std::string l6 = encode_v(noisy, 6, 0), l9 = encode_v(noisy, 9, 0);
+  EXPECT_EQ(version_of(l6), 5u);
+  EXPECT_FALSE(mixed(l6));
+  EXPECT_EQ(version_of(l9), 6u);
+  EXPECT_TRUE(mixed(l9)) << predictor_of(l9);
+  EXPECT_LT(l9.size(), encode_v(noisy, 9, 5).size());
+  expect_round_trip(noisy, l9, 14, "level 9");
+  // Re-encoding the decoded mesh gives the same bytes.
+  EXPECT_EQ(encode_v(decode_ok(l9), 9, 0), l9);
+  // Asked-for versions: 5 at level 9 has no mixing; 6 at level 6 is written as 6.
+  const std::string v5 = encode_v(noisy, 9, 5);
+  EXPECT_EQ(version_of(v5), 5u);
+  EXPECT_FALSE(mixed(v5));
+  EXPECT_EQ(version_of(encode_v(noisy, 6, 6)), 6u);
+  // The mixing flag in a version 5 file is an unknown predictor.
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(l9, h, parsed).ok());
+  ASSERT_EQ(parsed.size(), 1u);
+  EXPECT_EQ(decode_code(rebuild(l9, 5, {{parsed[0].id, parsed[0].data}})), tsm::ErrorCode::corrupt_data);
+  EXPECT_TRUE(decode_code(rebuild(l9, 6, {{parsed[0].id, parsed[0].data}})) == tsm::ErrorCode::ok);
+}

@@ -152,6 +152,60 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
   }
 }
 
+// Version 6's residual mixing (FORMAT.md §8.1.1, §8.5.3): on every predictor
+// with models (with and without the tangent step and planes) the positions
+// come back; version 5 refuses the flag; and on a noisy surface, where the
+// two contexts tell different things, mixing is smaller.
+TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
+  std::vector<std::pair<std::string, Mesh>> meshes = families();
+  using tsm::Predictor;
+  const int32_t beta[2] = {4096, 2048};
+  for (const auto& [name, m] : meshes)
+    for (int bits : {4, 11, 20}) {
+      Prepared p = prepare(m, bits);
+      tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
+      for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::parallelograms, 0}, {Predictor::spread, 0},
+                             {Predictor::ancestors, 2}})
+        for (bool tangent : {false, true})
+          for (bool use_lattice : {false, true}) {
+            if (tangent && pred == Predictor::ancestors) continue;
+            SCOPED_TRACE(name + " bits=" + std::to_string(bits) + " predictor=" + std::to_string(int(pred)) +
+                         " tangent=" + std::to_string(tangent) + " lattice=" + std::to_string(use_lattice));
+            const tsm::Lattice& L = use_lattice ? lattice : tsm::Lattice();
+            const std::string bytes =
+                tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, L, nullptr, tangent ? beta : nullptr, true);
+            ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kMixFlag);
+            std::vector<uint32_t> back;
+            tsm::GeometryStats st;
+            const tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
+            ASSERT_TRUE(s.ok()) << s.to_string();
+            EXPECT_EQ(back, p.q);
+            EXPECT_TRUE(st.mix);
+            EXPECT_EQ(st.tangent, tangent);
+            EXPECT_EQ(st.predictor, pred);
+            EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 5).code(),
+                      tsm::ErrorCode::corrupt_data);
+          }
+    }
+  // The raw predictor has no models to mix.
+  Prepared p = prepare(tsm_test::cube_quads(), 11);
+  std::string raw = tsm::encode_geometry_as(p.ce.layout, p.q, 11, Predictor::raw, 0, tsm::Lattice());
+  raw[0] = static_cast<char>(raw[0] | tsm::kMixFlag);
+  std::vector<uint32_t> back;
+  EXPECT_EQ(tsm::decode_geometry(raw, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
+  // A noisy sphere: smaller mixed.
+  Mesh noisy = tsm_test::icosphere(5);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> jitter(-0.004f, 0.004f);
+  for (float& x : noisy.positions) x += jitter(rng);
+  Prepared n = prepare(noisy, 14);
+  const std::string plain = tsm::encode_geometry_as(n.ce.layout, n.q, 14, Predictor::spread, 0, tsm::Lattice(),
+                                                    nullptr, beta);
+  const std::string mixed = tsm::encode_geometry_as(n.ce.layout, n.q, 14, Predictor::spread, 0, tsm::Lattice(),
+                                                    nullptr, beta, true);
+  EXPECT_LT(mixed.size(), plain.size() * 99 / 100) << plain.size() << " -> " << mixed.size();
+}
+
 // Version 5's tangent step (FORMAT.md §8.5.3): with any weights, on every
 // surface predictor, with and without planes, the positions come back.
 TEST(Geometry, TangentStepRoundTripsWithAnyWeights) {

@@ -327,6 +327,11 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
 }
 
 // Encoder: one part (the whole mesh or a segment) coded.
+// Whether a geometry stream uses residual mixing (format version 6).
+bool uses_mixing(const std::string& geometry) {
+  return !geometry.empty() && (static_cast<uint8_t>(geometry[0]) & kMixFlag);
+}
+
 struct EncodedPart {
   ConnectivityStreams streams;
   std::string geometry;
@@ -536,7 +541,8 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options) >= 5);
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options) >= 5,
+                                 written_version(options) >= 6);
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -755,7 +761,7 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const EncodeOptions& options, ContainerWriter& cw) {
+                       const EncodeOptions& options, ContainerWriter& cw, bool& mixed) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -848,6 +854,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     sp.geometry = p.geometry;
     sp.attributes = p.attributes;
     cw.add_section(kSectionSegment, write_segment(sp), 0);
+    mixed = mixed || uses_mixing(p.geometry);
     p = EncodedPart();
   }
   return Status::Ok();
@@ -916,14 +923,20 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     const std::string md = write_metadata(mesh.metadata);
     cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
   }
+  bool mixed = false;
   if (segments.size() == 1) {
     EncodedPart p;
     TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
+    mixed = uses_mixing(p.geometry);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, mixed));
   }
+  // Unless asked for a version: the oldest that holds what was coded (version
+  // 6 only adds residual mixing), so that most files stay readable by
+  // decoders of version 5.
+  if (options.format_version == 0 && !mixed) cw.set_version(5);
   out = cw.finish();
   return Status::Ok();
 }
@@ -1000,6 +1013,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
                             : gs.predictor == Predictor::raw     ? "raw"
                                                                  : "parallelograms";
   if (gs.tangent) info.geometry_predictor += "+tangent";
+  if (gs.mix) info.geometry_predictor += "+mix";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();

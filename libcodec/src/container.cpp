@@ -70,7 +70,15 @@ ContainerWriter::ContainerWriter(const Header& header) {
   write_header_fields(fw, header);
   w.varint(fields.size());
   w.bytes(fields);
+  header_end_ = out_.size();
   w.u32(checksum32(std::string_view(out_)));
+}
+
+void ContainerWriter::set_version(uint16_t version) {
+  out_[4] = static_cast<char>(version & 0xFF);
+  out_[5] = static_cast<char>(version >> 8);
+  const uint32_t c = checksum32(std::string_view(out_).substr(0, header_end_));
+  for (int i = 0; i < 4; ++i) out_[header_end_ + i] = static_cast<char>((c >> (8 * i)) & 0xFF);
 }
 
 void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zstd_level) {

@@ -11,8 +11,8 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 5;        // what the encoder writes
-constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 5
+constexpr uint16_t kFormatVersion = 6;        // what the encoder writes
+constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 6
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder
@@ -60,11 +60,15 @@ class ContainerWriter {
   explicit ContainerWriter(const Header& header);
   // Adds a section; tries zstd at `zstd_level` (0 = never) and keeps it when smaller.
   void add_section(uint16_t id, std::string_view payload, int zstd_level);
+  // Rewrites the preamble's version (and the header checksum over it): the
+  // encoder writes the oldest version that holds what it coded.
+  void set_version(uint16_t version);
   // Finishes the file (end marker) and returns the bytes.
   std::string finish();
 
  private:
   std::string out_;
+  size_t header_end_ = 0;  // offset of the header checksum
 };
 
 // Incremental reading, for bytes that may still be arriving: each reads one

@@ -59,6 +59,7 @@ constexpr int32_t kMaxBeta = 2 * kAlphaOne;  // the tangent step's weights: 0 ..
 
 constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
+constexpr int kMixCtx = 8;    // weight sets of residual mixing per coding position and decision
 
 // Predictors 1, 2 and 3, which predict from the triangles around a vertex
 // (parallelogram weights, the tangent step).
@@ -76,6 +77,11 @@ int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
 struct ResidualModels {
   ResidualModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
   ResidualModel m[3][kClasses][kActivity];
+  // Residual mixing (version 6, kMixFlag): the second model of each
+  // residual decision, by the second context, and the mixing weights by
+  // coding position and first context (capped at kMixCtx - 1).
+  ResidualModel m2[3][kClasses][kActivity];
+  MixWeights mix[3][kMixCtx][kMixKinds<kMantissa>];
   // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
   // then the lattice index offset from the plane nearest the prediction.
   Prob on[3][3];
@@ -99,6 +105,10 @@ struct EncodeSink {
     m.encode(e, static_cast<int32_t>(v));
     return static_cast<int32_t>(v);
   }
+  int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t v) {
+    MixEncodeOp op{e};
+    return code_mixed_sint(op, a, b, w, static_cast<int32_t>(v));
+  }
   uint32_t uint(UIntModel& m, uint32_t v) {
     m.encode(e, v);
     return v;
@@ -111,6 +121,7 @@ struct CollectSink {
   static constexpr bool kEncoder = true;
   int bit(Prob&, int b) { return b; }
   int32_t sint(ResidualModel&, int64_t v) { return static_cast<int32_t>(v); }
+  int32_t sint_mixed(ResidualModel&, ResidualModel&, MixWeights*, int64_t v) { return static_cast<int32_t>(v); }
   uint32_t uint(UIntModel&, uint32_t v) { return v; }
   bool truncated() const { return false; }
 };
@@ -120,6 +131,10 @@ struct DecodeSink {
   RangeDecoder d;
   int bit(Prob& p, int) { return d.bit(p); }
   int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
+  int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t) {
+    MixDecodeOp op{d};
+    return code_mixed_sint(op, a, b, w, 0);
+  }
   uint32_t uint(UIntModel& m, uint32_t) { return m.decode(d); }
   bool truncated() const { return d.overrun() > RangeDecoder::kMaxOverrun; }
 };
@@ -134,6 +149,12 @@ struct Coder {
   // parallelogram average against the neighbour average, 4.12 fixed point
   // (4096 = parallelograms only), fitted per mesh by least squares.
   int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
+  // Residual mixing (version 6): each residual from two models, the second by
+  // the largest residual of this vertex's axes coded so far (the first axis:
+  // the neighbours' activity where the first context is the spread, else the
+  // previous vertex's activity), mixed (range_coder.hpp).
+  bool mix = false;
+  int prev_act = 0;  // activity of the vertex coded last (0 before the first)
   bool spread_ctx = false;  // predictor spread: contexts from the parallelograms' spread
   // Tangent step (version 5, kTangentFlag): a vertex with a local normal codes
   // the two axes across the normal first, then the axis nearest it, predicted
@@ -230,7 +251,14 @@ struct Coder {
         }
       }
       if (!coded) {
-        int64_t r = s.sint(models->m[i][cls][ctx], static_cast<int64_t>(x) - p);
+        int64_t r;
+        if (mix) {
+          const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
+          r = s.sint_mixed(models->m[i][cls][ctx], models->m2[i][cls][ctx2], models->mix[i][std::min(ctx, kMixCtx - 1)],
+                           static_cast<int64_t>(x) - p);
+        } else {
+          r = s.sint(models->m[i][cls][ctx], static_cast<int64_t>(x) - p);
+        }
         if (p + r < 0 || p + r > qmax) return false;
         x = static_cast<uint32_t>(p + r);
       }
@@ -241,6 +269,7 @@ struct Coder {
       top = std::max(top, ar);
     }
     act[v] = static_cast<uint8_t>(std::min(bit_length(sum), 254));
+    prev_act = act[v];
     return true;
   }
 };
@@ -769,7 +798,7 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
 }
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent) {
+                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix) {
   if (pred == Predictor::raw) return encode_geometry_raw(g, q, bits, covers(lattice, q, g.vertex_count) ? lattice : Lattice());
   std::string head;
   ByteWriter w(head);
@@ -778,7 +807,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
                                                     weights[2] == kAlphaOne));
   if (!surface_predictor(pred)) tangent = nullptr;
   w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0) |
-                            (tangent ? kTangentFlag : 0)));
+                            (tangent ? kTangentFlag : 0) | (mix ? kMixFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (pred == Predictor::ancestors) {
     fit_lambda(g, q, K, lambda);
@@ -787,6 +816,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   }
   Coder c(g.vertex_count, bits);
   c.spread_ctx = pred == Predictor::spread;
+  c.mix = mix;
   if (pred != Predictor::ancestors && !default_weights)
     for (int k = 0; k < 3; ++k) {
       c.alpha[k] = weights[k];
@@ -897,7 +927,7 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 }
 
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats, bool tangent) {
+                            const Lattice* candidate, GeometryStats* stats, bool tangent, bool mix) {
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   int32_t lsq[3], est[3];
@@ -907,14 +937,16 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // `lattice` may be st.lattice itself (the assignment below is then a
   // self-assignment, which std::vector handles).
   int32_t beta[2];
-  auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr) {
-    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan);
+  auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
+                      bool mixed = false) {
+    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
     st.ancestors = K;
     st.lattice = lattice;
     st.tangent = tan != nullptr;
+    st.mix = mixed;
     weights = w;
     return true;
   };
@@ -975,6 +1007,9 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
     consider(st.predictor, 0, st.lattice, weights, beta);
   }
+  // Residual mixing (version 6) on whatever won: smaller, slower to decode.
+  if (mix && level >= kMixLevel && st.predictor != Predictor::raw)
+    consider(st.predictor, st.ancestors, st.lattice, weights, st.tangent ? beta : nullptr, true);
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
   return best;
@@ -989,6 +1024,13 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (!r.u8(kind)) return corrupt("empty section");
   const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
   bool default_weights = false;
+  if (version >= 6 && (kind & kMixFlag)) {
+    kind = static_cast<uint8_t>(kind & ~kMixFlag);
+    st.mix = true;
+    if ((kind & ~(kDefaultWeightsFlag | kTangentFlag)) > static_cast<uint8_t>(Predictor::spread))
+      return corrupt("predictor " + std::to_string(kind & ~(kDefaultWeightsFlag | kTangentFlag)) +
+                     " has no residual models to mix");
+  }
   if (version >= 5 && (kind & kTangentFlag)) {
     kind = static_cast<uint8_t>(kind & ~kTangentFlag);
     st.tangent = true;
@@ -1050,6 +1092,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   const size_t at = r.offset();
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   c.spread_ctx = st.predictor == Predictor::spread;
+  c.mix = st.mix;
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");

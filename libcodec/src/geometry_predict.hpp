@@ -37,6 +37,11 @@ constexpr uint8_t kDefaultWeightsFlag = 0x80;
 // bit set says the tangent step is on; its two weights follow the
 // parallelogram weights.
 constexpr uint8_t kTangentFlag = 0x40;
+// Version 6: the predictor byte of 0, 1, 2 or 3 (with the flags above) with
+// this bit set says residuals are coded with two mixed models each.
+constexpr uint8_t kMixFlag = 0x20;
+// The lowest encoder level that tries residual mixing (slower to decode).
+constexpr int kMixLevel = 7;
 
 // Per axis, the sorted coordinate values many vertices share (the voxel
 // planes of a marching-cubes surface, a CAD grid); empty when not used.
@@ -48,6 +53,7 @@ struct GeometryStats {
   Predictor predictor = Predictor::parallelograms;
   int ancestors = 0;  // K for the ancestor predictor
   bool tangent = false;  // version 5: the tangent step
+  bool mix = false;      // version 6: residual mixing
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -65,19 +71,22 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 
 // q: 3 quantized coordinates per output vertex. The encoder picks the
 // predictor by level, and the lattice (if a candidate is given) by size.
-// tangent: the tangent step may be tried (version 5).
+// tangent: the tangent step may be tried (version 5); mix: residual mixing
+// (version 6, from level kMixLevel).
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats = nullptr, bool tangent = true);
+                            const Lattice* candidate, GeometryStats* stats = nullptr, bool tangent = true,
+                            bool mix = true);
 // One predictor, lattice and set of parallelogram weights (per class of 1,
 // 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
 // experiments). tangent: the tangent step's two weights (4.12, surface
-// vertices and vertices with an anchor; version 5), null for none.
+// vertices and vertices with an anchor; version 5), null for none. mix:
+// residual mixing (version 6; not with the raw predictor).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
-                               const int32_t* tangent = nullptr);
+                               const int32_t* tangent = nullptr, bool mix = false);
 // `version`: the file's format version (3 knows neither the raw predictor
 // nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr, int version = 5);
+                       GeometryStats* stats = nullptr, int version = 6);
 
 }  // namespace tsm

@@ -88,6 +88,13 @@ class RangeEncoder {
       shift_low();
     }
   }
+  // A bit with a given probability of 0 (kProbMin..kProbMax), nothing adapted.
+  void bit_fixed(uint32_t p0, int b) {
+    Prob q;
+    q.p = static_cast<uint16_t>(p0);
+    q.n = kAdaptCountMax;
+    bit(q, b);
+  }
   // Equiprobable bits, most significant first (n <= 32).
   void direct(uint32_t value, int n) {
     for (int i = n - 1; i >= 0; --i) {
@@ -134,6 +141,12 @@ class RangeDecoder {
       code_ = (code_ << 8) | next_byte();
     }
     return b;
+  }
+  int bit_fixed(uint32_t p0) {
+    Prob q;
+    q.p = static_cast<uint16_t>(p0);
+    q.n = kAdaptCountMax;
+    return bit(q);
   }
   uint32_t direct(int n) {
     uint32_t v = 0;
@@ -266,6 +279,143 @@ struct SIntModelT {
     return neg ? -v : v;
   }
 };
+
+// Logistic mixing (format version 6, FORMAT.md §8.1.1): a decision coded
+// with two adaptive models at once, A and B, each seeing a different
+// context. Their probabilities are mapped to the logistic domain
+// (stretch), weighted by a small online-trained weight vector, and mapped
+// back (squash); both models then adapt as usual and the weights take a
+// gradient step towards the coded bit. Integer arithmetic only, so every
+// decoder computes the same probabilities.
+constexpr int kSquashTable[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
+                                  311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
+                                  3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
+// 1 / (1 + e^(-d/256)) in 1/4096, d clamped to [-2047, 2047]: linear
+// between the table's points, which are e^(-x) at x = -8, -7.5, .., 8.
+constexpr int squash(int d) {
+  d = d < -2047 ? -2047 : d > 2047 ? 2047 : d;
+  const int j = (d + 2048) >> 7, w = (d + 2048) & 127;
+  return (kSquashTable[j] * (128 - w) + kSquashTable[j + 1] * w + 64) >> 7;
+}
+// The inverse: for a 12-bit probability, the smallest d whose squash
+// reaches it (2047 above squash(2047)).
+struct StretchTable {
+  int16_t v[4096];
+  constexpr StretchTable() : v() {
+    int next = 0;
+    for (int d = -2047; d <= 2047; ++d) {
+      const int p = squash(d);
+      for (; next <= p; ++next) v[next] = static_cast<int16_t>(d);
+    }
+    for (; next < 4096; ++next) v[next] = 2047;
+  }
+};
+inline constexpr StretchTable kStretch{};
+
+constexpr int kMixWeightShift = 16;        // weights in 1/65536
+constexpr int kMixRateShift = 9;           // gradient step: input * error / 512
+constexpr int32_t kMixWeightLimit = 1 << 22;
+constexpr int kMixBias = 256;              // the third input, a constant
+
+struct MixWeights {
+  int32_t w[3] = {1 << (kMixWeightShift - 1), 1 << (kMixWeightShift - 1), 0};
+};
+
+struct MixStep {
+  int x[3];  // stretched inputs
+  int p;     // mixed probability of a 0 bit, 1/4096
+  uint32_t coded() const {  // as the range coder's 15-bit probability
+    return std::clamp<uint32_t>(static_cast<uint32_t>(p) << 3, kProbMin, kProbMax);
+  }
+};
+
+// The shifts below divide by powers of two rounding towards minus infinity
+// (FORMAT.md §8.1.1), which is what >> does to negative values with every
+// compiler we build with (and by definition from C++20).
+static_assert((-5 >> 1) == -3 && (int64_t{-5} >> 1) == -3, "arithmetic right shift");
+
+__attribute__((always_inline)) inline MixStep mix_predict(uint32_t pa, uint32_t pb, const MixWeights& m) {
+  MixStep s{{kStretch.v[pa >> 3], kStretch.v[pb >> 3], kMixBias}, 0};
+  const int64_t dot = int64_t{m.w[0]} * s.x[0] + int64_t{m.w[1]} * s.x[1] + int64_t{m.w[2]} * s.x[2];
+  s.p = squash(static_cast<int>(std::clamp<int64_t>(dot >> kMixWeightShift, -2047, 2047)));
+  return s;
+}
+
+template <class PA, class PB>
+__attribute__((always_inline)) inline void mix_update(PA& a, PB& b, MixWeights& m, const MixStep& s, int bit) {
+  adapt(a, bit);
+  adapt(b, bit);
+  const int err = (bit ? 0 : 4095) - s.p;
+  for (int k = 0; k < 3; ++k)  // |x * err| < 2^23
+    m.w[k] = std::clamp(m.w[k] + ((s.x[k] * err) >> kMixRateShift), -kMixWeightLimit, kMixWeightLimit);
+}
+
+// The coder side of a mixed signed integer: the encoder passes the bits it
+// codes, the decoder returns the bits it reads; code_mixed_sint below is the
+// same walk for both.
+struct MixEncodeOp {
+  RangeEncoder& e;
+  template <class PA, class PB>
+  int bit(PA& a, PB& b, MixWeights& m, int bit) {
+    const MixStep s = mix_predict(a.p, b.p, m);
+    e.bit_fixed(s.coded(), bit);
+    mix_update(a, b, m, s, bit);
+    return bit;
+  }
+  uint32_t direct(uint32_t v, int n) {
+    e.direct(v, n);
+    return v;
+  }
+};
+struct MixDecodeOp {
+  RangeDecoder& d;
+  template <class PA, class PB>
+  int bit(PA& a, PB& b, MixWeights& m, int) {
+    const MixStep s = mix_predict(a.p, b.p, m);
+    const int bit = d.bit_fixed(s.coded());
+    mix_update(a, b, m, s, bit);
+    return bit;
+  }
+  uint32_t direct(uint32_t, int n) { return d.direct(n); }
+};
+
+// Weight sets of a mixed signed integer: zero flag, sign, the six levels of
+// the length tree, then one per modelled mantissa bit.
+template <int M>
+constexpr int kMixKinds = 8 + M;
+
+// A signed integer as SIntModelT<M> codes it (zero flag, sign, magnitude - 1
+// as length and mantissa), every modelled decision mixed from A and B
+// (same node in both) with weights w[kind]. v: the encoder's value.
+// Returns the value (decoder: +-0x7FFFFFFF on an impossible length).
+template <int M, class Op>
+int32_t code_mixed_sint(Op& op, SIntModelT<M>& A, SIntModelT<M>& B, MixWeights* w, int32_t v) {
+  if (!op.bit(A.zero, B.zero, w[0], v != 0)) return 0;
+  const int neg = op.bit(A.sign, B.sign, w[1], v < 0);
+  const uint64_t mag = v < 0 ? static_cast<uint64_t>(-static_cast<int64_t>(v)) : static_cast<uint64_t>(v);
+  const int len = v ? bit_length(mag) - 1 : 0;  // the encoder's length
+  uint32_t node = 1;
+  for (int k = 0; k < 6; ++k) {
+    const int b = op.bit(A.magnitude.length.probs[node], B.magnitude.length.probs[node], w[2 + k], (len >> (5 - k)) & 1);
+    node = (node << 1) | static_cast<uint32_t>(b);
+  }
+  const int n = static_cast<int>(node) - 64;
+  if (n > 32) return neg ? -0x7FFFFFFF : 0x7FFFFFFF;
+  uint64_t x = 1;
+  const int top = n < M ? n : M;
+  uint32_t ctx = 1;
+  LazyProb* ra = top ? A.magnitude.row(n) : nullptr;
+  LazyProb* rb = top ? B.magnitude.row(n) : nullptr;
+  for (int k = 0; k < top; ++k) {
+    const int b = op.bit(ra[ctx], rb[ctx], w[8 + k], static_cast<int>((mag >> (n - 1 - k)) & 1));
+    ctx = (ctx << 1) | static_cast<uint32_t>(b);
+    x = (x << 1) | static_cast<uint64_t>(b);
+  }
+  const int rest = n - top;
+  if (rest > 0) x = (x << rest) | op.direct(static_cast<uint32_t>(mag & ((uint64_t{1} << rest) - 1)), rest);
+  const int32_t m = x >= 0x7FFFFFFFu ? 0x7FFFFFFF : static_cast<int32_t>(x);
+  return neg ? -m : m;
+}
 
 using UIntModel = UIntModelT<2>;
 using SIntModel = SIntModelT<2>;

@@ -35,9 +35,10 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (5); 4 writes files that
-  // decoders of version 4 read (without version 5's tangent step, so
-  // usually a little larger).
+  // The format version to write: 0 = the newest (6); 5 writes files that
+  // decoders of version 5 read (without version 6's residual mixing, which
+  // only levels 7-9 use); 4 files that decoders of version 4 read (without
+  // version 5's tangent step either, so usually a little larger).
   int format_version = 0;
 };
 
