@@ -74,14 +74,19 @@ int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
   return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
+// Residual mixing (version 6, kMixFlag): the second model of each residual
+// decision, by the second context, and the mixing weights by coding
+// position and first context (capped at kMixCtx - 1). Only allocated for a
+// mixed stream (about 1.8 MB of mostly untouched lazy rows).
+struct MixModels {
+  MixModels() {}  // as ResidualModels
+  ResidualModel m2[3][kClasses][kActivity];
+  MixWeights w[3][kMixCtx][kMixKinds<kMantissa>];
+};
+
 struct ResidualModels {
   ResidualModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
   ResidualModel m[3][kClasses][kActivity];
-  // Residual mixing (version 6, kMixFlag): the second model of each
-  // residual decision, by the second context, and the mixing weights by
-  // coding position and first context (capped at kMixCtx - 1).
-  ResidualModel m2[3][kClasses][kActivity];
-  MixWeights mix[3][kMixCtx][kMixKinds<kMantissa>];
   // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
   // then the lattice index offset from the plane nearest the prediction.
   Prob on[3][3];
@@ -153,7 +158,7 @@ struct Coder {
   // the largest residual of this vertex's axes coded so far (the first axis:
   // the neighbours' activity where the first context is the spread, else the
   // previous vertex's activity), mixed (range_coder.hpp).
-  bool mix = false;
+  std::unique_ptr<MixModels> mix;  // null: no mixing
   int prev_act = 0;  // activity of the vertex coded last (0 before the first)
   bool spread_ctx = false;  // predictor spread: contexts from the parallelograms' spread
   // Tangent step (version 5, kTangentFlag): a vertex with a local normal codes
@@ -254,7 +259,7 @@ struct Coder {
         int64_t r;
         if (mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
-          r = s.sint_mixed(models->m[i][cls][ctx], models->m2[i][cls][ctx2], models->mix[i][std::min(ctx, kMixCtx - 1)],
+          r = s.sint_mixed(models->m[i][cls][ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
                            static_cast<int64_t>(x) - p);
         } else {
           r = s.sint(models->m[i][cls][ctx], static_cast<int64_t>(x) - p);
@@ -816,7 +821,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   }
   Coder c(g.vertex_count, bits);
   c.spread_ctx = pred == Predictor::spread;
-  c.mix = mix;
+  if (mix) c.mix = std::make_unique<MixModels>();
   if (pred != Predictor::ancestors && !default_weights)
     for (int k = 0; k < 3; ++k) {
       c.alpha[k] = weights[k];
@@ -1092,7 +1097,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   const size_t at = r.offset();
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   c.spread_ctx = st.predictor == Predictor::spread;
-  c.mix = st.mix;
+  if (st.mix) c.mix = std::make_unique<MixModels>();
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");
