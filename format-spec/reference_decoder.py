@@ -259,26 +259,12 @@ class RangeDecoder:
     def bit(self, probs, i):
         """probs: a list of models (p | n << 16: probability and update
         count, §8.1), i: index of the one to use and adapt."""
-        p = probs[i] & 0xFFFF
-        n = probs[i] >> 16
-        s = SHIFT[n]
-        n = min(n + 1, 128)
-        bound = (self.range >> 15) * p
-        if self.code < bound:
-            self.range = bound
-            p = min(p + ((32768 - p) >> s), 32704)
-            b = 0
-        else:
-            self.code -= bound
-            self.range -= bound
-            p = max(p - (p >> s), 64)
-            b = 1
-        probs[i] = p | (n << 16)
-        self.normalize()
+        b = self.bit_fixed(probs[i] & 0xFFFF)
+        adapt(probs, i, b)
         return b
 
     def bit_fixed(self, p):
-        """A decision with probability p of a 0 bit, nothing adapted (§8.1.1)."""
+        """A decision with probability p of a 0 bit, nothing adapted."""
         bound = (self.range >> 15) * p
         if self.code < bound:
             self.range = bound
@@ -314,6 +300,7 @@ def probs(n):
 
 
 def adapt(probs, i, b):
+    """§8.1: the model's update after bit b (its shift grows with its update count)."""
     p = probs[i] & 0xFFFF
     n = probs[i] >> 16
     s = SHIFT[n]
@@ -1165,14 +1152,12 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                     stats['on_plane'] += 1
                     n_on += 1
                     coded = True
-            if not coded and mix:                            # version 6: two models mixed
-                ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
-                r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
-                x = p + r
-                if x < 0 or x > qmax:
-                    reject('geometry: coordinate outside the grid')
-            elif not coded:
-                r = residual[i][cls][ctx].decode(d)          # by coding position i (= a without a normal)
+            if not coded:
+                if mix:                                      # version 6: two models mixed
+                    ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
+                    r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
+                else:
+                    r = residual[i][cls][ctx].decode(d)      # by coding position i (= a without a normal)
                 x = p + r
                 if x < 0 or x > qmax:
                     reject('geometry: coordinate outside the grid')

@@ -109,6 +109,16 @@ Prepared prepare(const Mesh& m, int bits) {
   return p;
 }
 
+// Decodes a geometry section made for p's layout and expects p's positions
+// back; st: what the header said.
+::testing::AssertionResult decodes_to(const std::string& bytes, const Prepared& p, int bits, tsm::GeometryStats& st) {
+  std::vector<uint32_t> back;
+  const tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
+  if (!s.ok()) return ::testing::AssertionFailure() << s.to_string();
+  if (back != p.q) return ::testing::AssertionFailure() << "other positions decoded";
+  return ::testing::AssertionSuccess();
+}
+
 // The families the predictor round trips run on.
 std::vector<std::pair<std::string, Mesh>> families() {
   return {
@@ -139,11 +149,8 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
                        " K=" + std::to_string(K) + " lattice=" + std::to_string(use_lattice));
           std::string bytes =
               tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, use_lattice ? lattice : tsm::Lattice());
-          std::vector<uint32_t> back;
           tsm::GeometryStats st;
-          tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
-          ASSERT_TRUE(s.ok()) << s.to_string();
-          EXPECT_EQ(back, p.q);
+          ASSERT_TRUE(decodes_to(bytes, p, bits, st));
           EXPECT_EQ(st.predictor, pred);
           EXPECT_EQ(st.ancestors, K);
         }
@@ -175,14 +182,12 @@ TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
             const std::string bytes =
                 tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, L, nullptr, tangent ? beta : nullptr, true);
             ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kMixFlag);
-            std::vector<uint32_t> back;
             tsm::GeometryStats st;
-            const tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
-            ASSERT_TRUE(s.ok()) << s.to_string();
-            EXPECT_EQ(back, p.q);
+            ASSERT_TRUE(decodes_to(bytes, p, bits, st));
             EXPECT_TRUE(st.mix);
             EXPECT_EQ(st.tangent, tangent);
             EXPECT_EQ(st.predictor, pred);
+            std::vector<uint32_t> back;
             EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 5).code(),
                       tsm::ErrorCode::corrupt_data);
           }
@@ -223,14 +228,12 @@ TEST(Geometry, TangentStepRoundTripsWithAnyWeights) {
                          " beta=" + std::to_string(beta[0]) + " lattice=" + std::to_string(use_lattice));
             const tsm::Lattice& L = use_lattice ? lattice : tsm::Lattice();
             const std::string bytes = tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, 0, L, nullptr, beta);
-            std::vector<uint32_t> back;
             tsm::GeometryStats st;
-            const tsm::Status s = tsm::decode_geometry(bytes, p.ce.layout, bits, back, &st);
-            ASSERT_TRUE(s.ok()) << s.to_string();
-            EXPECT_EQ(back, p.q);
+            ASSERT_TRUE(decodes_to(bytes, p, bits, st));
             EXPECT_TRUE(st.tangent);
             EXPECT_EQ(st.predictor, pred);
             // Version 4 has no tangent step.
+            std::vector<uint32_t> back;
             EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 4).code(),
                       tsm::ErrorCode::corrupt_data);
           }

@@ -326,12 +326,12 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
   return Status::Ok();
 }
 
-// Encoder: one part (the whole mesh or a segment) coded.
 // Whether a geometry stream uses residual mixing (format version 6).
 bool uses_mixing(const std::string& geometry) {
   return !geometry.empty() && (static_cast<uint8_t>(geometry[0]) & kMixFlag);
 }
 
+// Encoder: one part (the whole mesh or a segment) coded.
 struct EncodedPart {
   ConnectivityStreams streams;
   std::string geometry;

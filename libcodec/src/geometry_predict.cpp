@@ -1032,9 +1032,9 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (version >= 6 && (kind & kMixFlag)) {
     kind = static_cast<uint8_t>(kind & ~kMixFlag);
     st.mix = true;
-    if ((kind & ~(kDefaultWeightsFlag | kTangentFlag)) > static_cast<uint8_t>(Predictor::spread))
-      return corrupt("predictor " + std::to_string(kind & ~(kDefaultWeightsFlag | kTangentFlag)) +
-                     " has no residual models to mix");
+    const int base = kind & ~(kDefaultWeightsFlag | kTangentFlag);
+    if (base > static_cast<int>(Predictor::spread))
+      return corrupt("predictor " + std::to_string(base) + " has no residual models to mix");
   }
   if (version >= 5 && (kind & kTangentFlag)) {
     kind = static_cast<uint8_t>(kind & ~kTangentFlag);

@@ -75,25 +75,22 @@ class RangeEncoder {
  public:
   template <class P>
   void bit(P& prob, int b) {
-    uint32_t bound = (range_ >> kProbBits) * prob.p;
+    bit_fixed(prob.p, b);
+    adapt(prob, b);
+  }
+  // A bit with a given probability of 0 (kProbMin..kProbMax), nothing adapted.
+  void bit_fixed(uint32_t p0, int b) {
+    uint32_t bound = (range_ >> kProbBits) * p0;
     if (!b) {
       range_ = bound;
     } else {
       low_ += bound;
       range_ -= bound;
     }
-    adapt(prob, b);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       shift_low();
     }
-  }
-  // A bit with a given probability of 0 (kProbMin..kProbMax), nothing adapted.
-  void bit_fixed(uint32_t p0, int b) {
-    Prob q;
-    q.p = static_cast<uint16_t>(p0);
-    q.n = kAdaptCountMax;
-    bit(q, b);
   }
   // Equiprobable bits, most significant first (n <= 32).
   void direct(uint32_t value, int n) {
@@ -125,7 +122,13 @@ class RangeDecoder {
   void init(std::string_view data);
   template <class P>
   int bit(P& prob) {
-    uint32_t bound = (range_ >> kProbBits) * prob.p;
+    const int b = bit_fixed(prob.p);
+    adapt(prob, b);
+    return b;
+  }
+  // A bit with a given probability of 0, nothing adapted.
+  int bit_fixed(uint32_t p0) {
+    uint32_t bound = (range_ >> kProbBits) * p0;
     int b;
     if (code_ < bound) {
       range_ = bound;
@@ -135,18 +138,11 @@ class RangeDecoder {
       range_ -= bound;
       b = 1;
     }
-    adapt(prob, b);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       code_ = (code_ << 8) | next_byte();
     }
     return b;
-  }
-  int bit_fixed(uint32_t p0) {
-    Prob q;
-    q.p = static_cast<uint16_t>(p0);
-    q.n = kAdaptCountMax;
-    return bit(q);
   }
   uint32_t direct(int n) {
     uint32_t v = 0;
