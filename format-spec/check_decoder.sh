@@ -94,6 +94,7 @@ for l in 0 6 9; do check mixed_l$l "$work/mixed.obj" 16 $l; done
 check mixed_small_l9 "$work/mixed_small.obj" 10 9
 check fan_l9 "$work/fan.obj" 12 9
 for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
+for q in 11 16; do check box_q$q "$work/box.obj" $q 6; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50
 dragon=$corpus/dragon_vrip_res4.ply
@@ -110,6 +111,7 @@ for f in cube_att.obj cube_att.ply sphere.obj test_nm.obj Box.ply test_pos_color
   corpus_case acheck "$(echo "$f" | tr . _)" "$edge/$f" 11 6
 done
 corpus_case acheck sphere_obj_segments "$edge/sphere.obj" 11 6 50
+corpus_case acheck sphere_obj_q14 "$edge/sphere.obj" 14 6  # parallelograms with planes from the top (version 7)
 corpus_case acheck test_pos_color_ply_segments "$edge/test_pos_color.ply" 11 6 40
 # predictor 2 (texture placement): vertex and corner domain, whole and segmented
 acheck uv_vertex "$work/uv_vertex.ply" 12 6

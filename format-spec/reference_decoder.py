@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 to 6), written from
+"""An independent decoder for .tsm files (format versions 3 to 7), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6):
+    if version not in (3, 4, 5, 6, 7):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -968,30 +968,40 @@ def floordiv(a, b):
 PREDICTOR_NAMES = ['ancestors', 'parallelograms', 'gate', 'spread', 'raw']
 
 
-def decode_lattice(d, qmax, vc):
-    """§8.5.2: per axis the sorted lattice planes."""
+def decode_lattice(d, qmax, vc, top=False):
+    """§8.5.2: per axis the sorted lattice planes; with top (version 7) an
+    axis of two or more planes has its last plane first, as qmax minus it."""
     lattice_count, lattice_gap = SIntModel(6), SIntModel(6)
     lattice = [[], [], []]
     for a in range(3):
         n = lattice_count.decode(d)
         if n < 0 or n > qmax + 1 or n > vc:
             reject('geometry: lattice count')
+        end = qmax + 1
+        last = []
+        if top and n >= 2:
+            end = qmax - lattice_gap.decode(d)
+            if end < 0 or end > qmax or d.truncated():
+                reject('geometry: lattice top plane')
+            last = [end]
+            n -= 1
         prev = -1
         for _ in range(n):
             x = prev + 1 + lattice_gap.decode(d)
-            if x <= prev or x > qmax or d.truncated():
+            if x <= prev or x >= end or d.truncated():
                 reject('geometry: lattice plane')
             lattice[a].append(x)
             prev = x
+        lattice[a] += last
     return lattice
 
 
-def decode_geometry_raw(payload, vc, qbits):
+def decode_geometry_raw(payload, vc, qbits, top=False):
     """§8.5.10 (version 4): the lattice planes, then each coordinate as
     equiprobable bits: a plane index where its axis has planes, else the grid value."""
     d = RangeDecoder(payload[1:])
     qmax = (1 << qbits) - 1
-    lattice = decode_lattice(d, qmax, vc)
+    lattice = decode_lattice(d, qmax, vc, top)
     nbits = []
     for L in lattice:
         if not L:
@@ -1032,6 +1042,10 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     default_weights = False
     tangent = False
     mix = False
+    top = False
+    if version >= 7 and predictor & 0x10:                           # §8.5.1, version 7
+        predictor &= 0xEF
+        top = True
     if version >= 6 and predictor & 0x20:                           # §8.5.1, version 6
         predictor &= 0xDF
         mix = True
@@ -1048,7 +1062,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if predictor > (4 if version >= 4 else 3):
         reject('geometry: predictor')
     if predictor == 4:                                               # §8.5.10 raw
-        return decode_geometry_raw(payload, layout['vertex_count'], qbits)
+        return decode_geometry_raw(payload, layout['vertex_count'], qbits, top)
     pos = 1
     K = 0
     lam = []
@@ -1089,7 +1103,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if mix:                                                          # version 6
         residual2 = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
         mixw = [[mix_weights() for _ in range(8)] for _ in range(3)]
-    lattice = decode_lattice(d, qmax, vc)
+    lattice = decode_lattice(d, qmax, vc, top)
     q = [[0, 0, 0] for _ in range(vc)]
     act = [UNKNOWN] * vc
     st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0, 'prev_act': 0}

@@ -14,6 +14,9 @@
   lattice.obj   a marching-tetrahedra isosurface on a 20^3 voxel grid: every
                 vertex lies on a grid edge, so many coordinates share voxel planes
                 (the geometry lattice), plus an isolated vertex
+  box.obj       a box of 6 quads, each with its own 4 corners (24 vertices on 2
+                planes per axis, the far ones at qmax: version 7 codes them
+                from the top)
 
   attributes.obj  mixed(12, 20) with vertex colours, corner `vt u v w` (a
                 3-component generic 'texcoord3') and corner `vn` with seams,
@@ -53,6 +56,20 @@ def fan(n=300):
         a = 2 * math.pi * i / n
         V.append((math.cos(a), math.sin(a), 0.2 * math.sin(3 * a)))
     return V, [[0, 1 + i, 1 + (i + 1) % n] for i in range(n)]
+
+
+def box():
+    V, F = [], []
+    for axis in range(3):
+        for side in (0, 1):
+            face = []
+            for u, w in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                p = [0, 0, 0]
+                p[axis], p[(axis + 1) % 3], p[(axis + 2) % 3] = side, u, w
+                face.append(len(V))
+                V.append(tuple(p))
+            F.append(face if side else face[::-1])
+    return V, F
 
 
 def sphere_rings(v, n_, m_):
@@ -556,6 +573,7 @@ def main():
     write_obj(os.path.join(out, 'mixed_small.obj'), *mixed(6, 10))
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
     write_obj(os.path.join(out, 'fan.obj'), *fan())
+    write_obj(os.path.join(out, 'box.obj'), *box())
     attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))

@@ -187,8 +187,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 7 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 7, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 8 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 8, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -360,4 +360,48 @@ TEST(FormatV6, MixingFromLevel7AndVersion6OnlyWhereUsed) {
   ASSERT_EQ(parsed.size(), 1u);
   EXPECT_EQ(decode_code(rebuild(l9, 5, {{parsed[0].id, parsed[0].data}})), tsm::ErrorCode::corrupt_data);
   EXPECT_TRUE(decode_code(rebuild(l9, 6, {{parsed[0].id, parsed[0].data}})) == tsm::ErrorCode::ok);
+}
+
+// Version 7 codes each axis's last lattice plane from the top (FORMAT.md
+// §8.5.2): the encoder sets the flag where the planes cost fewer bytes so,
+// and then writes version 7; a box's far corners at qmax cost a few bits
+// instead of about 20 each. Files without planes keep version 5.
+TEST(FormatV7, LatticePlanesFromTheTopOnlyWhereTheyPay) {
+  auto encode_v = [&](const Mesh& m, int bits, int version) {
+    std::string out;
+    tsm::EncodeOptions o;
+    o.quantization_bits = bits;
+    o.format_version = version;
+    EXPECT_TRUE(tsm::encode(m, o, out).ok());
+    return out;
+  };
+  auto version_of = [](const std::string& bytes) {
+    tsm::FileInfo fi;
+    EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+    return fi.format_version;
+  };
+  auto top = [](const std::string& bytes) { return predictor_of(bytes).find("+top") != std::string::npos; };
+  const Mesh box = tsm_test::cube_quads();
+  for (int bits : {11, 16, 24}) {
+    SCOPED_TRACE("bits=" + std::to_string(bits));
+    const std::string v7 = encode_v(box, bits, 0), v6 = encode_v(box, bits, 6);
+    EXPECT_EQ(version_of(v7), 7u);
+    EXPECT_TRUE(top(v7)) << predictor_of(v7);
+    EXPECT_EQ(version_of(v6), 6u);
+    EXPECT_FALSE(top(v6));
+    EXPECT_LE(v7.size() + 5, v6.size()) << v6.size() << " -> " << v7.size();
+    expect_round_trip(box, v7, bits, "box, version 7");
+    EXPECT_EQ(encode_v(decode_ok(v7), bits, 0), v7);
+    // The flag in a version 6 file is an unknown predictor.
+    tsm::Header h;
+    std::vector<tsm::Section> parsed;
+    ASSERT_TRUE(tsm::read_container(v7, h, parsed).ok());
+    ASSERT_EQ(parsed.size(), 1u);
+    EXPECT_EQ(decode_code(rebuild(v7, 6, {{parsed[0].id, parsed[0].data}})), tsm::ErrorCode::corrupt_data);
+    EXPECT_TRUE(decode_code(rebuild(v7, 7, {{parsed[0].id, parsed[0].data}})) == tsm::ErrorCode::ok);
+  }
+  // No planes (random positions): version 5, as before.
+  const std::string soup = encode_v(tsm_test::random_soup(200, 300, 3), 14, 0);
+  EXPECT_EQ(version_of(soup), 5u);
+  EXPECT_FALSE(top(soup));
 }

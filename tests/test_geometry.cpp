@@ -211,6 +211,70 @@ TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
   EXPECT_LT(mixed.size(), plain.size() * 99 / 100) << plain.size() << " -> " << mixed.size();
 }
 
+// Version 7's lattice planes from the top (FORMAT.md §8.5.2, kTopFlag): on
+// every predictor, with the planes find_lattice gives and with every value
+// of an axis as a plane (one plane and none included), the positions and
+// planes come back; version 6 refuses the flag; a box's far planes at qmax
+// cost fewer bytes from the top.
+TEST(Geometry, LatticePlanesFromTheTopRoundTrip) {
+  using tsm::Predictor;
+  std::vector<std::pair<std::string, Mesh>> meshes = families();
+  Mesh flat = tsm_test::grid_with_holes(6, 1);  // z = 0 everywhere: one plane on z
+  meshes.push_back({"flat grid", flat});
+  int planes_seen[3] = {0, 0, 0};  // axes of 0, 1, 2+ planes coded
+  for (const auto& [name, m] : meshes)
+    for (int bits : {4, 11, 20}) {
+      Prepared p = prepare(m, bits);
+      const uint32_t n = static_cast<uint32_t>(m.vertex_count());
+      tsm::Lattice every;  // every value of an axis as a plane
+      for (int a = 0; a < 3; ++a) {
+        std::vector<uint32_t>& L = every.values[a];
+        for (uint32_t v = 0; v < n; ++v) L.push_back(p.q[3 * size_t{v} + a]);
+        std::sort(L.begin(), L.end());
+        L.erase(std::unique(L.begin(), L.end()), L.end());
+        planes_seen[std::min<size_t>(L.size(), 2)]++;
+      }
+      const tsm::Lattice found = tsm::find_lattice(p.q, n);
+      for (const tsm::Lattice* L : std::initializer_list<const tsm::Lattice*>{&found, &every})
+        for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::spread, 0}, {Predictor::ancestors, 2},
+                               {Predictor::raw, 0}}) {
+          SCOPED_TRACE(name + " bits=" + std::to_string(bits) + " predictor=" + std::to_string(int(pred)) +
+                       (L == &every ? " every value" : " find_lattice"));
+          const std::string bytes =
+              tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, *L, nullptr, nullptr, false, true);
+          ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kTopFlag);
+          tsm::GeometryStats st;
+          ASSERT_TRUE(decodes_to(bytes, p, bits, st));
+          EXPECT_TRUE(st.top);
+          EXPECT_EQ(st.predictor, pred);
+          if (pred != Predictor::raw || L == &every) {  // raw keeps planes only where they hold every value
+            for (int a = 0; a < 3; ++a) EXPECT_EQ(st.lattice_planes[a], L->values[a].size());
+          }
+          std::vector<uint32_t> back;
+          EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 6).code(),
+                    tsm::ErrorCode::corrupt_data);
+        }
+    }
+  EXPECT_GT(planes_seen[0] + planes_seen[1], 0);
+  EXPECT_GT(planes_seen[2], 0);
+  // A box of 16-bit corners: from the top, its planes at qmax cost a few
+  // bits instead of about 20 each.
+  Prepared box = prepare(tsm_test::cube_quads(), 16);
+  tsm::Lattice corners;
+  for (int a = 0; a < 3; ++a) corners.values[a] = {0, 65535};
+  const std::string plain = tsm::encode_geometry_as(box.ce.layout, box.q, 16, Predictor::raw, 0, corners);
+  const std::string top =
+      tsm::encode_geometry_as(box.ce.layout, box.q, 16, Predictor::raw, 0, corners, nullptr, nullptr, false, true);
+  EXPECT_LE(top.size() + 5, plain.size()) << plain.size() << " -> " << top.size();
+  // The encoder's search sets the flag only where it pays (version 7), and
+  // never for version 6.
+  tsm::GeometryStats st;
+  tsm::encode_geometry(box.ce.layout, box.q, 16, 6, &corners, &st, 7);
+  EXPECT_TRUE(st.top);
+  tsm::encode_geometry(box.ce.layout, box.q, 16, 6, &corners, &st, 6);
+  EXPECT_FALSE(st.top);
+}
+
 // Version 5's tangent step (FORMAT.md §8.5.3): with any weights, on every
 // surface predictor, with and without planes, the positions come back.
 TEST(Geometry, TangentStepRoundTripsWithAnyWeights) {

@@ -326,9 +326,11 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
   return Status::Ok();
 }
 
-// Whether a geometry stream uses residual mixing (format version 6).
-bool uses_mixing(const std::string& geometry) {
-  return !geometry.empty() && (static_cast<uint8_t>(geometry[0]) & kMixFlag);
+// The oldest format version that reads a geometry stream: 7 for lattice
+// planes coded from the top, 6 for residual mixing, else 5.
+uint16_t needed_version(const std::string& geometry) {
+  const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
+  return kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
 }
 
 // Encoder: one part (the whole mesh or a segment) coded.
@@ -541,8 +543,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options) >= 5,
-                                 written_version(options) >= 6);
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options));
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -761,7 +762,7 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const EncodeOptions& options, ContainerWriter& cw, bool& mixed) {
+                       const EncodeOptions& options, ContainerWriter& cw, uint16_t& needed) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -854,7 +855,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     sp.geometry = p.geometry;
     sp.attributes = p.attributes;
     cw.add_section(kSectionSegment, write_segment(sp), 0);
-    mixed = mixed || uses_mixing(p.geometry);
+    needed = std::max(needed, needed_version(p.geometry));
     p = EncodedPart();
   }
   return Status::Ok();
@@ -923,20 +924,20 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     const std::string md = write_metadata(mesh.metadata);
     cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
   }
-  bool mixed = false;
+  uint16_t needed = 5;
   if (segments.size() == 1) {
     EncodedPart p;
     TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
-    mixed = uses_mixing(p.geometry);
+    needed = needed_version(p.geometry);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, mixed));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, needed));
   }
   // Unless asked for a version: the oldest that holds what was coded (version
-  // 6 only adds residual mixing), so that most files stay readable by
-  // decoders of version 5.
-  if (options.format_version == 0 && !mixed) cw.set_version(5);
+  // 6 only adds residual mixing, 7 the lattice planes from the top), so that
+  // most files stay readable by decoders of version 5.
+  if (options.format_version == 0 && needed < kFormatVersion) cw.set_version(needed);
   out = cw.finish();
   return Status::Ok();
 }
@@ -1014,6 +1015,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
                                                                  : "parallelograms";
   if (gs.tangent) info.geometry_predictor += "+tangent";
   if (gs.mix) info.geometry_predictor += "+mix";
+  if (gs.top) info.geometry_predictor += "+top";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();

@@ -150,6 +150,7 @@ struct Coder {
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
   int64_t qmax;
   Lattice lattice;
+  bool planes_from_top = false;  // version 7: each axis's last plane coded first, from the top (code_lattice)
   // Per parallelogram class (1, 2, 3+ parallelograms): the weight of the
   // parallelogram average against the neighbour average, 4.12 fixed point
   // (4096 = parallelograms only), fitted per mesh by least squares.
@@ -644,24 +645,52 @@ void fit_lambda(const GeometryLayout& g, const std::vector<uint32_t>& q, int K, 
   }
 }
 
-// The lattice values per axis: count, then increasing values as gaps.
+// The lattice values per axis: count, then increasing values as gaps; with
+// `top` (version 7, kTopFlag) an axis of two or more planes codes its last
+// plane first, as qmax minus it, and then the others as gaps below it.
 template <class Sink>
-bool code_lattice(Sink& s, Coder& c) {
+bool code_lattice(Sink& s, Lattice& lattice, int64_t qmax, size_t vertex_count, bool top) {
   ResidualModel count, gap;
   for (int a = 0; a < 3; ++a) {
-    std::vector<uint32_t>& L = c.lattice.values[a];
+    std::vector<uint32_t>& L = lattice.values[a];
     int64_t n = s.sint(count, static_cast<int64_t>(L.size()));
-    if (n < 0 || n > c.qmax + 1 || n > static_cast<int64_t>(c.act.size())) return false;
+    if (n < 0 || n > qmax + 1 || n > static_cast<int64_t>(vertex_count)) return false;
     if constexpr (!Sink::kEncoder) L.resize(static_cast<size_t>(n));
+    int64_t end = qmax + 1;  // the planes coded as gaps lie below it
+    if (top && n >= 2) {
+      end = qmax - s.sint(gap, qmax - L.back());  // L has n entries (decoder: resized)
+      if (end < 0 || end > qmax || s.truncated()) return false;
+      L.back() = static_cast<uint32_t>(end);
+      --n;
+    }
     int64_t prev = -1;
     for (int64_t i = 0; i < n; ++i) {
       int64_t x = prev + 1 + s.sint(gap, i < static_cast<int64_t>(L.size()) ? L[static_cast<size_t>(i)] - prev - 1 : 0);
-      if (x <= prev || x > c.qmax || s.truncated()) return false;
+      if (x <= prev || x >= end || s.truncated()) return false;
       L[static_cast<size_t>(i)] = static_cast<uint32_t>(x);
       prev = x;
     }
   }
   return true;
+}
+template <class Sink>
+bool code_lattice(Sink& s, Coder& c) {
+  return code_lattice(s, c.lattice, c.qmax, c.act.size(), c.planes_from_top);
+}
+
+// Version 7: whether the planes cost fewer bytes with each axis's last plane
+// coded from the top (the planes alone, fresh models; a tie keeps the
+// version 5 form, readable by older decoders).
+bool top_pays(const Lattice& lattice, int bits, uint32_t vertex_count) {
+  auto size = [&](bool top) {
+    EncodeSink s;
+    Lattice copy = lattice;
+    code_lattice(s, copy, (int64_t{1} << bits) - 1, vertex_count, top);
+    return s.e.finish().size();
+  };
+  for (int a = 0; a < 3; ++a)
+    if (lattice.values[a].size() >= 2) return size(true) < size(false);
+  return false;
 }
 
 }  // namespace
@@ -752,10 +781,11 @@ int index_bits(size_t planes) {
 }
 
 std::string encode_geometry_raw(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits,
-                                const Lattice& lattice) {
+                                const Lattice& lattice, bool top) {
   EncodeSink s;
   Coder c(g.vertex_count, bits);
   c.lattice = lattice;
+  c.planes_from_top = top;
   code_lattice(s, c);
   for (size_t i = 0; i < 3 * size_t{g.vertex_count}; ++i) {
     const std::vector<uint32_t>& L = lattice.values[i % 3];
@@ -767,7 +797,8 @@ std::string encode_geometry_raw(const GeometryLayout& g, const std::vector<uint3
       s.e.direct(static_cast<uint32_t>(it - L.begin()), index_bits(L.size()));
     }
   }
-  return std::string(1, static_cast<char>(Predictor::raw)) + s.e.finish();
+  return std::string(1, static_cast<char>(static_cast<uint8_t>(Predictor::raw) | (top ? kTopFlag : 0))) +
+         s.e.finish();
 }
 
 bool decode_geometry_raw(DecodeSink& s, Coder& c, uint32_t vertex_count, int bits, std::vector<uint32_t>& q) {
@@ -803,8 +834,12 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
 }
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix) {
-  if (pred == Predictor::raw) return encode_geometry_raw(g, q, bits, covers(lattice, q, g.vertex_count) ? lattice : Lattice());
+                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix,
+                               bool top) {
+  if (pred == Predictor::raw) {
+    const bool all_on = covers(lattice, q, g.vertex_count);
+    return encode_geometry_raw(g, q, bits, all_on ? lattice : Lattice(), top && all_on);
+  }
   std::string head;
   ByteWriter w(head);
   const bool default_weights =
@@ -812,7 +847,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
                                                     weights[2] == kAlphaOne));
   if (!surface_predictor(pred)) tangent = nullptr;
   w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0) |
-                            (tangent ? kTangentFlag : 0) | (mix ? kMixFlag : 0)));
+                            (tangent ? kTangentFlag : 0) | (mix ? kMixFlag : 0) | (top ? kTopFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (pred == Predictor::ancestors) {
     fit_lambda(g, q, K, lambda);
@@ -836,6 +871,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   }
   EncodeSink s;
   c.lattice = lattice;
+  c.planes_from_top = top;
   code_lattice(s, c);
   c.build_nearest();
   std::vector<uint32_t> work = q;
@@ -932,7 +968,8 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 }
 
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats, bool tangent, bool mix) {
+                            const Lattice* candidate, GeometryStats* stats, int version) {
+  const bool tangent = version >= 5, mix = version >= 6;
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   int32_t lsq[3], est[3];
@@ -944,7 +981,8 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   int32_t beta[2];
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
                       bool mixed = false) {
-    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed);
+    const bool top = version >= 7 && top_pays(lattice, bits, g.vertex_count);
+    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed, top);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
@@ -952,6 +990,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     st.lattice = lattice;
     st.tangent = tan != nullptr;
     st.mix = mixed;
+    st.top = top;
     weights = w;
     return true;
   };
@@ -1029,6 +1068,10 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (!r.u8(kind)) return corrupt("empty section");
   const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
   bool default_weights = false;
+  if (version >= 7 && (kind & kTopFlag)) {
+    kind = static_cast<uint8_t>(kind & ~kTopFlag);
+    st.top = true;
+  }
   if (version >= 6 && (kind & kMixFlag)) {
     kind = static_cast<uint8_t>(kind & ~kMixFlag);
     st.mix = true;
@@ -1054,6 +1097,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (st.predictor == Predictor::raw) {
     q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
     Coder c(g.vertex_count, bits);
+    c.planes_from_top = st.top;
     DecodeSink ds;
     ds.d.init(bytes.substr(1));
     if (!decode_geometry_raw(ds, c, g.vertex_count, bits, q))
@@ -1098,6 +1142,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   c.spread_ctx = st.predictor == Predictor::spread;
   if (st.mix) c.mix = std::make_unique<MixModels>();
+  c.planes_from_top = st.top;
   DecodeSink s;
   s.d.init(bytes.substr(at));
   if (!code_lattice(s, c)) return corrupt("bad lattice");

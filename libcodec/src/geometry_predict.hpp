@@ -40,6 +40,10 @@ constexpr uint8_t kTangentFlag = 0x40;
 // Version 6: the predictor byte of 0, 1, 2 or 3 (with the flags above) with
 // this bit set says residuals are coded with two mixed models each.
 constexpr uint8_t kMixFlag = 0x20;
+// Version 7: the predictor byte (any of the above) with this bit set says
+// that each axis of two or more lattice planes codes its last plane first,
+// as qmax minus it (a box's far corners: a few bits instead of ~20).
+constexpr uint8_t kTopFlag = 0x10;
 // The lowest encoder level that tries residual mixing (slower to decode).
 constexpr int kMixLevel = 7;
 
@@ -54,6 +58,7 @@ struct GeometryStats {
   int ancestors = 0;  // K for the ancestor predictor
   bool tangent = false;  // version 5: the tangent step
   bool mix = false;      // version 6: residual mixing
+  bool top = false;      // version 7: lattice planes' last coded from the top
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -71,22 +76,22 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 
 // q: 3 quantized coordinates per output vertex. The encoder picks the
 // predictor by level, and the lattice (if a candidate is given) by size.
-// tangent: the tangent step may be tried (version 5); mix: residual mixing
-// (version 6, from level kMixLevel).
+// version: what the file may use: from 5 the tangent step, from 6 residual
+// mixing (at level kMixLevel and up), from 7 planes coded from the top.
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats = nullptr, bool tangent = true,
-                            bool mix = true);
+                            const Lattice* candidate, GeometryStats* stats = nullptr, int version = 7);
 // One predictor, lattice and set of parallelogram weights (per class of 1,
 // 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
 // experiments). tangent: the tangent step's two weights (4.12, surface
 // vertices and vertices with an anchor; version 5), null for none. mix:
-// residual mixing (version 6; not with the raw predictor).
+// residual mixing (version 6; not with the raw predictor). top: the lattice
+// planes' last coded from the top (version 7).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
-                               const int32_t* tangent = nullptr, bool mix = false);
+                               const int32_t* tangent = nullptr, bool mix = false, bool top = false);
 // `version`: the file's format version (3 knows neither the raw predictor
 // nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr, int version = 6);
+                       GeometryStats* stats = nullptr, int version = 7);
 
 }  // namespace tsm

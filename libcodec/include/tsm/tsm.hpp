@@ -35,10 +35,13 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (6); 5 writes files that
-  // decoders of version 5 read (without version 6's residual mixing, which
-  // only levels 7-9 use); 4 files that decoders of version 4 read (without
-  // version 5's tangent step either, so usually a little larger).
+  // The format version to write: 0 = the newest (7; the file says the oldest
+  // version that reads it: 5 unless it uses residual mixing, 6, or lattice
+  // planes coded from the top, 7); 6 or 5 write files that decoders of that
+  // version read (without version 7's planes from the top, a few bytes on a
+  // box; 5 also without residual mixing, which only levels 7-9 use); 4 files
+  // that decoders of version 4 read (without version 5's tangent step
+  // either, so usually a little larger).
   int format_version = 0;
 };
 
@@ -116,8 +119,9 @@ struct FileInfo {
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
-  // "gate", "ancestors" (with K) or "raw", and the lattice planes per axis
-  // (0 = unused).
+  // "gate", "ancestors" (with K) or "raw", followed by "+tangent" (tangent
+  // step), "+mix" (residual mixing), "+top" (lattice planes from the top)
+  // where used, and the lattice planes per axis (0 = unused).
   std::string geometry_predictor;
   int ancestors = 0;
   uint32_t lattice_planes[3] = {0, 0, 0};
