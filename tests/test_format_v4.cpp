@@ -315,6 +315,28 @@ TEST(FormatV4, ShortFlushLeavesAtMostEightBytesOut) {
 
 }  // namespace
 
+namespace {
+
+// A file of the given quantization, level and asked-for format version (0:
+// the encoder's choice).
+std::string encode_as(const Mesh& m, int bits, int level, int version) {
+  std::string out;
+  tsm::EncodeOptions o;
+  o.quantization_bits = bits;
+  o.level = level;
+  o.format_version = version;
+  EXPECT_TRUE(tsm::encode(m, o, out).ok());
+  return out;
+}
+
+uint32_t version_of(const std::string& bytes) {
+  tsm::FileInfo fi;
+  EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+  return fi.format_version;
+}
+
+}  // namespace
+
 // Version 6 adds residual mixing (FORMAT.md §8.1.1), tried from level 7
 // (kMixLevel): the encoder writes version 6 only into files that use it,
 // otherwise version 5, unless a version is asked for; a mixed file decodes
@@ -324,20 +346,7 @@ TEST(FormatV6, MixingFromLevel7AndVersion6OnlyWhereUsed) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> jitter(-0.003f, 0.003f);
   for (float& x : noisy.positions) x += jitter(rng);
-  auto encode_v = [&](const Mesh& m, int level, int version) {
-    std::string out;
-    tsm::EncodeOptions o;
-    o.quantization_bits = 14;
-    o.level = level;
-    o.format_version = version;
-    EXPECT_TRUE(tsm::encode(m, o, out).ok());
-    return out;
-  };
-  auto version_of = [](const std::string& bytes) {
-    tsm::FileInfo fi;
-    EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
-    return fi.format_version;
-  };
+  auto encode_v = [&](const Mesh& m, int level, int version) { return encode_as(m, 14, level, version); };
   auto mixed = [](const std::string& bytes) { return predictor_of(bytes).find("+mix") != std::string::npos; };
   const std::string l6 = encode_v(noisy, 6, 0), l9 = encode_v(noisy, 9, 0);
   EXPECT_EQ(version_of(l6), 5u);
@@ -368,17 +377,7 @@ TEST(FormatV6, MixingFromLevel7AndVersion6OnlyWhereUsed) {
 // instead of about 20 each. Files without planes keep version 5.
 TEST(FormatV7, LatticePlanesFromTheTopOnlyWhereTheyPay) {
   auto encode_v = [&](const Mesh& m, int bits, int version) {
-    std::string out;
-    tsm::EncodeOptions o;
-    o.quantization_bits = bits;
-    o.format_version = version;
-    EXPECT_TRUE(tsm::encode(m, o, out).ok());
-    return out;
-  };
-  auto version_of = [](const std::string& bytes) {
-    tsm::FileInfo fi;
-    EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
-    return fi.format_version;
+    return encode_as(m, bits, tsm::kDefaultLevel, version);
   };
   auto top = [](const std::string& bytes) { return predictor_of(bytes).find("+top") != std::string::npos; };
   const Mesh box = tsm_test::cube_quads();
