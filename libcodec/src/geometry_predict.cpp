@@ -990,7 +990,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     st.lattice = lattice;
     st.tangent = tan != nullptr;
     st.mix = mixed;
-    st.top = top;
+    st.top = static_cast<uint8_t>(best[0]) & kTopFlag;  // raw drops planes that miss a vertex, and the flag
     weights = w;
     return true;
   };
