@@ -1,8 +1,14 @@
-// Connectivity alone (issue 3's linearity figure): encode_connectivity and
-// decode_connectivity on each mesh, medians of several runs, triangles per
-// second, and each mesh's rate relative to the fastest. Usage:
+// Connectivity alone (issue 3's figures). Usage:
 //   tsm_bench_connectivity [--runs N] MESH...
-// (default: the four dragon resolutions of ../shared/corpus).
+//     linearity: encode_connectivity and decode_connectivity on each mesh,
+//     medians of several runs, triangles per second, and each mesh's rate
+//     relative to the fastest (default: the four dragon resolutions).
+//   tsm_bench_connectivity --sizes [-q BITS] MESH...
+//     size: the connectivity bytes of a tsm file (`tsm info`'s figure) at the
+//     default level and at -l 9 beside Draco's connectivity alone, measured
+//     exactly around its edgebreaker step, at cl10 and cl7 (default: the
+//     bunny and the four dragons; q = 11).
+// Files from ../shared/corpus.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -11,22 +17,80 @@
 #include <vector>
 
 #include "connectivity.hpp"
+#include "bench_draco.hpp"
 #include "bench_timing.hpp"
+#include "tsm/tsm.hpp"
 #include "tsm/io.hpp"
 
 using tsm::bench::median;
 using tsm::bench::now_ms;
 
+namespace {
+
+// tsm's connectivity bytes in a file of `mesh` at `level` (0 on failure).
+uint64_t tsm_connectivity_bytes(const tsm::Mesh& mesh, int q, int level) {
+  tsm::EncodeOptions options;
+  options.quantization_bits = q;
+  options.level = level;
+  std::string bytes;
+  tsm::FileInfo info;
+  if (!tsm::encode(mesh, options, bytes).ok() || !tsm::inspect(bytes, info).ok()) return 0;
+  return info.connectivity_bytes;
+}
+
+int size_table(const std::vector<std::string>& files, int q) {
+  if (!tsm::bench::draco_available()) std::fprintf(stderr, "Draco is not built in: its columns stay empty\n");
+  std::printf("| mesh | vertices | tsm bytes | bits/v | tsm -l 9 bytes | bits/v | Draco cl10 bytes | bits/v | Draco cl7 bytes | bits/v | tsm / cl10 |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const std::string& f : files) {
+    tsm::Mesh m;
+    tsm::Status s = tsm::read_mesh(f, m);
+    if (!s.ok()) {
+      std::fprintf(stderr, "%s: %s\n", f.c_str(), s.to_string().c_str());
+      return 3;
+    }
+    m.attributes.clear();  // connectivity only; positions are what Draco is given
+    const double V = static_cast<double>(m.vertex_count());
+    const uint64_t t6 = tsm_connectivity_bytes(m, q, tsm::EncodeOptions().level);
+    const uint64_t t9 = tsm_connectivity_bytes(m, q, 9);
+    std::string error;
+    const size_t d10 = tsm::bench::draco_connectivity_bytes(m, q, 10, nullptr, error);
+    const size_t d7 = tsm::bench::draco_connectivity_bytes(m, q, 7, nullptr, error);
+    if (!error.empty()) std::fprintf(stderr, "%s: %s\n", f.c_str(), error.c_str());
+    auto bpv = [V](uint64_t b) { return V > 0 ? 8 * static_cast<double>(b) / V : 0.0; };
+    std::printf("| %s | %.0f | %llu | %.3f | %llu | %.3f | %zu | %.3f | %zu | %.3f | %.3f |\n",
+                f.substr(f.find_last_of('/') + 1).c_str(), V, static_cast<unsigned long long>(t6), bpv(t6),
+                static_cast<unsigned long long>(t9), bpv(t9), d10, bpv(d10), d7, bpv(d7),
+                d10 ? static_cast<double>(t6) / static_cast<double>(d10) : 0.0);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  int runs = 5;
+  int runs = 5, q = 11;
+  bool sizes = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--runs" && i + 1 < argc) {
       runs = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "-q" && i + 1 < argc) {
+      q = std::atoi(argv[++i]);
+    } else if (a == "--sizes") {
+      sizes = true;
     } else {
       files.push_back(a);
     }
+  }
+  if (sizes) {
+    if (files.empty())
+      for (const char* n : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply",
+                            "dragon_vrip.ply"})
+        files.push_back(std::string(TSM_CORPUS_DIR) + "/" + n);
+    return size_table(files, q);
   }
   if (files.empty())
     for (const char* n : {"dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply", "dragon_vrip.ply"})

@@ -26,6 +26,13 @@ struct DracoRun {
 // for Draco (it takes triangles only).
 DracoRun draco_roundtrip(const Mesh& mesh, int qbits, int level, int runs);
 
+// Draco's connectivity alone, exactly: the bytes its edgebreaker encoder
+// writes while it codes the connectivity (traversal symbols, splits, valence
+// contexts), measured around that step of an encode at `level` and `qbits`.
+// *file_bytes gets the whole file's size. 0 when Draco is not built in or
+// fails (then `error` says why).
+size_t draco_connectivity_bytes(const Mesh& mesh, int qbits, int level, size_t* file_bytes, std::string& error);
+
 // Loads a file with Draco's own reader (for the reader-speed comparison).
 bool draco_read(const std::string& path, double& ms, size_t& vertices, size_t& faces, std::string& error);
 
