@@ -27,6 +27,12 @@ using tsm::bench::now_ms;
 
 namespace {
 
+bool load(const std::string& path, tsm::Mesh& m) {
+  const tsm::Status s = tsm::read_mesh(path, m);
+  if (!s.ok()) std::fprintf(stderr, "%s: %s\n", path.c_str(), s.to_string().c_str());
+  return s.ok();
+}
+
 // tsm's connectivity bytes in a file of `mesh` at `level` (0 on failure).
 uint64_t tsm_connectivity_bytes(const tsm::Mesh& mesh, int q, int level) {
   tsm::EncodeOptions options;
@@ -44,11 +50,7 @@ int size_table(const std::vector<std::string>& files, int q) {
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const std::string& f : files) {
     tsm::Mesh m;
-    tsm::Status s = tsm::read_mesh(f, m);
-    if (!s.ok()) {
-      std::fprintf(stderr, "%s: %s\n", f.c_str(), s.to_string().c_str());
-      return 3;
-    }
+    if (!load(f, m)) return 3;
     m.attributes.clear();  // connectivity only; positions are what Draco is given
     const double V = static_cast<double>(m.vertex_count());
     const uint64_t t6 = tsm_connectivity_bytes(m, q, tsm::EncodeOptions().level);
@@ -103,17 +105,13 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   for (const std::string& f : files) {
     tsm::Mesh m;
-    tsm::Status s = tsm::read_mesh(f, m);
-    if (!s.ok()) {
-      std::fprintf(stderr, "%s: %s\n", f.c_str(), s.to_string().c_str());
-      return 3;
-    }
+    if (!load(f, m)) return 3;
     std::vector<double> enc, dec;
     tsm::ConnectivityEncoding ce;
     for (int r = 0; r < runs; ++r) {
       double t0 = now_ms();
       ce = tsm::ConnectivityEncoding();
-      s = tsm::encode_connectivity(m, ce);
+      tsm::Status s = tsm::encode_connectivity(m, ce);
       enc.push_back(now_ms() - t0);
       if (!s.ok()) return 5;
       tsm::Mesh back;
