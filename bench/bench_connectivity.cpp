@@ -33,15 +33,18 @@ bool load(const std::string& path, tsm::Mesh& m) {
   return s.ok();
 }
 
-// tsm's connectivity bytes in a file of `mesh` at `level` (0 on failure).
+// tsm's connectivity bytes in a file of `mesh` at `level` (0 on failure,
+// reported on stderr).
 uint64_t tsm_connectivity_bytes(const tsm::Mesh& mesh, int q, int level) {
   tsm::EncodeOptions options;
   options.quantization_bits = q;
   options.level = level;
   std::string bytes;
   tsm::FileInfo info;
-  if (!tsm::encode(mesh, options, bytes).ok() || !tsm::inspect(bytes, info).ok()) return 0;
-  return info.connectivity_bytes;
+  tsm::Status s = tsm::encode(mesh, options, bytes);
+  if (s.ok()) s = tsm::inspect(bytes, info);
+  if (!s.ok()) std::fprintf(stderr, "tsm at level %d: %s\n", level, s.to_string().c_str());
+  return s.ok() ? info.connectivity_bytes : 0;
 }
 
 int size_table(const std::vector<std::string>& files, int q) {
@@ -81,6 +84,10 @@ int main(int argc, char** argv) {
       runs = std::max(1, std::atoi(argv[++i]));
     } else if (a == "-q" && i + 1 < argc) {
       q = std::atoi(argv[++i]);
+      if (q < 1 || q > 30) {
+        std::fprintf(stderr, "-q takes 1..30 position bits, got %s\n", argv[i]);
+        return 2;
+      }
     } else if (a == "--sizes") {
       sizes = true;
     } else {
