@@ -242,6 +242,13 @@ Mesh ngon(int n) {
   return m;
 }
 
+Mesh jittered(Mesh m, float amplitude, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> offset(-amplitude, amplitude);
+  for (float& x : m.positions) x += offset(rng);
+  return m;
+}
+
 Mesh copies(const Mesh& src, int count) {
   Mesh m;
   for (int c = 0; c < count; ++c) {

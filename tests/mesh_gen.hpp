@@ -36,5 +36,8 @@ tsm::Mesh cube_quads();
 tsm::Mesh ngon(int n);
 // Disjoint copies of `m`, each shifted along x.
 tsm::Mesh copies(const tsm::Mesh& m, int count);
+// `m` with every coordinate moved by a uniform random offset in
+// [-amplitude, amplitude] (std::mt19937 seeded with `seed`): a noisy surface.
+tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);
 
 }  // namespace tsm_test

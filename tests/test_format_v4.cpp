@@ -343,10 +343,7 @@ void expect_needs_version(const std::string& bytes, uint16_t version) {
 // otherwise version 5, unless a version is asked for; a mixed file decodes
 // exactly, re-encodes to its own bytes, and is refused as version 5.
 TEST(FormatV6, MixingFromLevel7AndVersion6OnlyWhereUsed) {
-  Mesh noisy = tsm_test::icosphere(4);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> jitter(-0.003f, 0.003f);
-  for (float& x : noisy.positions) x += jitter(rng);
+  const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 11);
   auto encode_v = [&](const Mesh& m, int level, int version) { return encode_as(m, 14, level, version); };
   auto mixed = [](const std::string& bytes) { return predictor_of(bytes).find("+mix") != std::string::npos; };
   const std::string l6 = encode_v(noisy, 6, 0), l9 = encode_v(noisy, 9, 0);

@@ -199,11 +199,7 @@ TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
   std::vector<uint32_t> back;
   EXPECT_EQ(tsm::decode_geometry(raw, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
   // A noisy sphere: smaller mixed.
-  Mesh noisy = tsm_test::icosphere(5);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> jitter(-0.004f, 0.004f);
-  for (float& x : noisy.positions) x += jitter(rng);
-  Prepared n = prepare(noisy, 14);
+  Prepared n = prepare(tsm_test::jittered(tsm_test::icosphere(5), 0.004f, 7), 14);
   const std::string plain = tsm::encode_geometry_as(n.ce.layout, n.q, 14, Predictor::spread, 0, tsm::Lattice(),
                                                     nullptr, beta);
   const std::string mixed = tsm::encode_geometry_as(n.ce.layout, n.q, 14, Predictor::spread, 0, tsm::Lattice(),
