@@ -1042,10 +1042,10 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     default_weights = False
     tangent = False
     mix = False
-    top = False
+    planes_from_top = False  # version 7; `top` in code_vertex is the largest residual so far
     if version >= 7 and predictor & 0x10:                           # §8.5.1, version 7
         predictor &= 0xEF
-        top = True
+        planes_from_top = True
     if version >= 6 and predictor & 0x20:                           # §8.5.1, version 6
         predictor &= 0xDF
         mix = True
@@ -1062,7 +1062,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if predictor > (4 if version >= 4 else 3):
         reject('geometry: predictor')
     if predictor == 4:                                               # §8.5.10 raw
-        return decode_geometry_raw(payload, layout['vertex_count'], qbits, top)
+        return decode_geometry_raw(payload, layout['vertex_count'], qbits, planes_from_top)
     pos = 1
     K = 0
     lam = []
@@ -1103,7 +1103,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if mix:                                                          # version 6
         residual2 = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
         mixw = [[mix_weights() for _ in range(8)] for _ in range(3)]
-    lattice = decode_lattice(d, qmax, vc, top)
+    lattice = decode_lattice(d, qmax, vc, planes_from_top)
     q = [[0, 0, 0] for _ in range(vc)]
     act = [UNKNOWN] * vc
     st = {'last': [(qmax + 1) // 2] * 3, 'last_act': 0, 'prev_act': 0}
