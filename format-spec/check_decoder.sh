@@ -91,6 +91,7 @@ corpus_case() {  # check-function name file q level [segment_faces]
 # ---- connectivity and geometry
 check triangle "$work/triangle.obj" 8 0
 for l in 0 6 9; do check mixed_l$l "$work/mixed.obj" 16 $l; done
+check mixed_q30_l0 "$work/mixed.obj" 30 0  # version 8 tables: residuals of every bit length
 check mixed_small_l9 "$work/mixed_small.obj" 10 9
 check fan_l9 "$work/fan.obj" 12 9
 for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
@@ -119,6 +120,7 @@ acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150
 acheck uv_corner "$work/uv_corner.obj" 12 6
 acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
 corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
+corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # version 8 tables, the fast level
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000
 
 # ---- metadata (§4.6)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 to 7), written from
+"""An independent decoder for .tsm files (format versions 3 to 8), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6, 7):
+    if version not in (3, 4, 5, 6, 7, 8):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -1030,6 +1030,87 @@ def decode_geometry_raw(payload, vc, qbits, top=False):
     return q, ginfo
 
 
+class BitReader:
+    """§8.5.11: bits most significant first; reading past the end is corrupt."""
+    def __init__(self, data):
+        self.data = data
+        self.pos = 0                                      # in bits
+
+    def read(self, n):
+        v = 0
+        for _ in range(n):
+            byte = self.pos >> 3
+            if byte >= len(self.data):
+                reject('geometry: table-coded bit stream is truncated')
+            v = (v << 1) | ((self.data[byte] >> (7 - (self.pos & 7))) & 1)
+            self.pos += 1
+        return v
+
+
+def read_tables(payload, pos):
+    """§8.5.11: bit stream length, used-context map, code lengths; returns
+    ({context: {(length, code word): symbol}}, BitReader, offset of the range-coded stream)."""
+    if len(payload) < pos + 4 + 27:
+        reject('geometry: table block truncated')
+    nbytes = struct.unpack_from('<I', payload, pos)[0]
+    used = [c for c in range(216) if payload[pos + 4 + (c >> 3)] >> (c & 7) & 1]
+    p = pos + 4 + 27
+    tables = {}
+    for c in used:
+        if c >= 210:
+            reject('geometry: table for a context that does not exist')
+        if p >= len(payload):
+            reject('geometry: table block truncated')
+        S = payload[p]
+        p += 1
+        if not 1 <= S <= 63:
+            reject('geometry: table symbol count')
+        if p + (S + 1) // 2 > len(payload):
+            reject('geometry: table block truncated')
+        lengths = []
+        for j in range((S + 1) // 2):
+            lengths += [payload[p + j] >> 4, payload[p + j] & 15]
+        p += (S + 1) // 2
+        if S % 2 and lengths[S]:
+            reject('geometry: table padding nibble')
+        lengths = lengths[:S]
+        if max(lengths) > 11:
+            reject('geometry: code length above 11')
+        kraft = sum(1 << (11 - l) for l in lengths if l)
+        if kraft == 0 or kraft > 2048:
+            reject('geometry: table is empty or over-subscribed')
+        code, words = 0, {}                                  # canonical: by length, then symbol
+        for l in range(1, 12):
+            for sym in range(S):
+                if lengths[sym] == l:
+                    words[(l, code)] = sym
+                    code += 1
+            code <<= 1
+        tables[c] = words
+    if nbytes > len(payload) - p:
+        reject('geometry: table-coded bit stream longer than the section')
+    return tables, BitReader(payload[p:p + nbytes]), p + nbytes
+
+
+def table_residual(tables, bits, c):
+    """§8.5.11: one residual of context c."""
+    if c not in tables:
+        reject('geometry: residual in a context without a table')
+    words = tables[c]
+    word, length = 0, 0
+    while (length, word) not in words:
+        if length == 11:
+            reject('geometry: code word in no table')
+        word = (word << 1) | bits.read(1)
+        length += 1
+    sym = words[(length, word)]
+    if sym <= 6:
+        return sym - 3
+    n = (sym - 7) // 2 + 3                                   # bit length of |r|
+    mag = (1 << (n - 1)) | bits.read(n - 1)
+    return -mag if (sym - 7) & 1 else mag
+
+
 def decode_geometry(payload, layout, qbits, trace=None, version=4):
     vc = layout['vertex_count']
     tri, twin, ids, vparent = layout['tri'], layout['twin'], layout['id'], layout['vparent']
@@ -1043,6 +1124,11 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     tangent = False
     mix = False
     planes_from_top = False  # version 7; `top` in code_vertex is the largest residual so far
+    tables = None            # version 8: the prefix codes of §8.5.11
+    table_flag = False
+    if version >= 8 and predictor & 0x08:                           # §8.5.1, version 8
+        predictor &= 0xF7
+        table_flag = True
     if version >= 7 and predictor & 0x10:                           # §8.5.1, version 7
         predictor &= 0xEF
         planes_from_top = True
@@ -1061,6 +1147,8 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             reject('geometry: predictor without weights')
     if predictor > (4 if version >= 4 else 3):
         reject('geometry: predictor')
+    if table_flag and (predictor == 4 or mix):
+        reject('geometry: tables with the raw predictor or with mixing')
     if predictor == 4:                                               # §8.5.10 raw
         return decode_geometry_raw(payload, layout['vertex_count'], qbits, planes_from_top)
     pos = 1
@@ -1093,6 +1181,8 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         if beta[0] > 8192 or beta[1] > 8192:
             reject('geometry: tangent weight range')
         pos += 4
+    if table_flag:                                                   # §8.5.11, version 8
+        tables, bits, pos = read_tables(payload, pos)
     d = RangeDecoder(payload[pos:])
     # §8.2 models
     residual = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
@@ -1170,6 +1260,8 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                 if mix:                                      # version 6: two models mixed
                     ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
                     r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
+                elif tables is not None:                     # version 8: the context's prefix code
+                    r = table_residual(tables, bits, (i * 5 + cls) * 14 + ctx)
                 else:
                     r = residual[i][cls][ctx].decode(d)      # by coding position i (= a without a normal)
                 x = p + r

@@ -431,6 +431,9 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "grid_holes", tsm_test::grid_with_holes(10, 2), 30, 9);
   // a noisy sphere at level 9: residual mixing (format version 6)
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(3), 0.004f, 5), 14, 9);
+  // ... and at level 0: table-coded residuals (format version 8), at 30 bits too
+  encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(3), 0.004f, 5), 14, 0);
+  encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(2), 0.004f, 5), 30, 0);
   encode_seed(decode_dir, "quads", quad_grid(6), 1, 6);
   // Files of several segments (FORMAT.md §4.5).
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 12, 6, 40);

@@ -176,8 +176,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 8 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 8, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 9 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 9, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -391,4 +391,39 @@ TEST(FormatV7, LatticePlanesFromTheTopOnlyWhereTheyPay) {
   const std::string soup = encode_v(tsm_test::random_soup(200, 300, 3), 14, 0);
   EXPECT_EQ(version_of(soup), 5u);
   EXPECT_FALSE(top(soup));
+}
+
+// Version 8 codes the residuals of levels 0-2 with static prefix codes per
+// context (FORMAT.md §8.5.11): those files say version 8 and round trip
+// exactly and canonically; an asked-for version 7 codes them adaptively;
+// the default level keeps version 5; the table flag in a version 7 file is
+// an unknown predictor.
+TEST(FormatV8, TablesAtTheFastLevelsAndVersion8OnlyThere) {
+  const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
+  auto tables = [](const std::string& bytes) { return predictor_of(bytes).find("+tables") != std::string::npos; };
+  for (int level : {0, 1, 2}) {
+    SCOPED_TRACE("level " + std::to_string(level));
+    const std::string v8 = encode_as(noisy, 14, level, 0);
+    EXPECT_EQ(version_of(v8), 8u);
+    EXPECT_TRUE(tables(v8)) << predictor_of(v8);
+    expect_round_trip(noisy, v8, 14, "tables");
+    EXPECT_EQ(encode_as(decode_ok(v8), 14, level, 0), v8);
+    const std::string v7 = encode_as(noisy, 14, level, 7);
+    EXPECT_EQ(version_of(v7), 7u);  // an asked-for version is written as asked
+    EXPECT_FALSE(tables(v7));
+    // The tables cost a little: within 10% of the adaptive file on 2,562 vertices.
+    EXPECT_LT(v8.size(), v7.size() * 11 / 10) << v7.size() << " -> " << v8.size();
+    expect_needs_version(v8, 8);
+  }
+  const std::string l6 = encode_as(noisy, 14, tsm::kDefaultLevel, 0);
+  EXPECT_EQ(version_of(l6), 5u);
+  EXPECT_FALSE(tables(l6));
+  // Segments: each codes its own tables.
+  std::string seg;
+  tsm::EncodeOptions o;
+  o.level = 0;
+  o.segment_faces = 1000;
+  ASSERT_TRUE(tsm::encode(noisy, o, seg).ok());
+  EXPECT_EQ(version_of(seg), 8u);
+  expect_round_trip(noisy, seg, 14, "tables in segments");
 }

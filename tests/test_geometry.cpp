@@ -13,6 +13,7 @@
 #include "connectivity.hpp"
 #include "geometry_predict.hpp"
 #include "mesh_gen.hpp"
+#include "table_coder.hpp"
 #include "test_util.hpp"
 #include "tsm/tsm.hpp"
 
@@ -159,18 +160,18 @@ TEST(Geometry, EveryPredictorRoundTripsOnEveryFamily) {
   }
 }
 
-// Version 6's residual mixing (FORMAT.md §8.1.1, §8.5.3): on every predictor
-// with models (with and without the tangent step and planes) the positions
-// come back; version 5 refuses the flag; and on a noisy surface, where the
-// two contexts tell different things, mixing is smaller.
-TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
-  std::vector<std::pair<std::string, Mesh>> meshes = families();
+// Calls f(p, bits, predictor, K, tangent weights or null, lattice) for every
+// family at each quantization of `bit_list`, every predictor with residual
+// models (ancestors with K = 2), with and without the tangent step (not for
+// ancestors) and the family's lattice planes, under a trace naming them.
+template <class F>
+void for_each_model_coding(std::initializer_list<int> bit_list, F&& f) {
   using tsm::Predictor;
-  const int32_t beta[2] = {4096, 2048};
-  for (const auto& [name, m] : meshes)
-    for (int bits : {4, 11, 20}) {
-      Prepared p = prepare(m, bits);
-      tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
+  static const int32_t beta[2] = {4096, 2048};
+  for (const auto& [name, m] : families())
+    for (int bits : bit_list) {
+      const Prepared p = prepare(m, bits);
+      const tsm::Lattice lattice = tsm::find_lattice(p.q, static_cast<uint32_t>(m.vertex_count()));
       for (auto [pred, K] : {std::pair{Predictor::gate, 0}, {Predictor::parallelograms, 0}, {Predictor::spread, 0},
                              {Predictor::ancestors, 2}})
         for (bool tangent : {false, true})
@@ -178,20 +179,112 @@ TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
             if (tangent && pred == Predictor::ancestors) continue;
             SCOPED_TRACE(name + " bits=" + std::to_string(bits) + " predictor=" + std::to_string(int(pred)) +
                          " tangent=" + std::to_string(tangent) + " lattice=" + std::to_string(use_lattice));
-            const tsm::Lattice& L = use_lattice ? lattice : tsm::Lattice();
-            const std::string bytes =
-                tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, L, nullptr, tangent ? beta : nullptr, true);
-            ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kMixFlag);
-            tsm::GeometryStats st;
-            ASSERT_TRUE(decodes_to(bytes, p, bits, st));
-            EXPECT_TRUE(st.mix);
-            EXPECT_EQ(st.tangent, tangent);
-            EXPECT_EQ(st.predictor, pred);
-            std::vector<uint32_t> back;
-            EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 5).code(),
-                      tsm::ErrorCode::corrupt_data);
+            f(p, bits, pred, K, tangent ? beta : nullptr, use_lattice ? lattice : tsm::Lattice());
           }
     }
+}
+
+// Version 8's table-coded residuals (FORMAT.md §8.5.11): on every predictor
+// with residual models (with and without the tangent step and planes) the
+// positions come back, at 30 bits too (residuals of every bit length);
+// version 7 refuses the flag, and so does mixing or the raw predictor.
+TEST(Geometry, TableResidualsRoundTripOnEveryFamily) {
+  using tsm::Predictor;
+  for_each_model_coding({4, 11, 20, 30}, [](const Prepared& p, int bits, Predictor pred, int K, const int32_t* beta,
+                                            const tsm::Lattice& L) {
+    const std::string bytes =
+        tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, L, nullptr, beta, false, false, true);
+    ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kTableFlag);
+    tsm::GeometryStats st;
+    ASSERT_TRUE(decodes_to(bytes, p, bits, st));
+    EXPECT_TRUE(st.tables);
+    EXPECT_EQ(st.tangent, beta != nullptr);
+    EXPECT_EQ(st.predictor, pred);
+    std::vector<uint32_t> back;
+    EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 7).code(), tsm::ErrorCode::corrupt_data);
+  });
+  Prepared p = prepare(tsm_test::icosphere(2), 11);
+  std::vector<uint32_t> back;
+  std::string raw = tsm::encode_geometry_as(p.ce.layout, p.q, 11, Predictor::raw, 0, tsm::Lattice());
+  raw[0] = static_cast<char>(raw[0] | tsm::kTableFlag);
+  EXPECT_EQ(tsm::decode_geometry(raw, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
+  std::string mixed = tsm::encode_geometry_as(p.ce.layout, p.q, 11, Predictor::gate, 0, tsm::Lattice(), nullptr,
+                                              nullptr, true);
+  mixed[0] = static_cast<char>(mixed[0] | tsm::kTableFlag);
+  EXPECT_EQ(tsm::decode_geometry(mixed, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
+}
+
+// A table-coded stream with its table block, bit stream length or bit
+// stream damaged is refused (or, for a damaged bit stream that still
+// parses, decodes to positions on the grid), never read out of bounds.
+TEST(Geometry, DamagedTablesAreRefused) {
+  Prepared p = prepare(tsm_test::jittered(tsm_test::icosphere(3), 0.01f, 3), 12);
+  const std::string good = tsm::encode_geometry_as(p.ce.layout, p.q, 12, tsm::Predictor::gate, 0, tsm::Lattice(),
+                                                   nullptr, nullptr, false, false, true);
+  ASSERT_EQ(static_cast<uint8_t>(good[0]), tsm::kDefaultWeightsFlag | tsm::kTableFlag | 2);  // no weights stored
+  std::vector<uint32_t> back;
+  ASSERT_TRUE(tsm::decode_geometry(good, p.ce.layout, 12, back).ok());
+  const size_t map_at = 5, tables_at = map_at + tsm::kTableMapBytes;
+  uint32_t bit_bytes = 0;
+  for (int k = 0; k < 4; ++k) bit_bytes |= uint32_t{static_cast<uint8_t>(good[1 + k])} << (8 * k);
+  auto code = [&](const std::string& bytes) { return tsm::decode_geometry(bytes, p.ce.layout, 12, back).code(); };
+  auto with = [&](size_t at, uint8_t value) {
+    std::string b = good;
+    b[at] = static_cast<char>(value);
+    return b;
+  };
+  // Every prefix is refused.
+  for (size_t n = 0; n < good.size(); n += 7) EXPECT_EQ(code(good.substr(0, n)), tsm::ErrorCode::corrupt_data) << n;
+  // The bit stream's length: past the section, or shorter than its bits.
+  EXPECT_EQ(code(with(4, 0x7F)), tsm::ErrorCode::corrupt_data);
+  std::string shorter = good;
+  shorter[1] = static_cast<char>(static_cast<uint8_t>(good[1]) - 1);
+  EXPECT_EQ(code(shorter), tsm::ErrorCode::corrupt_data);
+  // The first table: no symbols, too many, a length of 12, over-subscribed.
+  size_t first = map_at;
+  while (good[first] == 0) ++first;
+  EXPECT_EQ(code(with(tables_at, 0)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(tables_at, 64)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(tables_at + 1, 0xCC)), tsm::ErrorCode::corrupt_data);
+  std::string all_ones = good;
+  const size_t S = static_cast<uint8_t>(good[tables_at]);
+  for (size_t j = 0; j < (S + 1) / 2; ++j) all_ones[tables_at + 1 + j] = static_cast<char>(S % 2 && j == S / 2 ? 0x10 : 0x11);
+  EXPECT_EQ(code(all_ones), tsm::ErrorCode::corrupt_data);
+  // A used context's table left out of the map; a context that does not exist.
+  const uint8_t m = static_cast<uint8_t>(good[first]);
+  EXPECT_EQ(code(with(first, static_cast<uint8_t>(m & (m - 1)))), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(map_at + 26, 0x04)), tsm::ErrorCode::corrupt_data);  // context 210
+  // Every byte of the table block and the first of the bit stream, changed:
+  // refused, or positions on the grid; never a crash (the sanitizer build).
+  const size_t end = tables_at + (good.size() - tables_at - bit_bytes) / 2 + 8;
+  for (size_t at = map_at; at < std::min(end, good.size()); ++at)
+    for (uint8_t x : {uint8_t{0x00}, uint8_t{0x5A}, uint8_t{0xFF}}) {
+      const tsm::Status s = tsm::decode_geometry(with(at, x), p.ce.layout, 12, back);
+      if (s.ok()) {
+        ASSERT_EQ(back.size(), p.q.size());
+        for (uint32_t v : back) ASSERT_LE(v, 4095u);
+      }
+    }
+}
+
+// Version 6's residual mixing (FORMAT.md §8.1.1, §8.5.3): on every predictor
+// with models (with and without the tangent step and planes) the positions
+// come back; version 5 refuses the flag; and on a noisy surface, where the
+// two contexts tell different things, mixing is smaller.
+TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
+  using tsm::Predictor;
+  for_each_model_coding({4, 11, 20}, [](const Prepared& p, int bits, Predictor pred, int K, const int32_t* beta,
+                                        const tsm::Lattice& L) {
+    const std::string bytes = tsm::encode_geometry_as(p.ce.layout, p.q, bits, pred, K, L, nullptr, beta, true);
+    ASSERT_TRUE(static_cast<uint8_t>(bytes[0]) & tsm::kMixFlag);
+    tsm::GeometryStats st;
+    ASSERT_TRUE(decodes_to(bytes, p, bits, st));
+    EXPECT_TRUE(st.mix);
+    EXPECT_EQ(st.tangent, beta != nullptr);
+    EXPECT_EQ(st.predictor, pred);
+    std::vector<uint32_t> back;
+    EXPECT_EQ(tsm::decode_geometry(bytes, p.ce.layout, bits, back, nullptr, 5).code(), tsm::ErrorCode::corrupt_data);
+  });
   // The raw predictor has no models to mix.
   Prepared p = prepare(tsm_test::cube_quads(), 11);
   std::string raw = tsm::encode_geometry_as(p.ce.layout, p.q, 11, Predictor::raw, 0, tsm::Lattice());
@@ -199,6 +292,7 @@ TEST(Geometry, ResidualMixingRoundTripsOnEveryFamily) {
   std::vector<uint32_t> back;
   EXPECT_EQ(tsm::decode_geometry(raw, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
   // A noisy sphere: smaller mixed.
+  const int32_t beta[2] = {4096, 2048};
   Prepared n = prepare(tsm_test::jittered(tsm_test::icosphere(5), 0.004f, 7), 14);
   const std::string plain = tsm::encode_geometry_as(n.ce.layout, n.q, 14, Predictor::spread, 0, tsm::Lattice(),
                                                     nullptr, beta);

@@ -326,11 +326,12 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
   return Status::Ok();
 }
 
-// The oldest format version that reads a geometry stream: 7 for lattice
-// planes coded from the top, 6 for residual mixing, else 5.
+// The oldest format version that reads a geometry stream: 8 for residuals
+// through tables, 7 for lattice planes coded from the top, 6 for residual
+// mixing, else 5.
 uint16_t needed_version(const std::string& geometry) {
   const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
-  return kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
+  return kind & kTableFlag ? 8 : kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
 }
 
 // Encoder: one part (the whole mesh or a segment) coded.
@@ -1016,6 +1017,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   if (gs.tangent) info.geometry_predictor += "+tangent";
   if (gs.mix) info.geometry_predictor += "+mix";
   if (gs.top) info.geometry_predictor += "+top";
+  if (gs.tables) info.geometry_predictor += "+tables";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
   return Status::Ok();

@@ -32,14 +32,17 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "byte_io.hpp"
 #include "connectivity.hpp"
 #include "range_coder.hpp"
+#include "table_coder.hpp"
 #include "tsm/compare.hpp"
 
 namespace tsm {
@@ -110,6 +113,8 @@ struct EncodeSink {
     m.encode(e, static_cast<int32_t>(v));
     return static_cast<int32_t>(v);
   }
+  // A surface residual (context: Coder::vertex's, numbered for the tables).
+  int32_t residual(ResidualModel& m, int, int64_t v) { return sint(m, v); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t v) {
     MixEncodeOp op{e};
     return code_mixed_sint(op, a, b, w, static_cast<int32_t>(v));
@@ -126,9 +131,33 @@ struct CollectSink {
   static constexpr bool kEncoder = true;
   int bit(Prob&, int b) { return b; }
   int32_t sint(ResidualModel&, int64_t v) { return static_cast<int32_t>(v); }
+  int32_t residual(ResidualModel&, int, int64_t v) { return static_cast<int32_t>(v); }
   int32_t sint_mixed(ResidualModel&, ResidualModel&, MixWeights*, int64_t v) { return static_cast<int32_t>(v); }
   uint32_t uint(UIntModel&, uint32_t v) { return v; }
   bool truncated() const { return false; }
+};
+
+// Version 8 (kTableFlag): the surface residuals through static prefix codes
+// per context, everything else through the range coder as before. The
+// encoder counts the symbols in a first pass, builds the codes, then codes.
+constexpr int kTableContexts = 3 * kClasses * kActivity;
+struct TableCountSink : CollectSink {
+  std::vector<std::array<uint32_t, kTableSymbols>> count = std::vector<std::array<uint32_t, kTableSymbols>>(kTableContexts);
+  int32_t residual(ResidualModel&, int ctx, int64_t v) {
+    ++count[ctx][table_symbol(v).symbol];
+    return static_cast<int32_t>(v);
+  }
+};
+struct TableEncodeSink : EncodeSink {
+  std::vector<CodeLengths> length;
+  std::vector<std::array<uint32_t, kTableSymbols>> code;
+  BitWriter bits;
+  int32_t residual(ResidualModel&, int ctx, int64_t v) {
+    const TableSymbol t = table_symbol(v);
+    bits.put(code[ctx][t.symbol], length[ctx][t.symbol]);
+    if (t.raw_bits) bits.put(t.raw, t.raw_bits);
+    return static_cast<int32_t>(v);
+  }
 };
 
 struct DecodeSink {
@@ -136,12 +165,25 @@ struct DecodeSink {
   RangeDecoder d;
   int bit(Prob& p, int) { return d.bit(p); }
   int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
+  int32_t residual(ResidualModel& m, int, int64_t) { return m.decode(d); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t) {
     MixDecodeOp op{d};
     return code_mixed_sint(op, a, b, w, 0);
   }
   uint32_t uint(UIntModel& m, uint32_t) { return m.decode(d); }
   bool truncated() const { return d.overrun() > RangeDecoder::kMaxOverrun; }
+};
+
+struct TableDecodeSink : DecodeSink {
+  TableSet tables;
+  BitReader bits;
+  bool bad_code = false;  // a code word no table assigns, or a context without a table
+  int32_t residual(ResidualModel&, int ctx, int64_t) {
+    int32_t r = 0;
+    if (!tables.has(ctx) || !tables.decode(bits, ctx, r)) bad_code = true;
+    return r;
+  }
+  bool truncated() const { return DecodeSink::truncated() || bits.overrun() || bad_code; }
 };
 
 struct Coder {
@@ -263,7 +305,7 @@ struct Coder {
           r = s.sint_mixed(models->m[i][cls][ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
                            static_cast<int64_t>(x) - p);
         } else {
-          r = s.sint(models->m[i][cls][ctx], static_cast<int64_t>(x) - p);
+          r = s.residual(models->m[i][cls][ctx], (i * kClasses + cls) * kActivity + ctx, static_cast<int64_t>(x) - p);
         }
         if (p + r < 0 || p + r > qmax) return false;
         x = static_cast<uint32_t>(p + r);
@@ -835,11 +877,12 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix,
-                               bool top) {
+                               bool top, bool tables) {
   if (pred == Predictor::raw) {
     const bool all_on = covers(lattice, q, g.vertex_count);
     return encode_geometry_raw(g, q, bits, all_on ? lattice : Lattice(), top && all_on);
   }
+  if (mix) tables = false;
   std::string head;
   ByteWriter w(head);
   const bool default_weights =
@@ -847,41 +890,65 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
                                                     weights[2] == kAlphaOne));
   if (!surface_predictor(pred)) tangent = nullptr;
   w.u8(static_cast<uint8_t>(static_cast<uint8_t>(pred) | (default_weights ? kDefaultWeightsFlag : 0) |
-                            (tangent ? kTangentFlag : 0) | (mix ? kMixFlag : 0) | (top ? kTopFlag : 0)));
+                            (tangent ? kTangentFlag : 0) | (mix ? kMixFlag : 0) | (top ? kTopFlag : 0) |
+                            (tables ? kTableFlag : 0)));
   int32_t lambda[kMaxAncestors] = {0, 0, 0, 0};
   if (pred == Predictor::ancestors) {
     fit_lambda(g, q, K, lambda);
     w.u8(static_cast<uint8_t>(K));
     for (int i = 0; i < K; ++i) w.u32(static_cast<uint32_t>(lambda[i]));
   }
-  Coder c(g.vertex_count, bits);
-  c.spread_ctx = pred == Predictor::spread;
-  if (mix) c.mix = std::make_unique<MixModels>();
+  int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne}, beta[2] = {kAlphaOne, kAlphaOne};
   if (pred != Predictor::ancestors && !default_weights)
     for (int k = 0; k < 3; ++k) {
-      c.alpha[k] = weights[k];
-      w.u16(static_cast<uint16_t>(static_cast<int16_t>(c.alpha[k])));
+      alpha[k] = weights[k];
+      w.u16(static_cast<uint16_t>(static_cast<int16_t>(alpha[k])));
     }
-  if (tangent) {
-    c.tangent = true;
+  if (tangent)
     for (int i = 0; i < 2; ++i) {
-      c.beta[i] = std::clamp<int32_t>(tangent[i], 0, kMaxBeta);
-      w.u16(static_cast<uint16_t>(c.beta[i]));
+      beta[i] = std::clamp<int32_t>(tangent[i], 0, kMaxBeta);
+      w.u16(static_cast<uint16_t>(beta[i]));
     }
+  // One coding pass with a given sink (the table encoder makes two).
+  auto pass = [&](auto& s) {
+    Coder c(g.vertex_count, bits);
+    c.spread_ctx = pred == Predictor::spread;
+    if (mix) c.mix = std::make_unique<MixModels>();
+    std::copy(alpha, alpha + 3, c.alpha);
+    if (tangent) {
+      c.tangent = true;
+      std::copy(beta, beta + 2, c.beta);
+    }
+    c.lattice = lattice;
+    c.planes_from_top = top;
+    code_lattice(s, c);
+    c.build_nearest();
+    std::vector<uint32_t> work = q;
+    if (pred == Predictor::ancestors)
+      code_ancestors(g, K, lambda, c, s, work);
+    else if (pred == Predictor::parallelograms || pred == Predictor::spread)
+      code_greedy(g, c, s, work);
+    else
+      code_march_order(g, false, c, s, work);
+  };
+  if (!tables) {
+    EncodeSink s;
+    pass(s);
+    return head + s.e.finish();
   }
-  EncodeSink s;
-  c.lattice = lattice;
-  c.planes_from_top = top;
-  code_lattice(s, c);
-  c.build_nearest();
-  std::vector<uint32_t> work = q;
-  if (pred == Predictor::ancestors)
-    code_ancestors(g, K, lambda, c, s, work);
-  else if (pred == Predictor::parallelograms || pred == Predictor::spread)
-    code_greedy(g, c, s, work);
-  else
-    code_march_order(g, false, c, s, work);
-  return head + s.e.finish();
+  // Tables (FORMAT.md §8.5.11): count, build the codes, code; then the
+  // bit stream's length, the table block, the bit stream, the range stream.
+  TableCountSink counts;
+  pass(counts);
+  TableEncodeSink s;
+  for (const auto& count : counts.count) {
+    s.length.push_back(table_code_lengths(count));
+    s.code.push_back(canonical_codes(s.length.back()));
+  }
+  pass(s);
+  const std::string bitstream = s.bits.finish();
+  w.u32(static_cast<uint32_t>(bitstream.size()));
+  return head + write_tables(s.length) + bitstream + s.e.finish();
 }
 
 
@@ -970,19 +1037,22 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
                             const Lattice* candidate, GeometryStats* stats, int version) {
   const bool tangent = version >= 5, mix = version >= 6;
+  // The fast levels: residuals through static prefix codes (version 8).
+  const bool tables = version >= 8 && level <= kTableLevel;
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
+  st.tables = tables;
   int32_t lsq[3], est[3];
   fit_alphas(g, q, bits, st.predictor, lsq, est);
   const int32_t* weights = est;
-  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est);
+  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est, nullptr, false, false, tables);
   // `lattice` may be st.lattice itself (the assignment below is then a
   // self-assignment, which std::vector handles).
   int32_t beta[2];
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
                       bool mixed = false) {
     const bool top = version >= 7 && top_pays(lattice, bits, g.vertex_count);
-    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed, top);
+    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
@@ -991,10 +1061,11 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     st.tangent = tan != nullptr;
     st.mix = mixed;
     st.top = static_cast<uint8_t>(best[0]) & kTopFlag;  // raw drops planes that miss a vertex, and the flag
+    st.tables = static_cast<uint8_t>(best[0]) & kTableFlag;  // raw and mixing have none
     weights = w;
     return true;
   };
-  if (level >= 3 && candidate) {
+  if ((level >= 3 || tables) && candidate) {
     // Shared coordinate planes: keep them where they make the file smaller
     // (all candidate axes at once, then at high levels each axis alone).
     const Lattice& found = *candidate;
@@ -1068,6 +1139,10 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (!r.u8(kind)) return corrupt("empty section");
   const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
   bool default_weights = false;
+  if (version >= 8 && (kind & kTableFlag)) {
+    kind = static_cast<uint8_t>(kind & ~kTableFlag);
+    st.tables = true;
+  }
   if (version >= 7 && (kind & kTopFlag)) {
     kind = static_cast<uint8_t>(kind & ~kTopFlag);
     st.top = true;
@@ -1094,6 +1169,8 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   }
   if (kind > newest) return corrupt("unknown predictor " + std::to_string(kind));
   st.predictor = static_cast<Predictor>(kind);
+  if (st.tables && (st.predictor == Predictor::raw || st.mix))
+    return corrupt(st.mix ? "residual mixing and tables at once" : "the raw predictor has no residuals for tables");
   if (st.predictor == Predictor::raw) {
     q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
     Coder c(g.vertex_count, bits);
@@ -1138,31 +1215,54 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       c.beta[i] = x;
     }
   }
-  const size_t at = r.offset();
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
   c.spread_ctx = st.predictor == Predictor::spread;
   if (st.mix) c.mix = std::make_unique<MixModels>();
   c.planes_from_top = st.top;
-  DecodeSink s;
-  s.d.init(bytes.substr(at));
-  if (!code_lattice(s, c)) return corrupt("bad lattice");
-  c.build_nearest();
-  for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(c.lattice.values[a].size());
-  q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
-  bool ok;
-  if (st.predictor == Predictor::ancestors) {
+  if (st.predictor == Predictor::ancestors)
     for (uint32_t v = 0; v < g.vertex_count; ++v)
       if (g.parent[v] != kNone && g.parent[v] >= v) return corrupt("bad vertex tree parent");
-    ok = code_ancestors(g, st.ancestors, lambda, c, s, q);
-  } else {
-    ok = st.predictor == Predictor::parallelograms || st.predictor == Predictor::spread
-             ? code_greedy(g, c, s, q)
-             : code_march_order(g, false, c, s, q);
+  auto run = [&](auto& s) -> Status {
+    if (!code_lattice(s, c)) return corrupt("bad lattice");
+    c.build_nearest();
+    for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(c.lattice.values[a].size());
+    q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
+    bool ok;
+    if (st.predictor == Predictor::ancestors)
+      ok = code_ancestors(g, st.ancestors, lambda, c, s, q);
+    else
+      ok = st.predictor == Predictor::parallelograms || st.predictor == Predictor::spread
+               ? code_greedy(g, c, s, q)
+               : code_march_order(g, false, c, s, q);
+    if (!ok || s.truncated()) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(s)>, TableDecodeSink>) {
+        if (s.bad_code) return corrupt("a residual's code word is in no table");
+        if (s.bits.overrun()) return corrupt("table-coded bit stream is truncated");
+      }
+      return corrupt(s.truncated() ? "stream is truncated" : "coordinate outside the grid");
+    }
+    if (stats) *stats = st;
+    return Status::Ok();
+  };
+  if (!st.tables) {
+    DecodeSink s;
+    s.d.init(bytes.substr(r.offset()));
+    return run(s);
   }
-  if (!ok) return corrupt(s.truncated() ? "stream is truncated" : "coordinate outside the grid");
-  if (s.truncated()) return corrupt("stream is truncated");
-  if (stats) *stats = st;
-  return Status::Ok();
+  // Version 8 (§8.5.11): the bit stream's length, the tables, the bit
+  // stream, then the range-coded stream.
+  uint32_t bit_bytes;
+  if (!r.u32(bit_bytes)) return corrupt("truncated predictor header");
+  auto s = std::make_unique<TableDecodeSink>();
+  std::string why;
+  if (!s->tables.read(r, kTableContexts, why)) return corrupt(why);
+  std::string_view bitstream;
+  if (!r.bytes(bit_bytes, bitstream))
+    return corrupt("the table-coded bit stream has " + std::to_string(bit_bytes) + " bytes, the section holds " +
+                   std::to_string(r.remaining()));
+  s->bits.init(bitstream);
+  s->d.init(bytes.substr(r.offset()));
+  return run(*s);
 }
 
 }  // namespace tsm

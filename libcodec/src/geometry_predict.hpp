@@ -44,6 +44,12 @@ constexpr uint8_t kMixFlag = 0x20;
 // that each axis of two or more lattice planes codes its last plane first,
 // as qmax minus it (a box's far corners: a few bits instead of ~20).
 constexpr uint8_t kTopFlag = 0x10;
+// Version 8: the predictor byte of 0, 1, 2 or 3 (any flag above but mixing)
+// with this bit set says the residuals are coded with static prefix codes
+// per context (table_coder.hpp), stored before the streams: the fast levels.
+constexpr uint8_t kTableFlag = 0x08;
+// The highest encoder level that codes residuals with tables (version 8).
+constexpr int kTableLevel = 2;
 // The lowest encoder level that tries residual mixing (slower to decode).
 constexpr int kMixLevel = 7;
 
@@ -59,6 +65,7 @@ struct GeometryStats {
   bool tangent = false;  // version 5: the tangent step
   bool mix = false;      // version 6: residual mixing
   bool top = false;      // version 7: lattice planes' last coded from the top
+  bool tables = false;   // version 8: residuals through static prefix codes
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -77,21 +84,24 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 // q: 3 quantized coordinates per output vertex. The encoder picks the
 // predictor by level, and the lattice (if a candidate is given) by size.
 // version: what the file may use: from 5 the tangent step, from 6 residual
-// mixing (at level kMixLevel and up), from 7 planes coded from the top.
+// mixing (at level kMixLevel and up), from 7 planes coded from the top,
+// from 8 residuals through tables (at level kTableLevel and below).
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats = nullptr, int version = 7);
+                            const Lattice* candidate, GeometryStats* stats = nullptr, int version = 8);
 // One predictor, lattice and set of parallelogram weights (per class of 1,
 // 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
 // experiments). tangent: the tangent step's two weights (4.12, surface
 // vertices and vertices with an anchor; version 5), null for none. mix:
 // residual mixing (version 6; not with the raw predictor). top: the lattice
-// planes' last coded from the top (version 7).
+// planes' last coded from the top (version 7). tables: residuals through
+// static prefix codes (version 8; not with mixing or the raw predictor).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
-                               const int32_t* tangent = nullptr, bool mix = false, bool top = false);
+                               const int32_t* tangent = nullptr, bool mix = false, bool top = false,
+                               bool tables = false);
 // `version`: the file's format version (3 knows neither the raw predictor
 // nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr, int version = 7);
+                       GeometryStats* stats = nullptr, int version = 8);
 
 }  // namespace tsm

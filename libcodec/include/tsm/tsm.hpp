@@ -35,9 +35,11 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (7; the file says the oldest
-  // version that reads it: 5 unless it uses residual mixing, 6, or lattice
-  // planes coded from the top, 7); 6 or 5 write files that decoders of that
+  // The format version to write: 0 = the newest (8; the file says the oldest
+  // version that reads it: 5 unless it uses residual mixing, 6, lattice
+  // planes coded from the top, 7, or residuals through tables, which levels
+  // 0-2 use, 8); 7 writes files that decoders of version 7 read (levels 0-2
+  // then code residuals adaptively: slower to decode); 6 or 5 write files that decoders of that
   // version read (without version 7's planes from the top, a few bytes on a
   // box; 5 also without residual mixing, which only levels 7-9 use); 4 files
   // that decoders of version 4 read (without version 5's tangent step

@@ -1,0 +1,167 @@
+// Static prefix codes per context: see table_coder.hpp (entropy coding
+// stage, format version 8; FORMAT.md §8.5.11).
+#include "table_coder.hpp"
+
+#include <algorithm>
+
+#include "byte_io.hpp"
+
+namespace tsm {
+
+TableSymbol table_symbol(int64_t r) {
+  if (r >= -kTableDirect && r <= kTableDirect) return {static_cast<int>(r) + kTableDirect, 0, 0};
+  const uint32_t mag = static_cast<uint32_t>(r < 0 ? -r : r);
+  const int n = 32 - __builtin_clz(mag);  // 3..30
+  return {2 * kTableDirect + 1 + 2 * (n - 3) + (r < 0 ? 1 : 0), n - 1, mag & ((1u << (n - 1)) - 1)};
+}
+
+namespace {
+
+// Plain Huffman lengths (no limit) of the positive counts.
+CodeLengths huffman_lengths(const std::array<uint64_t, kTableSymbols>& count) {
+  CodeLengths len{};
+  struct Node {
+    uint64_t weight;
+    int id;  // < kTableSymbols: a leaf; else an inner node
+  };
+  std::vector<Node> heap;
+  std::vector<int> parent(2 * kTableSymbols, -1);
+  for (int s = 0; s < kTableSymbols; ++s)
+    if (count[s]) heap.push_back({count[s], s});
+  if (heap.size() == 1) {
+    len[heap[0].id] = 1;
+    return len;
+  }
+  auto later = [](const Node& a, const Node& b) { return a.weight != b.weight ? a.weight > b.weight : a.id > b.id; };
+  std::make_heap(heap.begin(), heap.end(), later);
+  int next = kTableSymbols;
+  while (heap.size() > 1) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const Node a = heap.back();
+    heap.pop_back();
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const Node b = heap.back();
+    heap.pop_back();
+    parent[a.id] = parent[b.id] = next;
+    heap.push_back({a.weight + b.weight, next++});
+    std::push_heap(heap.begin(), heap.end(), later);
+  }
+  for (int s = 0; s < kTableSymbols; ++s) {
+    if (!count[s]) continue;
+    int d = 0;
+    for (int x = s; parent[x] >= 0; x = parent[x]) ++d;
+    len[s] = static_cast<uint8_t>(d);
+  }
+  return len;
+}
+
+}  // namespace
+
+CodeLengths table_code_lengths(const std::array<uint32_t, kTableSymbols>& count) {
+  std::array<uint64_t, kTableSymbols> c;
+  for (int s = 0; s < kTableSymbols; ++s) c[s] = count[s];
+  // Too long a code word: flatten the counts (halve, keeping every seen
+  // symbol at 1 or more) until none is; 63 symbols fit in 6 bits, so this ends.
+  for (;;) {
+    CodeLengths len = huffman_lengths(c);
+    if (*std::max_element(len.begin(), len.end()) <= kTableMaxLength) return len;
+    for (uint64_t& x : c)
+      if (x) x = std::max<uint64_t>(1, x >> 1);
+  }
+}
+
+std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length) {
+  std::array<uint32_t, kTableSymbols> code{};
+  uint32_t next = 0;
+  for (int l = 1; l <= kTableMaxLength; ++l) {
+    for (int s = 0; s < kTableSymbols; ++s)
+      if (length[s] == l) code[s] = next++;
+    next <<= 1;
+  }
+  return code;
+}
+
+std::string write_tables(const std::vector<CodeLengths>& lengths) {
+  std::string out(kTableMapBytes, '\0');
+  ByteWriter w(out);
+  for (size_t c = 0; c < lengths.size(); ++c) {
+    int S = 0;
+    for (int s = 0; s < kTableSymbols; ++s)
+      if (lengths[c][s]) S = s + 1;
+    if (S == 0) continue;
+    out[c >> 3] = static_cast<char>(static_cast<uint8_t>(out[c >> 3]) | (1u << (c & 7)));
+    w.u8(static_cast<uint8_t>(S));
+    for (int s = 0; s < S; s += 2)
+      w.u8(static_cast<uint8_t>(lengths[c][s] << 4 | (s + 1 < S ? lengths[c][s + 1] : 0)));
+  }
+  return out;
+}
+
+bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
+  std::string_view map;
+  if (contexts > 8 * kTableMapBytes || !r.bytes(kTableMapBytes, map)) {
+    why = "table block is truncated";
+    return false;
+  }
+  slot_.assign(static_cast<size_t>(contexts), -1);
+  int used = 0;
+  for (int c = 0; c < 8 * kTableMapBytes; ++c) {
+    if (!((static_cast<uint8_t>(map[c >> 3]) >> (c & 7)) & 1)) continue;
+    if (c >= contexts) {
+      why = "table for context " + std::to_string(c) + ", which does not exist";
+      return false;
+    }
+    slot_[c] = static_cast<int16_t>(used++);
+  }
+  entries_.assign(static_cast<size_t>(used) << kTableMaxLength, 0);
+  for (int c = 0; c < contexts; ++c) {
+    if (slot_[c] < 0) continue;
+    uint8_t S;
+    if (!r.u8(S)) {
+      why = "table block is truncated";
+      return false;
+    }
+    if (S < 1 || S > kTableSymbols) {
+      why = "table of context " + std::to_string(c) + " has " + std::to_string(S) + " symbols (1.." +
+            std::to_string(kTableSymbols) + ")";
+      return false;
+    }
+    CodeLengths len{};
+    for (int s = 0; s < S; s += 2) {
+      uint8_t b;
+      if (!r.u8(b)) {
+        why = "table block is truncated";
+        return false;
+      }
+      len[s] = b >> 4;
+      if (s + 1 < S) len[s + 1] = b & 15;
+      else if (b & 15) {
+        why = "table of context " + std::to_string(c) + ": padding nibble is not zero";
+        return false;
+      }
+    }
+    uint32_t kraft = 0;  // in units of 2^-kTableMaxLength
+    for (int s = 0; s < kTableSymbols; ++s) {
+      if (len[s] > kTableMaxLength) {
+        why = "table of context " + std::to_string(c) + ": code length " + std::to_string(len[s]) + " above " +
+              std::to_string(kTableMaxLength);
+        return false;
+      }
+      if (len[s]) kraft += 1u << (kTableMaxLength - len[s]);
+    }
+    if (kraft == 0 || kraft > (1u << kTableMaxLength)) {
+      why = "table of context " + std::to_string(c) + (kraft ? " has more code words than fit" : " is empty");
+      return false;
+    }
+    const std::array<uint32_t, kTableSymbols> code = canonical_codes(len);
+    uint16_t* t = &entries_[static_cast<size_t>(slot_[c]) << kTableMaxLength];
+    for (int s = 0; s < kTableSymbols; ++s) {
+      if (!len[s]) continue;
+      const int free = kTableMaxLength - len[s];
+      std::fill(t + (code[s] << free), t + ((code[s] + 1) << free), static_cast<uint16_t>((s + 1) << 4 | len[s]));
+    }
+  }
+  return true;
+}
+
+}  // namespace tsm

@@ -1,0 +1,146 @@
+// Static prefix codes per context (entropy coding stage, format version 8;
+// FORMAT.md §8.5.11). The fast levels code the geometry residuals with one
+// canonical prefix code per residual context, stored in the file, instead
+// of the adaptive binary models of range_coder.hpp: one table lookup per
+// value instead of about ten adaptive decisions (6-9x faster to decode,
+// 1-2% larger; README "What table-driven residuals would give"). The
+// contexts are the adaptive coder's (seed 004 §3.2 predicts, the contexts
+// of design notes §6 say how much was known); only the coder changes.
+//
+// A residual r is a symbol: -3..3 are symbols 0..6 of their own; a larger
+// |r| of bit length n (3..30) is symbol 7 + 2 (n - 3) + (r < 0) followed by
+// the n - 1 bits below its leading one, raw. Bits are written most
+// significant first.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tsm {
+
+class ByteReader;
+
+constexpr int kTableDirect = 3;                              // residuals -3..3 are symbols of their own
+constexpr int kTableMaxBitLength = 30;                       // |r| < 2^30
+constexpr int kTableSymbols = 2 * kTableDirect + 1 + 2 * (kTableMaxBitLength - 2);  // 63
+constexpr int kTableMaxLength = 11;                          // longest code word, bits
+constexpr int kTableMapBytes = 27;                           // the used-context map: 210 bits
+
+using CodeLengths = std::array<uint8_t, kTableSymbols>;
+
+struct TableSymbol {
+  int symbol;
+  int raw_bits;  // n - 1 raw bits follow (0 for the direct symbols)
+  uint32_t raw;
+};
+// r must satisfy |r| < 2^30.
+TableSymbol table_symbol(int64_t r);
+
+// Huffman code lengths (1..kTableMaxLength, 0 for symbols never seen) for
+// counts; one symbol seen gets length 1. Deterministic: the encoder's
+// choice only, the file stores the lengths.
+CodeLengths table_code_lengths(const std::array<uint32_t, kTableSymbols>& count);
+
+// The canonical code words of lengths that satisfy Kraft (FORMAT.md
+// §8.5.11: by length, then by symbol).
+std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length);
+
+// The table block: the used-context map, then per used context its symbol
+// count and 4-bit code lengths. contexts <= 8 * kTableMapBytes.
+std::string write_tables(const std::vector<CodeLengths>& lengths);
+
+class BitWriter {
+ public:
+  void put(uint32_t value, int n) {  // n <= 32
+    acc_ = (acc_ << n) | (n == 32 ? value : value & ((uint64_t{1} << n) - 1));
+    have_ += n;
+    while (have_ >= 8) {
+      have_ -= 8;
+      out_.push_back(static_cast<char>(static_cast<uint8_t>(acc_ >> have_)));
+    }
+  }
+  // The bytes, the last one padded with zero bits.
+  std::string finish() {
+    if (have_ > 0) put(0, 8 - have_);
+    std::string s;
+    s.swap(out_);
+    return s;
+  }
+
+ private:
+  uint64_t acc_ = 0;
+  int have_ = 0;
+  std::string out_;
+};
+
+// Reads bits most significant first; past the end it reads zero bits and
+// remembers that it did (overrun()), which the caller turns into an error.
+class BitReader {
+ public:
+  void init(std::string_view data) {
+    p_ = reinterpret_cast<const uint8_t*>(data.data());
+    end_ = p_ + data.size();
+    buf_ = 0;
+    avail_ = 0;
+    consumed_ = 0;
+    limit_ = 8 * static_cast<uint64_t>(data.size());
+  }
+  // At least 57 bits in the buffer.
+  void refill() {
+    while (avail_ <= 56) {
+      const uint64_t byte = p_ < end_ ? *p_++ : 0;
+      buf_ |= byte << (56 - avail_);
+      avail_ += 8;
+    }
+  }
+  uint32_t peek(int n) const { return static_cast<uint32_t>(buf_ >> (64 - n)); }  // 1 <= n <= 32
+  void skip(int n) {
+    buf_ <<= n;
+    avail_ -= n;
+    consumed_ += static_cast<uint64_t>(n);
+  }
+  bool overrun() const { return consumed_ > limit_; }
+
+ private:
+  const uint8_t* p_ = nullptr;
+  const uint8_t* end_ = nullptr;
+  uint64_t buf_ = 0;
+  int avail_ = 0;
+  uint64_t consumed_ = 0, limit_ = 0;
+};
+
+// The decoder's codes: one lookup table of 2^kTableMaxLength entries per
+// used context (at most 210 of them, under 1 MB).
+class TableSet {
+ public:
+  // Reads the table block for `contexts` contexts; false with the reason.
+  bool read(ByteReader& r, int contexts, std::string& why);
+  bool has(int ctx) const { return ctx >= 0 && ctx < static_cast<int>(slot_.size()) && slot_[ctx] >= 0; }
+  // One residual of context ctx (which has a code); false on a code word
+  // the table does not assign.
+  bool decode(BitReader& b, int ctx, int32_t& r) const {
+    b.refill();
+    const uint16_t e = entries_[(static_cast<size_t>(slot_[ctx]) << kTableMaxLength) + b.peek(kTableMaxLength)];
+    if (e == 0) return false;
+    b.skip(e & 15);
+    const int s = (e >> 4) - 1;
+    if (s <= 2 * kTableDirect) {
+      r = s - kTableDirect;
+      return true;
+    }
+    const int m = s - (2 * kTableDirect + 1), n = (m >> 1) + 3;
+    const uint32_t raw = b.peek(n - 1);
+    b.skip(n - 1);
+    const int32_t mag = static_cast<int32_t>((uint32_t{1} << (n - 1)) | raw);
+    r = (m & 1) ? -mag : mag;
+    return true;
+  }
+
+ private:
+  std::vector<int16_t> slot_;     // per context: its table, or -1
+  std::vector<uint16_t> entries_;  // (symbol + 1) << 4 | length; 0: no code word
+};
+
+}  // namespace tsm

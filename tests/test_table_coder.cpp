@@ -1,0 +1,155 @@
+// The static prefix codes of format version 8 (table_coder.hpp, FORMAT.md
+// §8.5.11): symbols, code lengths, canonical codes and the table block.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "byte_io.hpp"
+#include "table_coder.hpp"
+
+namespace {
+
+using tsm::CodeLengths;
+using tsm::kTableSymbols;
+
+std::array<uint32_t, kTableSymbols> zero_counts() { return std::array<uint32_t, kTableSymbols>{}; }
+
+// Codes values in context 0 (its lengths from their own counts) and reads them back.
+std::vector<int32_t> round_trip(const std::vector<int64_t>& values, size_t* bytes = nullptr) {
+  auto count = zero_counts();
+  for (int64_t v : values) ++count[tsm::table_symbol(v).symbol];
+  std::vector<CodeLengths> lengths(1, tsm::table_code_lengths(count));
+  const auto code = tsm::canonical_codes(lengths[0]);
+  tsm::BitWriter w;
+  for (int64_t v : values) {
+    const tsm::TableSymbol t = tsm::table_symbol(v);
+    w.put(code[t.symbol], lengths[0][t.symbol]);
+    if (t.raw_bits) w.put(t.raw, t.raw_bits);
+  }
+  const std::string bits = w.finish();
+  if (bytes) *bytes = bits.size();
+  const std::string block = tsm::write_tables(lengths);
+  tsm::ByteReader r(block);
+  tsm::TableSet set;
+  std::string why;
+  EXPECT_TRUE(set.read(r, 1, why)) << why;
+  EXPECT_EQ(r.remaining(), 0u);
+  tsm::BitReader br;
+  br.init(bits);
+  std::vector<int32_t> out;
+  for (size_t i = 0; i < values.size(); ++i) {
+    int32_t x = 0;
+    EXPECT_TRUE(set.decode(br, 0, x));
+    out.push_back(x);
+  }
+  EXPECT_FALSE(br.overrun());
+  return out;
+}
+
+TEST(TableCoder, SymbolsCoverEveryResidual) {
+  std::vector<int64_t> values;
+  for (int64_t v = -70; v <= 70; ++v) values.push_back(v);
+  for (int n = 3; n <= 30; ++n)
+    for (int64_t v : {int64_t{1} << (n - 1), (int64_t{1} << n) - 1}) {
+      values.push_back(v);
+      values.push_back(-v);
+    }
+  const std::vector<int32_t> back = round_trip(values);
+  ASSERT_EQ(back.size(), values.size());
+  for (size_t i = 0; i < values.size(); ++i) EXPECT_EQ(back[i], values[i]) << i;
+  EXPECT_EQ(tsm::table_symbol(-3).symbol, 0);
+  EXPECT_EQ(tsm::table_symbol(3).symbol, 6);
+  EXPECT_EQ(tsm::table_symbol(4).symbol, 7);
+  EXPECT_EQ(tsm::table_symbol(-4).symbol, 8);
+  EXPECT_EQ(tsm::table_symbol(-((int64_t{1} << 30) - 1)).symbol, kTableSymbols - 1);
+}
+
+TEST(TableCoder, LengthsAreLimitedAndCanonicalCodesArePrefixFree) {
+  // Fibonacci counts make the unlimited Huffman code as deep as it gets.
+  auto count = zero_counts();
+  uint32_t a = 1, b = 1;
+  for (int s = 0; s < 40; ++s) {
+    count[s] = a;
+    const uint32_t c = a + b;
+    a = b;
+    b = c;
+  }
+  const CodeLengths len = tsm::table_code_lengths(count);
+  uint32_t kraft = 0;
+  for (int s = 0; s < kTableSymbols; ++s) {
+    EXPECT_LE(len[s], tsm::kTableMaxLength);
+    EXPECT_EQ(len[s] != 0, count[s] != 0) << s;
+    if (len[s]) kraft += 1u << (tsm::kTableMaxLength - len[s]);
+  }
+  EXPECT_EQ(kraft, 1u << tsm::kTableMaxLength);  // complete
+  const auto code = tsm::canonical_codes(len);
+  for (int s = 0; s < kTableSymbols; ++s)
+    for (int t = 0; t < kTableSymbols; ++t) {
+      if (s == t || !len[s] || !len[t] || len[s] > len[t]) continue;
+      EXPECT_NE(code[t] >> (len[t] - len[s]), code[s]) << s << " is a prefix of " << t;
+    }
+  // One symbol: a 1-bit code.
+  auto one = zero_counts();
+  one[5] = 100;
+  EXPECT_EQ(tsm::table_code_lengths(one)[5], 1);
+  const std::vector<int32_t> back = round_trip(std::vector<int64_t>(50, 2));
+  EXPECT_EQ(back, std::vector<int32_t>(50, 2));
+}
+
+TEST(TableCoder, SkewedResidualsCostNearTheirEntropy) {
+  std::mt19937 rng(7);
+  std::geometric_distribution<int> geo(0.3);
+  std::vector<int64_t> values;
+  for (int i = 0; i < 20000; ++i) values.push_back((rng() & 1) ? geo(rng) : -geo(rng));
+  size_t bytes = 0;
+  const std::vector<int32_t> back = round_trip(values, &bytes);
+  for (size_t i = 0; i < values.size(); ++i) ASSERT_EQ(back[i], values[i]);
+  // A few bits each (about 3.4 of entropy), nowhere near 8.
+  EXPECT_LT(bytes, values.size() * 4 / 8);
+}
+
+// Every malformed table block is refused with a reason, never read.
+TEST(TableCoder, MalformedTableBlocksAreRefused) {
+  auto refused = [](const std::string& block, int contexts = 4) {
+    tsm::ByteReader r(block);
+    tsm::TableSet set;
+    std::string why;
+    const bool ok = set.read(r, contexts, why);
+    return !ok && !why.empty();
+  };
+  std::string map(tsm::kTableMapBytes, '\0');
+  map[0] = 1;  // context 0
+  EXPECT_FALSE(refused(map + std::string("\x02\x11", 2)));          // lengths 1, 1: complete
+  EXPECT_FALSE(refused(map + std::string("\x01\x10", 2)));          // one symbol of length 1
+  EXPECT_TRUE(refused(map));                                        // its table is missing
+  EXPECT_TRUE(refused(map + std::string("\x00", 1)));               // no symbols
+  EXPECT_TRUE(refused(map + std::string("\x40", 1)));               // 64 symbols
+  EXPECT_TRUE(refused(map + std::string("\x02\x00", 2)));           // every length 0
+  EXPECT_TRUE(refused(map + std::string("\x03\x11\x10", 3)));       // three of length 1: Kraft > 1
+  EXPECT_TRUE(refused(map + std::string("\x01\xC0", 2)));           // length 12
+  EXPECT_TRUE(refused(map + std::string("\x01\x11", 2)));           // padding nibble not zero
+  EXPECT_TRUE(refused(map.substr(0, 10)));                          // the map itself cut
+  std::string far = std::string(tsm::kTableMapBytes, '\0');
+  far[1] = 1;  // context 8, of 4
+  EXPECT_TRUE(refused(far + std::string("\x01\x10", 2)));
+  // A code word no symbol has (an incomplete code) is refused when read.
+  const std::string block = map + std::string("\x01\x10", 2);
+  tsm::ByteReader r(block);
+  tsm::TableSet set;
+  std::string why;
+  ASSERT_TRUE(set.read(r, 4, why));
+  tsm::BitReader br;
+  const std::string ones("\xFF", 1);
+  br.init(ones);
+  int32_t x;
+  EXPECT_FALSE(set.decode(br, 0, x));
+  // Reading past the end is seen.
+  tsm::BitReader empty;
+  empty.init(std::string_view());
+  EXPECT_TRUE(set.decode(empty, 0, x));
+  EXPECT_TRUE(empty.overrun());
+}
+
+}  // namespace
