@@ -37,7 +37,6 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
-#include <type_traits>
 
 #include "byte_io.hpp"
 #include "connectivity.hpp"
@@ -172,6 +171,8 @@ struct DecodeSink {
   }
   uint32_t uint(UIntModel& m, uint32_t) { return m.decode(d); }
   bool truncated() const { return d.overrun() > RangeDecoder::kMaxOverrun; }
+  // Why truncated() holds, for the error message.
+  const char* truncation() const { return "stream is truncated"; }
 };
 
 struct TableDecodeSink : DecodeSink {
@@ -184,6 +185,10 @@ struct TableDecodeSink : DecodeSink {
     return r;
   }
   bool truncated() const { return DecodeSink::truncated() || bits.overrun() || bad_code; }
+  const char* truncation() const {
+    return bad_code ? "a residual's code word is in no table"
+                    : bits.overrun() ? "table-coded bit stream is truncated" : DecodeSink::truncation();
+  }
 };
 
 struct Coder {
@@ -1234,13 +1239,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       ok = st.predictor == Predictor::parallelograms || st.predictor == Predictor::spread
                ? code_greedy(g, c, s, q)
                : code_march_order(g, false, c, s, q);
-    if (!ok || s.truncated()) {
-      if constexpr (std::is_same_v<std::decay_t<decltype(s)>, TableDecodeSink>) {
-        if (s.bad_code) return corrupt("a residual's code word is in no table");
-        if (s.bits.overrun()) return corrupt("table-coded bit stream is truncated");
-      }
-      return corrupt(s.truncated() ? "stream is truncated" : "coordinate outside the grid");
-    }
+    if (!ok || s.truncated()) return corrupt(s.truncated() ? s.truncation() : "coordinate outside the grid");
     if (stats) *stats = st;
     return Status::Ok();
   };

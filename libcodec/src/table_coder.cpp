@@ -5,14 +5,15 @@
 #include <algorithm>
 
 #include "byte_io.hpp"
+#include "range_coder.hpp"  // bit_length
 
 namespace tsm {
 
 TableSymbol table_symbol(int64_t r) {
   if (r >= -kTableDirect && r <= kTableDirect) return {static_cast<int>(r) + kTableDirect, 0, 0};
   const uint32_t mag = static_cast<uint32_t>(r < 0 ? -r : r);
-  const int n = 32 - __builtin_clz(mag);  // 3..30
-  return {2 * kTableDirect + 1 + 2 * (n - 3) + (r < 0 ? 1 : 0), n - 1, mag & ((1u << (n - 1)) - 1)};
+  const int n = bit_length(mag);  // kTableEscapeLength .. kTableMaxBitLength
+  return {2 * kTableDirect + 1 + 2 * (n - kTableEscapeLength) + (r < 0 ? 1 : 0), n - 1, mag & ((1u << (n - 1)) - 1)};
 }
 
 namespace {

@@ -3,7 +3,7 @@
 // canonical prefix code per residual context, stored in the file, instead
 // of the adaptive binary models of range_coder.hpp: one table lookup per
 // value instead of about ten adaptive decisions (6-9x faster to decode,
-// 1-2% larger; README "What table-driven residuals would give"). The
+// 1-2% larger; README "Format version 8 (session 16)"). The
 // contexts are the adaptive coder's (seed 004 §3.2 predicts, the contexts
 // of design notes §6 say how much was known); only the coder changes.
 //
@@ -23,8 +23,10 @@ namespace tsm {
 class ByteReader;
 
 constexpr int kTableDirect = 3;                              // residuals -3..3 are symbols of their own
+constexpr int kTableEscapeLength = 3;                        // bit length of the smallest |r| not direct
 constexpr int kTableMaxBitLength = 30;                       // |r| < 2^30
-constexpr int kTableSymbols = 2 * kTableDirect + 1 + 2 * (kTableMaxBitLength - 2);  // 63
+constexpr int kTableSymbols =
+    2 * kTableDirect + 1 + 2 * (kTableMaxBitLength - kTableEscapeLength + 1);  // 63
 constexpr int kTableMaxLength = 11;                          // longest code word, bits
 constexpr int kTableMapBytes = 27;                           // the used-context map: 210 bits
 
@@ -130,7 +132,7 @@ class TableSet {
       r = s - kTableDirect;
       return true;
     }
-    const int m = s - (2 * kTableDirect + 1), n = (m >> 1) + 3;
+    const int m = s - (2 * kTableDirect + 1), n = (m >> 1) + kTableEscapeLength;
     const uint32_t raw = b.peek(n - 1);
     b.skip(n - 1);
     const int32_t mag = static_cast<int32_t>((uint32_t{1} << (n - 1)) | raw);
