@@ -125,7 +125,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   TSM_RETURN_IF_ERROR(
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
   if (!s.segmented) {
-    out.global.assign(c.vertex_count, kNone);
+    if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
     TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats, s.version));
   } else {
     TSM_RETURN_IF_ERROR(
@@ -395,8 +395,8 @@ OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qi
 bool in_anchor_order(const ConnectivityEncoding& ce, const std::vector<uint32_t>& key) {
   const GeometryLayout& g = ce.layout;
   std::vector<uint8_t> on_triangle(g.vertex_count, 0);
-  for (uint32_t p : g.tri)
-    if (g.vertex[p] != kNone) on_triangle[g.vertex[p]] = 1;
+  for (uint32_t v : g.corners())
+    if (v != kNone) on_triangle[v] = 1;
   uint32_t last = 0;
   for (uint32_t v = 0; v < g.vertex_count; ++v) {
     if (on_triangle[v]) continue;

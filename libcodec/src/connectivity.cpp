@@ -75,8 +75,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   }
   std::vector<uint8_t> cut_he = f.tree_he;
   std::vector<uint32_t> local(m.triangle_count()), corner_pos(m.tri.size());
-  std::vector<uint32_t> comp_tris, scratch_pos, scratch_parent, scratch_edge;
-  std::vector<uint8_t> scratch_slot;
+  std::vector<uint32_t> comp_tris, scratch_corner, scratch_twin, scratch_loop_he;
   // Per pre-order position: which triangle corners reference it, filled as we go.
   std::vector<uint32_t> pos_of(m.vertex_count);
   for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
@@ -164,8 +163,15 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       std::vector<uint32_t> local_loop(cl.loop.size());
       for (size_t p = 0; p < cl.loop.size(); ++p) local_loop[p] = pos_of[cl.loop[p]] - start;
       uint64_t used = 0;
-      TSM_RETURN_IF_ERROR(decode_triangle_tree(static_cast<uint32_t>(cl.loop.size()), tr, local_loop, end - start,
-                                               source, scratch_pos, scratch_parent, scratch_slot, scratch_edge, used));
+      const uint32_t L = static_cast<uint32_t>(cl.loop.size());
+      scratch_corner.resize(3 * size_t{L});
+      scratch_twin.resize(3 * size_t{L});
+      scratch_loop_he.assign(L, kNone);
+      TriangleTreeOut walk;
+      walk.corner = scratch_corner.data();
+      walk.twin = scratch_twin.data();
+      walk.loop_he = scratch_loop_he.data();
+      TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, local_loop, end - start, source, walk, used));
       if (used != tr.bits.size()) return Status(ErrorCode::internal, "marching bits: the walk used another count");
     }
     st.triangle_runs += tr.march.size();
@@ -210,17 +216,16 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   for (uint32_t p = 0; p < P; ++p)
     if (m.kind[f.order[p]] != VertexKind::virtual_ && first_pos[m.source[f.order[p]]] == p)
       g.parent[out_id[p]] = f.parent[p] == kNone ? kNone : out_id[f.parent[p]];
-  g.vertex = out_id;
   g.anchor.assign(g.vertex_count, kNone);
   if (hints.anchor)
     for (uint32_t v = 0; v < g.vertex_count; ++v) g.anchor[v] = (*hints.anchor)[out.vertex_order[v]];
   if (dec_tri.size() != m.triangle_count()) return Status(ErrorCode::internal, "triangle trees lost triangles");
-  g.tri.resize(3 * dec_tri.size());
+  g.corner.resize(3 * dec_tri.size());
   g.twin.resize(3 * dec_tri.size());
   for (size_t k = 0; k < dec_tri.size(); ++k) {
     const uint32_t t = dec_tri[k];
     for (uint32_t e = 0; e < 3; ++e) {
-      g.tri[3 * k + e] = pos_of[m.tri[3 * t + (rot[t] + e) % 3]];
+      g.corner[3 * k + e] = out_id[pos_of[m.tri[3 * t + (rot[t] + e) % 3]]];
       const uint32_t h = m.twin[3 * t + (rot[t] + e) % 3], t2 = h / 3;
       g.twin[3 * k + e] = 3 * dec_of[t2] + (h % 3 + 3 - rot[t2]) % 3;
     }
@@ -279,23 +284,29 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   const bool polygons = dop.bit(om.has_polygons);
   if (C > max_positions) return corrupt("more components than vertices");
 
-  std::vector<uint32_t> parent;       // global pre-order parent positions
-  std::vector<uint32_t>& tri_vertex = layout.tri;  // decoded triangles, pre-order positions
-  tri_vertex.clear();
-  std::vector<uint32_t> tri_parent;   // global decode index of the parent triangle
-  std::vector<uint8_t> tri_slot, tri_glued;
-  std::vector<uint32_t> local_parent, loop, loop_twin, tri_pos, tparent, edge_loop, loop_he;
-  std::vector<uint32_t>& twin = layout.twin;  // per decoded half-edge
+  std::vector<uint32_t> parent;  // global pre-order parent positions
+  // Decoded triangles, written in place by the triangle tree walk: per
+  // half-edge the pre-order position at its origin (output vertex ids once
+  // the topology stream has numbered them) and the half-edge across it.
+  std::vector<uint32_t>& corner = layout.corner;
+  std::vector<uint32_t>& twin = layout.twin;
+  corner.clear();
   twin.clear();
-  std::vector<uint8_t> tslot;
+  layout.corner_ref = nullptr;
+  // Polygons only: per triangle its parent (global decode index), the
+  // parent's edge it shares and whether it is glued to the parent there.
+  std::vector<uint32_t> tri_parent;
+  std::vector<uint8_t> tri_slot, tri_glued;
+  std::vector<uint32_t> local_parent, loop, loop_twin, loop_he;
   std::vector<std::pair<uint32_t, uint32_t>> stack;  // branching node, runs started at it so far
   // The header's counts are within the streams' budget (check_budget): the
-  // common case (one surface, triangles) then grows no array while decoding.
-  parent.reserve(vertex_count + 1);
-  tri_vertex.reserve(corner_count);
-  tri_parent.reserve(corner_count / 3);
-  tri_slot.reserve(corner_count / 3);
-  tri_glued.reserve(corner_count / 3);
+  // common case then grows no array while decoding (holes add a triangle
+  // per hole edge, polygons up to 6 half-edges per 4 corners; reserving
+  // touches no memory).
+  parent.reserve(vertex_count + vertex_count / 8 + 64);  // virtual vertices and duplicates beyond the count
+  const size_t half_edges = corner_count + corner_count / 2 + 96;
+  corner.reserve(half_edges);
+  twin.reserve(half_edges);
   int prev_leaf = 1;
   for (uint32_t c = 0; c < C; ++c) {
     const uint32_t start = static_cast<uint32_t>(parent.size());
@@ -336,12 +347,12 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     uint32_t nj = om.count.decode(dop);
     if (nj > max_jumps || nj % 2 || overrun()) return corrupt("bad jump edge count");
     std::vector<JumpEndpoint> jumps(nj);
-    uint32_t corner = 0;
+    uint32_t jump_corner = 0;
     for (uint32_t i = 0; i < nj; ++i) {
       uint32_t d = om.corner.decode(dop);
       if (d > 2 * n) return corrupt("jump edge corner out of range");
-      corner += d;
-      jumps[i] = {corner, 0, kNone};
+      jump_corner += d;
+      jumps[i] = {jump_corner, 0, kNone};
     }
     for (uint32_t i = 0; i < nj; ++i) {
       if (jumps[i].partner != kNone) continue;
@@ -381,41 +392,44 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       Source(RangeDecoder& dec, Prob* p) : d(dec), probs(p) {}
       int bit(int ctx) override { return d.bit(probs[ctx]); }
     } source(dt, tm.bit);
+    const uint32_t T = L - 2, base = static_cast<uint32_t>(corner.size() / 3);
+    if (uint64_t{base} + T > corner_count + max_positions) return corrupt("more triangles than the header allows");
+    corner.resize(3 * (size_t{base} + T));
+    twin.resize(3 * (size_t{base} + T), kNone);
+    loop_he.assign(L, kNone);
+    TriangleTreeOut walk;
+    walk.corner = corner.data() + 3 * size_t{base};
+    walk.twin = twin.data();
+    walk.loop_he = loop_he.data();
+    walk.vertex_base = start;
+    walk.he_base = 3 * base;
+    if (polygons) {
+      tri_parent.resize(size_t{base} + T);
+      tri_slot.resize(size_t{base} + T);
+      tri_glued.resize(size_t{base} + T, 0);
+      walk.parent = tri_parent.data() + base;
+      walk.slot = tri_slot.data() + base;
+    }
     uint64_t used = 0;
-    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, loop, n, source, tri_pos, tparent, tslot, edge_loop, used));
+    TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, loop, n, source, walk, used));
     st.marching_bits += used;
     if (overrun()) return corrupt("triangle tree stream is truncated");
-    const uint32_t T = L - 2, base = static_cast<uint32_t>(tri_parent.size());
-    // Half-edges across: parent and child share the gate; each loop edge
-    // meets the loop edge that walks the same cut edge the other way.
-    twin.resize(3 * (static_cast<size_t>(base) + T), kNone);
-    loop_he.assign(L, kNone);
-    for (uint32_t h = 0; h < 3 * T; ++h)
-      if (edge_loop[h] != kNone) {
-        if (loop_he[edge_loop[h]] != kNone) return corrupt("a loop edge belongs to two triangles");
-        loop_he[edge_loop[h]] = 3 * base + h;
+    // Each loop edge meets the loop edge that walks the same cut edge the
+    // other way (parent and child were paired by the walk). With loop_twin
+    // an involution without fixed points, every pair is mutual: the cut
+    // surface closes (no half-edge is left without a twin: checked below).
+    for (uint32_t p = 0; p < L; ++p) {
+      const uint32_t o = loop_twin[p];
+      if (loop_he[p] == kNone || o >= L || o == p || loop_twin[o] != p) return corrupt("the cut surface does not close");
+      twin[loop_he[p]] = loop_he[o];
+    }
+    if (polygons)
+      for (uint32_t k = 0; k < T; ++k) {
+        uint32_t& par = tri_parent[base + k];
+        if (par != kNone) par += base;
+        if (k > 0)
+          tri_glued[base + k] = static_cast<uint8_t>(dt.bit(tm.diagonal[k == 1 ? 0 : tri_glued[base + k - 1]]));
       }
-    uint32_t* tw = twin.data() + 3 * size_t{base};
-    for (uint32_t h = 0; h < 3 * T; ++h)
-      if (edge_loop[h] != kNone) tw[h] = loop_he[loop_twin[edge_loop[h]]];
-    for (uint32_t k = 1; k < T; ++k) {  // the edge a triangle is entered by (its slot 0) is its parent's slot
-      const uint32_t par = 3 * (base + tparent[k]) + tslot[k];
-      tw[3 * k] = par;
-      twin[par] = 3 * (base + k);
-    }
-    tri_vertex.resize(3 * (size_t{base} + T));
-    tri_parent.resize(size_t{base} + T);
-    tri_slot.resize(size_t{base} + T);
-    tri_glued.resize(size_t{base} + T, 0);
-    uint32_t* tv = tri_vertex.data() + 3 * size_t{base};
-    for (uint32_t h = 0; h < 3 * T; ++h) tv[h] = start + loop[tri_pos[h]];
-    for (uint32_t k = 0; k < T; ++k) {
-      tri_parent[base + k] = tparent[k] == kNone ? kNone : base + tparent[k];
-      tri_slot[base + k] = tslot[k];
-      if (polygons && k > 0)
-        tri_glued[base + k] = static_cast<uint8_t>(dt.bit(tm.diagonal[k == 1 ? 0 : tri_glued[base + k - 1]]));
-    }
-    if (tri_vertex.size() > 3 * (corner_count + max_positions)) return corrupt("more triangles than the header allows");
   }
 
   // Vertex kinds and output ids.
@@ -456,8 +470,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (next_id != vertex_count)
     return corrupt("connectivity gives " + std::to_string(next_id) + " vertices, the header says " +
                    std::to_string(vertex_count));
-  for (size_t h = 0; h < twin.size(); ++h)
-    if (twin[h] >= twin.size() || twin[twin[h]] != h) return corrupt("the cut surface does not close");
+  // Pairs are mutual by construction (the walk pairs parent and child, the
+  // loop pairs above); a half-edge that got no twin is the one way left.
+  if (std::find(twin.begin(), twin.end(), kNone) != twin.end()) return corrupt("the cut surface does not close");
   layout.vertex_count = static_cast<uint32_t>(vertex_count);
   layout.parent.assign(vertex_count, kNone);
   for (uint32_t p = 0; p < P; ++p) {
@@ -467,12 +482,29 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       layout.parent[out_id[p]] = out_id[parent[p]];
     }
   }
-  layout.vertex = out_id;
+  // Triangle corners: pre-order positions -> output vertex ids (kNone:
+  // virtual); without virtual vertices and stitches they are the same.
+  if (nvirt != 0 || nstitch != 0)
+    for (uint32_t& x : corner) x = out_id[x];
+
+  // Side faces: kept verbatim (the topology stream's last list).
+  const uint32_t nside = om.count.decode(dop);
+  if (nside > face_count) return corrupt("more side faces than faces");
+  std::vector<uint32_t> side, side_start(1, 0);
+  for (uint32_t i = 0; i < nside; ++i) {
+    uint32_t n = om.face_size.decode(dop);
+    if (n > corner_count || side.size() + n > corner_count || overrun()) return corrupt("bad side face size");
+    for (uint32_t j = 0; j < n; ++j) {
+      side.push_back(om.index.decode(dop));
+      if (side.back() >= vertex_count) return corrupt("side face corner out of range");
+    }
+    side_start.push_back(static_cast<uint32_t>(side.size()));
+  }
 
   // Faces: triangles in decode order, polygons glued along flagged edges.
   out.face_offsets.assign(1, 0);
   out.indices.clear();
-  const uint32_t NT = static_cast<uint32_t>(tri_parent.size());
+  const uint32_t NT = static_cast<uint32_t>(corner.size() / 3);
   out.face_offsets.reserve(std::min<uint64_t>(face_count, NT) + 1);
   out.indices.reserve(std::min<uint64_t>(corner_count, 3 * uint64_t{NT}));
   std::vector<uint32_t> node_vertex, node_next, edge_node;
@@ -489,15 +521,38 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     out.face_offsets.push_back(static_cast<uint32_t>(out.indices.size()));
     return true;
   };
-  for (uint32_t k = 0; k < NT; ++k) {
-    const uint32_t* tv = &tri_vertex[3 * static_cast<size_t>(k)];
-    if (is_virtual[tv[0]] || is_virtual[tv[1]] || is_virtual[tv[2]]) {
-      if (tri_glued[k]) return corrupt("a virtual triangle is flagged as part of a polygon");
-      continue;
+  if (!polygons && nvirt == 0 && nside == 0) {
+    // Every triangle is a face: the corners are the indices (the layout
+    // reads them there).
+    if (NT > face_count || 3 * uint64_t{NT} > corner_count) return corrupt("more faces than the header says");
+    out.indices = std::move(corner);
+    corner = std::vector<uint32_t>();
+    layout.corner_ref = &out.indices;
+    out.face_offsets.resize(size_t{NT} + 1);
+    for (uint32_t k = 0; k <= NT; ++k) out.face_offsets[k] = 3 * k;
+  } else if (!polygons) {
+    // Triangles, skipping virtual ones, straight into the output.
+    const size_t max_faces = std::min<uint64_t>({face_count, NT, corner_count / 3});
+    out.face_offsets.resize(max_faces + 1);
+    out.indices.resize(3 * max_faces);
+    uint32_t* fo = out.face_offsets.data();
+    uint32_t* ix = out.indices.data();
+    size_t nf = 0;
+    for (uint32_t k = 0; k < NT; ++k) {
+      const uint32_t* c = &corner[3 * static_cast<size_t>(k)];
+      if (c[0] == kNone || c[1] == kNone || c[2] == kNone) continue;
+      if (nf == max_faces) return corrupt("more faces than the header says");
+      std::copy(c, c + 3, ix + 3 * nf);
+      ++nf;
+      fo[nf] = static_cast<uint32_t>(3 * nf);
     }
-    uint32_t c[3] = {out_id[tv[0]], out_id[tv[1]], out_id[tv[2]]};
-    if (!polygons) {
-      if (!push_face(c, 3)) return corrupt("more faces than the header says");
+    out.face_offsets.resize(nf + 1);
+    out.indices.resize(3 * nf);
+  }
+  for (uint32_t k = 0; polygons && k < NT; ++k) {
+    const uint32_t* c = &corner[3 * static_cast<size_t>(k)];
+    if (c[0] == kNone || c[1] == kNone || c[2] == kNone) {
+      if (tri_glued[k]) return corrupt("a virtual triangle is flagged as part of a polygon");
       continue;
     }
     if (!tri_glued[k]) {
@@ -551,9 +606,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
         // The apex is a corner of every triangle of the fan: count corners.
         count.assign(poly.size(), 0);
         for (uint32_t i = member_start[k]; i < member_start[k + 1]; ++i) {
-          const uint32_t* tv = &tri_vertex[3 * static_cast<size_t>(members[i])];
+          const uint32_t* tv = &corner[3 * static_cast<size_t>(members[i])];
           for (int c = 0; c < 3; ++c) {
-            auto it = std::find(poly.begin(), poly.end(), out_id[tv[c]]);
+            auto it = std::find(poly.begin(), poly.end(), tv[c]);
             if (it != poly.end()) count[static_cast<size_t>(it - poly.begin())]++;
           }
         }
@@ -564,20 +619,10 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     }
   }
 
-  // Side faces.
-  uint32_t nside = om.count.decode(dop);
-  if (nside > face_count) return corrupt("more side faces than faces");
-  std::vector<uint32_t> corners;
-  for (uint32_t i = 0; i < nside; ++i) {
-    uint32_t n = om.face_size.decode(dop);
-    if (n > corner_count || overrun()) return corrupt("bad side face size");
-    corners.resize(n);
-    for (uint32_t j = 0; j < n; ++j) {
-      corners[j] = om.index.decode(dop);
-      if (corners[j] >= vertex_count) return corrupt("side face corner out of range");
-    }
-    if (!push_face(corners.data(), n)) return corrupt("more faces than the header says");
-  }
+  // Side faces (decoded above), after the triangles and polygons.
+  for (uint32_t i = 0; i < nside; ++i)
+    if (!push_face(side.data() + side_start[i], side_start[i + 1] - side_start[i]))
+      return corrupt("more faces than the header says");
   if (overrun()) return corrupt("connectivity streams are truncated");
   if (out.face_count() != face_count || out.indices.size() != corner_count)
     return corrupt("connectivity gives " + std::to_string(out.face_count()) + " faces and " +

@@ -211,18 +211,31 @@ struct MarchBitSource {
   virtual ~MarchBitSource() = default;
 };
 
-// Decoder (and encoder, to share the contexts): triangles as loop-position
-// triples, in decode order; each non-root triangle's first edge is the one
-// shared with its parent. parent[k] is the decode index of triangle k's
-// parent (kNone for the root). edge_loop[3k + e] is the loop position p
-// when edge e of triangle k is loop edge p (loop[p] -> loop[p+1]), kNone
-// when it is shared with a triangle of the same tree. runs.bits is unused:
-// bits come from `bits`; loop maps loop positions to the component's local
-// vertices (n of them), for the valence contexts.
+// Where decode_triangle_tree writes the triangles it walks, in decode order
+// k = 0..T-1 (T = loop length - 2); half-edge 3k + e of the tree is global
+// half-edge he_base + 3k + e. Each non-root triangle's edge 0 is the one it
+// shares with its parent.
+//   corner[3k + e]   vertex_base + loop[loop position of corner e]
+//   twin[he_base + 3k] and the parent's shared edge: paired (global ids);
+//                    loop edges are left alone (loop_he pairs them)
+//   loop_he[p]       the global half-edge that is loop edge p (loop[p] ->
+//                    loop[p+1]); kNone on entry (a position claimed twice is
+//                    refused)
+//   parent, slot     optional (null: not written): per triangle its parent's
+//                    decode index (kNone at the root) and the parent's edge
+struct TriangleTreeOut {
+  uint32_t* corner = nullptr;
+  uint32_t* twin = nullptr;
+  uint32_t* loop_he = nullptr;
+  uint32_t vertex_base = 0, he_base = 0;
+  uint32_t* parent = nullptr;
+  uint8_t* slot = nullptr;
+};
+// Decoder (and encoder, to share the contexts): the walk of the triangle
+// tree. runs.bits is unused: bits come from `bits`; loop maps loop positions
+// to the component's local vertices (n of them), for the valence contexts.
 Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, const std::vector<uint32_t>& loop,
-                            uint32_t n, MarchBitSource& bits, std::vector<uint32_t>& tri_pos,
-                            std::vector<uint32_t>& parent, std::vector<uint8_t>& parent_edge,
-                            std::vector<uint32_t>& edge_loop, uint64_t& bit_count);
+                            uint32_t n, MarchBitSource& bits, const TriangleTreeOut& out, uint64_t& bit_count);
 
 // Stage 5: the whole connectivity, coded.
 struct ConnectivityStats {

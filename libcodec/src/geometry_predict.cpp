@@ -86,16 +86,23 @@ struct MixModels {
   MixWeights w[3][kMixCtx][kMixKinds<kMantissa>];
 };
 
-struct ResidualModels {
-  ResidualModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
-  ResidualModel m[3][kClasses][kActivity];
-  // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
-  // then the lattice index offset from the plane nearest the prediction.
+// The surface residuals' adaptive models, one per context (coding position,
+// predictor class, activity), numbered as the tables number them (context
+// (i * kClasses + cls) * kActivity + ctx). Not allocated when the residuals
+// go through tables (about 1.8 MB that the decoder would otherwise set up).
+constexpr int kTableContexts = 3 * kClasses * kActivity;
+struct SurfaceModels {
+  SurfaceModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
+  ResidualModel m[kTableContexts];
+};
+
+// Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
+// then the lattice index offset from the plane nearest the prediction.
+// Allocated on the first lattice decision.
+struct LatticeModels {
+  LatticeModels() {}  // as SurfaceModels
   Prob on[3][3];
   ResidualModel index[3][3][kActivity];
-  // Vertices on no triangle: predicted from an anchor surface vertex.
-  Prob has_anchor;
-  UIntModel anchor_gap;
 };
 
 // The encoder's and decoder's view of the coded symbols; everything else in
@@ -113,7 +120,7 @@ struct EncodeSink {
     return static_cast<int32_t>(v);
   }
   // A surface residual (context: Coder::vertex's, numbered for the tables).
-  int32_t residual(ResidualModel& m, int, int64_t v) { return sint(m, v); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t v) { return sint(m->m[ctx], v); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t v) {
     MixEncodeOp op{e};
     return code_mixed_sint(op, a, b, w, static_cast<int32_t>(v));
@@ -130,7 +137,7 @@ struct CollectSink {
   static constexpr bool kEncoder = true;
   int bit(Prob&, int b) { return b; }
   int32_t sint(ResidualModel&, int64_t v) { return static_cast<int32_t>(v); }
-  int32_t residual(ResidualModel&, int, int64_t v) { return static_cast<int32_t>(v); }
+  int32_t residual(SurfaceModels*, int, int64_t v) { return static_cast<int32_t>(v); }
   int32_t sint_mixed(ResidualModel&, ResidualModel&, MixWeights*, int64_t v) { return static_cast<int32_t>(v); }
   uint32_t uint(UIntModel&, uint32_t v) { return v; }
   bool truncated() const { return false; }
@@ -139,10 +146,9 @@ struct CollectSink {
 // Version 8 (kTableFlag): the surface residuals through static prefix codes
 // per context, everything else through the range coder as before. The
 // encoder counts the symbols in a first pass, builds the codes, then codes.
-constexpr int kTableContexts = 3 * kClasses * kActivity;
 struct TableCountSink : CollectSink {
   std::vector<std::array<uint32_t, kTableSymbols>> count = std::vector<std::array<uint32_t, kTableSymbols>>(kTableContexts);
-  int32_t residual(ResidualModel&, int ctx, int64_t v) {
+  int32_t residual(SurfaceModels*, int ctx, int64_t v) {
     ++count[ctx][table_symbol(v).symbol];
     return static_cast<int32_t>(v);
   }
@@ -151,7 +157,7 @@ struct TableEncodeSink : EncodeSink {
   std::vector<CodeLengths> length;
   std::vector<std::array<uint32_t, kTableSymbols>> code;
   BitWriter bits;
-  int32_t residual(ResidualModel&, int ctx, int64_t v) {
+  int32_t residual(SurfaceModels*, int ctx, int64_t v) {
     const TableSymbol t = table_symbol(v);
     bits.put(code[ctx][t.symbol], length[ctx][t.symbol]);
     if (t.raw_bits) bits.put(t.raw, t.raw_bits);
@@ -164,7 +170,7 @@ struct DecodeSink {
   RangeDecoder d;
   int bit(Prob& p, int) { return d.bit(p); }
   int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
-  int32_t residual(ResidualModel& m, int, int64_t) { return m.decode(d); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t) { return m->m[ctx].decode(d); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t) {
     MixDecodeOp op{d};
     return code_mixed_sint(op, a, b, w, 0);
@@ -179,7 +185,7 @@ struct TableDecodeSink : DecodeSink {
   TableSet tables;
   BitReader bits;
   bool bad_code = false;  // a code word no table assigns, or a context without a table
-  int32_t residual(ResidualModel&, int ctx, int64_t) {
+  int32_t residual(SurfaceModels*, int ctx, int64_t) {
     int32_t r = 0;
     if (!tables.has(ctx) || !tables.decode(bits, ctx, r)) bad_code = true;
     return r;
@@ -192,8 +198,21 @@ struct TableDecodeSink : DecodeSink {
 };
 
 struct Coder {
-  Coder(uint32_t vertex_count, int bits) : act(vertex_count, kUnknown), qmax((int64_t{1} << bits) - 1) {}
-  std::unique_ptr<ResidualModels> models = std::make_unique<ResidualModels>();
+  // surface_models: false when the surface residuals go through tables (or
+  // there are none: the raw predictor).
+  Coder(uint32_t vertex_count, int bits, bool surface_models)
+      : act(vertex_count, kUnknown), qmax((int64_t{1} << bits) - 1) {
+    if (surface_models) surface = std::make_unique<SurfaceModels>();
+  }
+  std::unique_ptr<SurfaceModels> surface;
+  std::unique_ptr<LatticeModels> lattice_models;  // made on the first lattice decision
+  LatticeModels& lat() {
+    if (!lattice_models) lattice_models = std::make_unique<LatticeModels>();
+    return *lattice_models;
+  }
+  // Vertices on no triangle: predicted from an anchor surface vertex.
+  Prob has_anchor;
+  UIntModel anchor_gap;
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
   int64_t qmax;
   Lattice lattice;
@@ -293,9 +312,10 @@ struct Coder {
           on = it != L.end() && *it == x;
           jx = static_cast<size_t>(it - L.begin());
         }
-        on = s.bit(models->on[a][on_count], on);
+        LatticeModels& lm = lat();
+        on = s.bit(lm.on[a][on_count], on);
         if (on) {
-          int64_t d = s.sint(models->index[a][on_count][ctx], static_cast<int64_t>(jx) - static_cast<int64_t>(j));
+          int64_t d = s.sint(lm.index[a][on_count][ctx], static_cast<int64_t>(jx) - static_cast<int64_t>(j));
           int64_t k = static_cast<int64_t>(j) + d;
           if (k < 0 || k >= static_cast<int64_t>(L.size())) return false;
           x = L[static_cast<size_t>(k)];
@@ -307,10 +327,10 @@ struct Coder {
         int64_t r;
         if (mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
-          r = s.sint_mixed(models->m[i][cls][ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
+          r = s.sint_mixed(surface->m[(i * kClasses + cls) * kActivity + ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
                            static_cast<int64_t>(x) - p);
         } else {
-          r = s.residual(models->m[i][cls][ctx], (i * kClasses + cls) * kActivity + ctx, static_cast<int64_t>(x) - p);
+          r = s.residual(surface.get(), (i * kClasses + cls) * kActivity + ctx, static_cast<int64_t>(x) - p);
         }
         if (p + r < 0 || p + r > qmax) return false;
         x = static_cast<uint32_t>(p + r);
@@ -373,12 +393,11 @@ struct SurfaceCoder {
   std::vector<uint32_t>& q;
   int64_t last[3];
   int last_act = 0;
-  std::vector<uint32_t> cv;  // per half-edge: the output vertex at its origin (kNone: virtual), one load less
+  const std::vector<uint32_t>& cv;  // per half-edge: the output vertex at its origin (kNone: virtual)
 
   SurfaceCoder(const GeometryLayout& layout, Coder& coder, Sink& sink, std::vector<uint32_t>& qs)
-      : g(layout), c(coder), s(sink), q(qs), cv(layout.tri.size()) {
+      : g(layout), c(coder), s(sink), q(qs), cv(layout.corners()) {
     for (int a = 0; a < 3; ++a) last[a] = (c.qmax + 1) / 2;
-    for (size_t h = 0; h < cv.size(); ++h) cv[h] = g.vertex[g.tri[h]];
   }
   uint32_t known(uint32_t h) const {  // output vertex at the origin of half-edge h if decoded, else kNone
     uint32_t v = cv[h];
@@ -394,7 +413,7 @@ struct SurfaceCoder {
     do {
       f(h);
       h = he_next(g.twin[h]);
-    } while (h != h0 && ++guard < g.tri.size());
+    } while (h != h0 && ++guard < g.corners().size());
   }
   // Per output vertex, its smallest half-edge (kNone for one on no
   // triangle); built on first use.
@@ -510,8 +529,8 @@ struct SurfaceCoder {
         if (x != kNone && x >= prev_anchor && c.act[x] != kUnknown) anchor = x;
       }
       int64_t pred[3];
-      if (s.bit(c.models->has_anchor, anchor != kNone)) {
-        uint32_t gap = s.uint(c.models->anchor_gap, anchor - prev_anchor);
+      if (s.bit(c.has_anchor, anchor != kNone)) {
+        uint32_t gap = s.uint(c.anchor_gap, anchor - prev_anchor);
         anchor = prev_anchor + gap;
         if (gap == 0xFFFFFFFFu || anchor < prev_anchor || anchor >= g.vertex_count || c.act[anchor] == kUnknown)
           return false;
@@ -539,7 +558,7 @@ struct SurfaceCoder {
 template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
-  for (uint32_t h0 = 0; h0 < g.tri.size(); ++h0) {
+  for (uint32_t h0 = 0; h0 < g.corners().size(); ++h0) {
     if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
     if (!sc.code(h0, multi)) return false;
     if ((h0 & 4095) == 0 && s.truncated()) return false;
@@ -556,7 +575,7 @@ template <class Sink>
 bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   const uint32_t n = g.vertex_count;
-  const uint32_t H = static_cast<uint32_t>(g.tri.size());
+  const uint32_t H = static_cast<uint32_t>(g.corners().size());
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
   std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
   constexpr int kBuckets = 16;
@@ -787,7 +806,7 @@ void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predi
 // squares and by the size estimate (fit_alpha); the caller codes both.
 void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                 int32_t lsq[3], int32_t est[3]) {
-  Coder fit(g.vertex_count, bits);
+  Coder fit(g.vertex_count, bits, false);
   collect_pass(g, q, pred, fit);
   for (int k = 0; k < 3; ++k) {
     est[k] = fit_alpha(fit.samples[k]);
@@ -806,7 +825,7 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
 // estimate (0 .. 1.5).
 void fit_betas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                const Lattice& lattice, const int32_t* weights, int32_t beta[2]) {
-  Coder fit(g.vertex_count, bits);
+  Coder fit(g.vertex_count, bits, false);
   fit.tangent = true;
   fit.lattice = lattice;
   fit.build_nearest();
@@ -830,7 +849,7 @@ int index_bits(size_t planes) {
 std::string encode_geometry_raw(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits,
                                 const Lattice& lattice, bool top) {
   EncodeSink s;
-  Coder c(g.vertex_count, bits);
+  Coder c(g.vertex_count, bits, false);
   c.lattice = lattice;
   c.planes_from_top = top;
   code_lattice(s, c);
@@ -916,7 +935,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
     }
   // One coding pass with a given sink (the table encoder makes two).
   auto pass = [&](auto& s) {
-    Coder c(g.vertex_count, bits);
+    Coder c(g.vertex_count, bits, !tables);
     c.spread_ctx = pred == Predictor::spread;
     if (mix) c.mix = std::make_unique<MixModels>();
     std::copy(alpha, alpha + 3, c.alpha);
@@ -961,8 +980,8 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
   const uint32_t n = g.vertex_count;
   std::vector<uint32_t> anchor(n, kNone);
   std::vector<uint8_t> on_surface(n, 0);
-  for (uint32_t p : g.tri)
-    if (g.vertex[p] != kNone) on_surface[g.vertex[p]] = 1;
+  for (uint32_t v : g.corners())
+    if (v != kNone) on_surface[v] = 1;
   uint32_t surface = 0;
   for (uint32_t v = 0; v < n; ++v) surface += on_surface[v];
   if (surface == 0 || surface == n) return anchor;
@@ -1178,7 +1197,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     return corrupt(st.mix ? "residual mixing and tables at once" : "the raw predictor has no residuals for tables");
   if (st.predictor == Predictor::raw) {
     q.assign(3 * static_cast<size_t>(g.vertex_count), 0);
-    Coder c(g.vertex_count, bits);
+    Coder c(g.vertex_count, bits, false);
     c.planes_from_top = st.top;
     DecodeSink ds;
     ds.d.init(bytes.substr(1));
@@ -1209,7 +1228,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       if (!r.u16(x)) return corrupt("truncated predictor header");
       alpha[k] = static_cast<int16_t>(x);
     }
-  Coder c(g.vertex_count, bits);
+  Coder c(g.vertex_count, bits, !st.tables);
   if (st.tangent) {
     c.tangent = true;
     for (int i = 0; i < 2; ++i) {

@@ -14,9 +14,16 @@ namespace tsm {
 // The decoded surface as the geometry coder sees it. The connectivity encoder
 // and decoder build it identically, so the predictors see the same mesh.
 struct GeometryLayout {
-  std::vector<uint32_t> tri;     // 3 per triangle: cut-surface position, in decode order, ccw
-  std::vector<uint32_t> twin;    // per half-edge 3k+e (corner e -> e+1): the half-edge across it
-  std::vector<uint32_t> vertex;  // per position: output vertex id, kNone for a virtual vertex
+  // Per half-edge 3k+e of triangle k (decode order, ccw; corner e -> e+1):
+  // the output vertex at its origin (kNone: a virtual vertex), and the
+  // half-edge across it.
+  // The decoder may instead point corner_ref at the output mesh's indices
+  // when they are the same list (no virtual triangles, no polygons): read
+  // the corners through corners(), and keep that mesh in place meanwhile.
+  std::vector<uint32_t> corner;
+  const std::vector<uint32_t>* corner_ref = nullptr;
+  const std::vector<uint32_t>& corners() const { return corner_ref ? *corner_ref : corner; }
+  std::vector<uint32_t> twin;
   std::vector<uint32_t> parent;  // per output vertex: its vertex-tree parent (kNone at roots)
   std::vector<uint32_t> anchor;  // encoder: per output vertex on no triangle, a surface vertex near it (or kNone)
   uint32_t vertex_count = 0;     // output vertices

@@ -109,11 +109,12 @@ std::vector<std::vector<uint32_t>> split_faces(const Mesh& mesh, const std::vect
 
 std::vector<uint8_t> reference_contexts(const GeometryLayout& g) {
   std::vector<uint8_t> ctx(g.vertex_count, 0);
-  for (size_t t = 0; t + 2 < g.tri.size(); t += 3) {
+  const std::vector<uint32_t>& corner = g.corners();
+  for (size_t t = 0; t + 2 < corner.size(); t += 3) {
     bool hole = false;
-    for (int k = 0; k < 3; ++k) hole = hole || g.vertex[g.tri[t + k]] == kNone;
+    for (int k = 0; k < 3; ++k) hole = hole || corner[t + k] == kNone;
     for (int k = 0; k < 3; ++k) {
-      const uint32_t v = g.vertex[g.tri[t + k]];
+      const uint32_t v = corner[t + k];
       if (v != kNone) ctx[v] = std::max<uint8_t>(ctx[v], hole ? 2 : 1);
     }
   }
@@ -180,10 +181,10 @@ GeometryLayout own_layout(const GeometryLayout& g, const std::vector<uint32_t>& 
   for (uint32_t v = 0; v < g.vertex_count; ++v)
     if (global[v] == kNone) rank[v] = n++;
   o.vertex_count = n;
-  o.tri = g.tri;
   o.twin = g.twin;
-  o.vertex.resize(g.vertex.size());
-  for (size_t p = 0; p < g.vertex.size(); ++p) o.vertex[p] = g.vertex[p] == kNone ? kNone : rank[g.vertex[p]];
+  const std::vector<uint32_t>& corner = g.corners();
+  o.corner.resize(corner.size());
+  for (size_t h = 0; h < corner.size(); ++h) o.corner[h] = corner[h] == kNone ? kNone : rank[corner[h]];
   o.parent.assign(n, kNone);
   if (!g.anchor.empty()) o.anchor.assign(n, kNone);
   for (uint32_t v = 0; v < g.vertex_count; ++v) {

@@ -86,9 +86,7 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
 }
 
 Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vector<uint32_t>& loop, uint32_t n,
-                            MarchBitSource& bits, std::vector<uint32_t>& tri_pos, std::vector<uint32_t>& parent,
-                            std::vector<uint8_t>& parent_edge, std::vector<uint32_t>& edge_loop,
-                            uint64_t& bit_count) {
+                            MarchBitSource& bits, const TriangleTreeOut& out, uint64_t& bit_count) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "triangle tree: " + what); };
   const size_t nr = runs.march.size();
   if (L < 4 || runs.root >= L) return corrupt("bad loop length or root position");
@@ -113,12 +111,10 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   if (sizes.size() != 1 || sizes[0] != L - 3) return corrupt("runs do not add up to one tree of loop length - 2 triangles");
 
   const uint32_t T = L - 2;
-  tri_pos.resize(3 * static_cast<size_t>(T));
-  parent.resize(T);
-  parent_edge.resize(T);
-  edge_loop.assign(3 * static_cast<size_t>(T), kNone);
-  auto fwd = [L](uint32_t p, uint32_t d) { return (p + d) % L; };
-  auto bwd = [L](uint32_t p, uint32_t d) { return (p + L - d) % L; };
+  // Loop positions move by less than L: a compare instead of a division.
+  auto fwd = [L](uint32_t p, uint32_t d) { return p + d >= L ? p + d - L : p + d; };
+  auto bwd = [L](uint32_t p, uint32_t d) { return p >= d ? p - d : p + L - d; };
+  auto span_of = [L](uint32_t a, uint32_t b) { return a >= b ? a - b : a + L - b; };  // (a - b) mod L
   if (loop.size() != L) return corrupt("loop length mismatch");
   std::vector<uint32_t> valence(n, 0);  // triangles emitted so far around each vertex
   std::vector<uint8_t> visits(n, 0);    // loop positions of each vertex (its tree degree), capped at 3
@@ -126,22 +122,41 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
     if (loop[p] >= n) return corrupt("loop vertex out of range");
     if (visits[loop[p]] < 3) ++visits[loop[p]];
   }
+  uint32_t* const corner = out.corner;
+  uint32_t* const twin = out.twin;
+  uint32_t* const loop_he = out.loop_he;
+  const uint32_t vb = out.vertex_base, hb = out.he_base;
   uint32_t k = 0;
+  // Triangle (a, b, x) entered through the parent's edge `slot`.
   auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) {
-    ++valence[loop[a]];
-    ++valence[loop[b]];
-    ++valence[loop[x]];
-    tri_pos[3 * k] = a;
-    tri_pos[3 * k + 1] = b;
-    tri_pos[3 * k + 2] = x;
-    parent[k] = par;
-    parent_edge[k] = slot;
+    const uint32_t va = loop[a], vbb = loop[b], vx = loop[x];
+    ++valence[va];
+    ++valence[vbb];
+    ++valence[vx];
+    uint32_t* c = corner + 3 * size_t{k};
+    c[0] = vb + va;
+    c[1] = vb + vbb;
+    c[2] = vb + vx;
+    if (par != kNone) {
+      const uint32_t ph = hb + 3 * par + slot;
+      twin[hb + 3 * size_t{k}] = ph;
+      twin[ph] = hb + 3 * k;
+    }
+    if (out.parent) {
+      out.parent[k] = par;
+      out.slot[k] = slot;
+    }
     return k++;
+  };
+  bool twice = false;  // a loop edge claimed by two triangles (a forged file)
+  auto on_loop = [&](uint32_t p, uint32_t t, uint32_t e) {
+    twice |= loop_he[p] != kNone;
+    loop_he[p] = hb + 3 * t + e;
   };
   const uint32_t r = runs.root;
   emit(bwd(r, 1), r, fwd(r, 1), kNone, 0);
-  edge_loop[0] = bwd(r, 1);
-  edge_loop[1] = r;
+  on_loop(bwd(r, 1), 0, 0);
+  on_loop(r, 0, 1);
   struct Gate {
     uint32_t a, b, par;
     uint8_t slot;
@@ -153,31 +168,29 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
     // Edges in this polygon besides the gate: (a - b) mod L.
     int prev = 2;
     for (uint32_t i = 0; i < runs.march[ri]; ++i) {
-      uint32_t span = (cur.a + L - cur.b) % L;
-      if (span < 3) return corrupt("a march step leaves no room for the rest of the run");
+      if (span_of(cur.a, cur.b) < 3) return corrupt("a march step leaves no room for the rest of the run");
+      const uint32_t right = fwd(cur.b, 1), left = bwd(cur.a, 1);
       const int ctx = ((static_cast<int>(std::min<uint32_t>(valence[loop[cur.a]], 7)) * 8 +
                         static_cast<int>(std::min<uint32_t>(valence[loop[cur.b]], 7))) * 3 + prev) * 9 +
-                      (visits[loop[fwd(cur.b, 1)]] - 1) * 3 + (visits[loop[bwd(cur.a, 1)]] - 1);
+                      (visits[loop[right]] - 1) * 3 + (visits[loop[left]] - 1);
       prev = bits.bit(ctx);
       ++bit_count;
       if (prev == 0) {
-        uint32_t x = fwd(cur.b, 1);
-        uint32_t t = emit(cur.a, cur.b, x, cur.par, cur.slot);
-        edge_loop[3 * static_cast<size_t>(t) + 1] = cur.b;
-        cur = {cur.a, x, t, 2};
+        uint32_t t = emit(cur.a, cur.b, right, cur.par, cur.slot);
+        on_loop(cur.b, t, 1);
+        cur = {cur.a, right, t, 2};
       } else {
-        uint32_t x = bwd(cur.a, 1);
-        uint32_t t = emit(cur.a, cur.b, x, cur.par, cur.slot);
-        edge_loop[3 * static_cast<size_t>(t) + 2] = x;
-        cur = {x, cur.b, t, 1};
+        uint32_t t = emit(cur.a, cur.b, left, cur.par, cur.slot);
+        on_loop(left, t, 2);
+        cur = {left, cur.b, t, 1};
       }
     }
-    uint32_t span = (cur.a + L - cur.b) % L;
+    const uint32_t span = span_of(cur.a, cur.b);
     if (!runs.branch[ri]) {
       if (span != 2) return corrupt("a leaf triangle does not close its polygon");
       uint32_t t = emit(cur.a, cur.b, fwd(cur.b, 1), cur.par, cur.slot);
-      edge_loop[3 * static_cast<size_t>(t) + 1] = cur.b;
-      edge_loop[3 * static_cast<size_t>(t) + 2] = fwd(cur.b, 1);
+      on_loop(cur.b, t, 1);
+      on_loop(fwd(cur.b, 1), t, 2);
       if (stack.empty()) {
         if (ri + 1 != nr) return corrupt("runs left after the last polygon closed");
         break;
@@ -194,6 +207,7 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
     }
   }
   if (k != T) return corrupt("triangle count does not match the loop");
+  if (twice) return corrupt("a loop edge belongs to two triangles");
   return Status::Ok();
 }
 
