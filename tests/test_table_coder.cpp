@@ -152,4 +152,107 @@ TEST(TableCoder, MalformedTableBlocksAreRefused) {
   EXPECT_TRUE(empty.overrun());
 }
 
+// The reader's refill takes 8 bytes at a time while 8 are left and single
+// bytes near the end: fields of every width at every bit offset read back,
+// and past the end come zero bits, flagged.
+TEST(TableCoder, BitReaderReadsEveryWidthAtEveryOffset) {
+  std::mt19937 rng(7);
+  for (int round = 0; round < 200; ++round) {
+    std::vector<std::pair<uint32_t, int>> fields;
+    tsm::BitWriter w;
+    const int count = static_cast<int>(rng() % 40);
+    for (int i = 0; i < count; ++i) {
+      const int n = 1 + static_cast<int>(rng() % 32);
+      const uint32_t v = n == 32 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(rng()) & ((1u << n) - 1);
+      fields.push_back({v, n});
+      w.put(v, n);
+    }
+    const std::string bytes = w.finish();
+    tsm::BitReader r;
+    r.init(bytes);
+    for (const auto& [v, n] : fields) {
+      r.refill();
+      if (n <= 16 && (rng() & 1)) {  // the table decoder's two-step read
+        const uint32_t hi = r.peek(n);
+        r.skip(n);
+        ASSERT_EQ(hi, v);
+        continue;
+      }
+      const int first = n / 2;
+      uint32_t got = first ? r.peek(first) : 0;
+      if (first) r.skip(first);
+      r.refill();
+      got = static_cast<uint32_t>((uint64_t{got} << (n - first)) | r.peek(n - first));
+      r.skip(n - first);
+      ASSERT_EQ(got, v) << "round " << round;
+    }
+    EXPECT_FALSE(r.overrun());
+    const size_t pad = 8 * bytes.size() - [&] {
+      size_t bits = 0;
+      for (const auto& f : fields) bits += static_cast<size_t>(f.second);
+      return bits;
+    }();
+    r.refill();
+    if (pad) {
+      EXPECT_EQ(r.peek(static_cast<int>(pad)), 0u);
+      r.skip(static_cast<int>(pad));
+    }
+    EXPECT_FALSE(r.overrun());
+    r.refill();
+    EXPECT_EQ(r.peek(32), 0u);  // past the end: zeros
+    r.skip(1);
+    EXPECT_TRUE(r.overrun());
+  }
+}
+
+// Code words longer than the primary lookup (kTablePrimary bits) go through
+// a second table: a code with every length 1..11 decodes every symbol, and
+// an unassigned long code word is refused.
+TEST(TableCoder, LongCodeWordsDecodeThroughTheSecondTable) {
+  static_assert(tsm::kTablePrimary < tsm::kTableMaxLength, "the test needs code words past the primary table");
+  // Lengths 1, 2, ..., 10, 11, 11: a complete code (Kraft sum 1) over 12
+  // symbols; then the same without the last symbol (incomplete).
+  for (const bool complete : {true, false}) {
+    CodeLengths len{};
+    for (int s = 0; s < 11; ++s) len[static_cast<size_t>(s)] = static_cast<uint8_t>(s + 1);
+    if (complete) len[11] = 11;
+    const auto code = tsm::canonical_codes(len);
+    const std::string block = tsm::write_tables(std::vector<CodeLengths>{len});
+    tsm::ByteReader br(block);
+    tsm::TableSet set;
+    std::string why;
+    ASSERT_TRUE(set.read(br, 1, why)) << why;
+    tsm::BitWriter w;
+    const int symbols = complete ? 12 : 11;
+    std::vector<int32_t> want;
+    for (int rep = 0; rep < 3; ++rep)
+      for (int s = 0; s < symbols; ++s) {
+        w.put(code[static_cast<size_t>(s)], len[static_cast<size_t>(s)]);
+        // Symbols 0..6 are the residuals -3..3; 7.. are escapes with raw bits.
+        int32_t r = s - tsm::kTableDirect;
+        if (s > 2 * tsm::kTableDirect) {
+          const int m = s - (2 * tsm::kTableDirect + 1), n = (m >> 1) + tsm::kTableEscapeLength;
+          const uint32_t raw = static_cast<uint32_t>(rep) & ((1u << (n - 1)) - 1);
+          w.put(raw, n - 1);
+          r = static_cast<int32_t>((1u << (n - 1)) | raw);
+          if (m & 1) r = -r;
+        }
+        want.push_back(r);
+      }
+    if (!complete) w.put(0x7FF, 11);  // the one code word of 11 ones is unassigned
+    const std::string bits = w.finish();
+    tsm::BitReader r;
+    r.init(bits);
+    for (int32_t expected : want) {
+      int32_t x = 0;
+      ASSERT_TRUE(set.decode(r, 0, x));
+      EXPECT_EQ(x, expected);
+    }
+    int32_t x = 0;
+    if (!complete) {
+      EXPECT_FALSE(set.decode(r, 0, x));
+    }
+  }
+}
+
 }  // namespace

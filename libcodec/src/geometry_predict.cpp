@@ -69,10 +69,48 @@ bool surface_predictor(Predictor p) {
   return p == Predictor::parallelograms || p == Predictor::gate || p == Predictor::spread;
 }
 
-int64_t floor_shift(int64_t x, int s) { return x >= 0 ? x >> s : -((-x + (int64_t{1} << s) - 1) >> s); }
+// floor(x / 2^s): an arithmetic shift (GCC, Clang and MSVC shift signed
+// values arithmetically; C++20 requires it). No branch on the sign, which
+// the residuals' predictions have at random.
+static_assert((int64_t{-5} >> 1) == -3, "signed right shift must be arithmetic (floor)");
+inline int64_t floor_shift(int64_t x, int s) { return x >> s; }
 
-int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign
-  int64_t num = 2 * sum + n, den = 2 * n;
+// floor(x / d) for 0 <= x < 2^57 and 2 <= d <= kSmallDivisor by a multiply:
+// with m = floor((2^64 - 1) / d) + 1, m d = 2^64 + e with 0 <= e <= d, so
+// x m / 2^64 exceeds x / d by x e / (d 2^64) < 1 / d, which never crosses
+// the next integer. The prediction's averages divide by 2..128 once per
+// axis and vertex, where a 64-bit division costs tens of cycles.
+constexpr int64_t kSmallDivisor = 128;
+struct Reciprocals {
+  uint64_t m[kSmallDivisor + 1] = {};
+  constexpr Reciprocals() {
+    for (int d = 2; d <= kSmallDivisor; ++d) m[d] = ~uint64_t{0} / static_cast<uint64_t>(d) + 1;
+  }
+};
+inline constexpr Reciprocals kReciprocal{};
+
+#ifdef __SIZEOF_INT128__
+__extension__ typedef unsigned __int128 uint128;  // GCC and Clang (64-bit targets and wasm32)
+#endif
+// div_round's quotient floor(num / den) for |num| < 2^40 and den <= 128,
+// without a branch on the sign: num + 2^40 den is positive and below 2^48.
+__attribute__((always_inline)) inline bool floor_div_small(int64_t num, int64_t den, int64_t& q) {
+#ifdef __SIZEOF_INT128__
+  constexpr int64_t kLimit = int64_t{1} << 40;
+  if (den > kSmallDivisor || num >= kLimit || num <= -kLimit) return false;
+  const uint64_t x = static_cast<uint64_t>(num + (den << 40));
+  q = static_cast<int64_t>((static_cast<uint128>(x) * kReciprocal.m[den]) >> 64) - kLimit;
+  return true;
+#else
+  (void)num, (void)den, (void)q;
+  return false;
+#endif
+}
+
+__attribute__((always_inline)) inline int64_t div_round(int64_t sum, int64_t n) {  // round half up, any sign; n >= 1
+  const int64_t num = 2 * sum + n, den = 2 * n;
+  int64_t q;
+  if (floor_div_small(num, den, q)) return q;
   return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
@@ -413,7 +451,7 @@ struct SurfaceCoder {
     do {
       f(h);
       h = he_next(g.twin[h]);
-    } while (h != h0 && ++guard < g.corners().size());
+    } while (h != h0 && ++guard < cv.size());
   }
   // Per output vertex, its smallest half-edge (kNone for one on no
   // triangle); built on first use.
@@ -558,7 +596,8 @@ struct SurfaceCoder {
 template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
-  for (uint32_t h0 = 0; h0 < g.corners().size(); ++h0) {
+  const uint32_t H = static_cast<uint32_t>(sc.cv.size());
+  for (uint32_t h0 = 0; h0 < H; ++h0) {
     if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
     if (!sc.code(h0, multi)) return false;
     if ((h0 & 4095) == 0 && s.truncated()) return false;

@@ -195,7 +195,9 @@ struct BitTreeModel {
   }
 };
 
-inline int bit_length(uint64_t x) { return x ? 64 - __builtin_clzll(x) : 0; }
+// 0 for 0, else floor(log2 x) + 1; without a branch on x == 0 (residual
+// sums are 0 often enough and at random).
+inline int bit_length(uint64_t x) { return 64 - __builtin_clzll(x | 1) - (x == 0); }
 
 // An adaptive model for unsigned integers up to 2^32 - 2: the bit length of
 // v + 1 as a 6-bit tree symbol, then the bits below the leading one; the top

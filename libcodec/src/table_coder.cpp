@@ -114,7 +114,8 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
     }
     slot_[c] = static_cast<int16_t>(used++);
   }
-  entries_.assign(static_cast<size_t>(used) << kTableMaxLength, 0);
+  primary_.assign(static_cast<size_t>(used) << kTablePrimary, 0);
+  secondary_.clear();
   for (int c = 0; c < contexts; ++c) {
     if (slot_[c] < 0) continue;
     uint8_t S;
@@ -155,11 +156,27 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
       return false;
     }
     const std::array<uint32_t, kTableSymbols> code = canonical_codes(len);
-    uint16_t* t = &entries_[static_cast<size_t>(slot_[c]) << kTableMaxLength];
+    uint16_t* t = &primary_[static_cast<size_t>(slot_[c]) << kTablePrimary];
     for (int s = 0; s < kTableSymbols; ++s) {
       if (!len[s]) continue;
+      const uint16_t entry = static_cast<uint16_t>((s + 1) << 4 | len[s]);
+      if (len[s] <= kTablePrimary) {
+        const int free = kTablePrimary - len[s];
+        std::fill(t + (code[s] << free), t + ((code[s] + 1) << free), entry);
+        continue;
+      }
+      // A longer code word: its first kTablePrimary bits select a secondary
+      // table (made on first use; at most 2^kTablePrimary per context, so
+      // the index fits below kSecondary), the rest index it.
+      uint16_t& head = t[code[s] >> (len[s] - kTablePrimary)];
+      if (!head) {
+        head = static_cast<uint16_t>(kSecondary | (secondary_.size() >> kSecondaryBits));
+        secondary_.resize(secondary_.size() + (size_t{1} << kSecondaryBits), 0);
+      }
+      uint16_t* sub = &secondary_[static_cast<size_t>(head & ~kSecondary) << kSecondaryBits];
       const int free = kTableMaxLength - len[s];
-      std::fill(t + (code[s] << free), t + ((code[s] + 1) << free), static_cast<uint16_t>((s + 1) << 4 | len[s]));
+      const uint32_t low = (code[s] << free) & ((1u << kSecondaryBits) - 1);
+      std::fill(sub + low, sub + low + (1u << free), entry);
     }
   }
   return true;

@@ -14,6 +14,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -89,8 +90,25 @@ class BitReader {
     consumed_ = 0;
     limit_ = 8 * static_cast<uint64_t>(data.size());
   }
-  // At least 57 bits in the buffer.
+  // At least 57 bits in the buffer. With 8 bytes left, one load: the
+  // bytes below the buffer's valid bits are or-ed in again by the next
+  // refill at the same place (the same bits), so they do no harm.
   void refill() {
+    if (avail_ > 56) return;
+    if (end_ - p_ >= 8) {
+      uint64_t w;
+      std::memcpy(&w, p_, 8);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+      w = __builtin_bswap64(w);  // the stream is most significant bit first
+#elif !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_BIG_ENDIAN__
+#error "byte order unknown"
+#endif
+      buf_ |= w >> avail_;
+      const int take = (63 - avail_) >> 3;
+      p_ += take;
+      avail_ += 8 * take;
+      return;
+    }
     while (avail_ <= 56) {
       const uint64_t byte = p_ < end_ ? *p_++ : 0;
       buf_ |= byte << (56 - avail_);
@@ -113,8 +131,14 @@ class BitReader {
   uint64_t consumed_ = 0, limit_ = 0;
 };
 
-// The decoder's codes: one lookup table of 2^kTableMaxLength entries per
-// used context (at most 210 of them, under 1 MB).
+// The decoder's codes, two lookups deep: per used context a primary table
+// of 2^kTablePrimary entries indexed by the next kTablePrimary bits, which
+// resolves every code word up to that length; a longer one's prefix points
+// at a secondary table indexed by the bits after it. The primary tables of
+// all contexts stay small enough for the first-level cache (at most 210 x
+// 256 bytes), where one flat 2^11 table per context (470 KB on the bunny)
+// missed it on most lookups.
+constexpr int kTablePrimary = 7;
 class TableSet {
  public:
   // Reads the table block for `contexts` contexts; false with the reason.
@@ -122,9 +146,12 @@ class TableSet {
   bool has(int ctx) const { return ctx >= 0 && ctx < static_cast<int>(slot_.size()) && slot_[ctx] >= 0; }
   // One residual of context ctx (which has a code); false on a code word
   // the table does not assign.
-  bool decode(BitReader& b, int ctx, int32_t& r) const {
+  __attribute__((always_inline)) bool decode(BitReader& b, int ctx, int32_t& r) const {
     b.refill();
-    const uint16_t e = entries_[(static_cast<size_t>(slot_[ctx]) << kTableMaxLength) + b.peek(kTableMaxLength)];
+    uint16_t e = primary_[(static_cast<size_t>(slot_[ctx]) << kTablePrimary) + b.peek(kTablePrimary)];
+    if (e & kSecondary)
+      e = secondary_[(static_cast<size_t>(e & ~kSecondary) << kSecondaryBits) +
+                     (b.peek(kTableMaxLength) & ((1u << kSecondaryBits) - 1))];
     if (e == 0) return false;
     b.skip(e & 15);
     const int s = (e >> 4) - 1;
@@ -141,8 +168,11 @@ class TableSet {
   }
 
  private:
-  std::vector<int16_t> slot_;     // per context: its table, or -1
-  std::vector<uint16_t> entries_;  // (symbol + 1) << 4 | length; 0: no code word
+  static constexpr int kSecondaryBits = kTableMaxLength - kTablePrimary;
+  static constexpr uint16_t kSecondary = 0x8000;  // primary entry: index of a secondary table
+  std::vector<int16_t> slot_;          // per context: its primary table, or -1
+  std::vector<uint16_t> primary_;      // (symbol + 1) << 4 | length, kSecondary | table, or 0: no code word
+  std::vector<uint16_t> secondary_;    // (symbol + 1) << 4 | length, or 0
 };
 
 }  // namespace tsm
