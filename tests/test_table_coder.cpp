@@ -255,4 +255,32 @@ TEST(TableCoder, LongCodeWordsDecodeThroughTheSecondTable) {
   }
 }
 
+// A context the map leaves without a table decodes nothing (the decoder
+// reads it as a code with no code words), while its neighbours decode.
+TEST(TableCoder, ContextWithoutATableIsRefused) {
+  std::string block(tsm::kTableMapBytes, '\0');
+  block[0] = 2;                             // context 1 only, of 4
+  block += std::string("\x02\x11", 2);      // lengths 1, 1: residuals -3 ("0") and -2 ("1")
+  tsm::ByteReader br(block);
+  tsm::TableSet set;
+  std::string why;
+  ASSERT_TRUE(set.read(br, 4, why)) << why;
+  EXPECT_FALSE(set.has(0));
+  EXPECT_TRUE(set.has(1));
+  const std::string bits("\x40", 1);  // 0, 1, then zeros
+  for (int ctx : {0, 2, 3}) {
+    tsm::BitReader r;
+    r.init(bits);
+    int32_t x = 0;
+    EXPECT_FALSE(set.decode(r, ctx, x)) << "context " << ctx;
+  }
+  tsm::BitReader r;
+  r.init(bits);
+  int32_t x = 0;
+  ASSERT_TRUE(set.decode(r, 1, x));
+  EXPECT_EQ(x, -3);
+  ASSERT_TRUE(set.decode(r, 1, x));
+  EXPECT_EQ(x, -2);
+}
+
 }  // namespace

@@ -37,6 +37,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "byte_io.hpp"
 #include "connectivity.hpp"
@@ -225,7 +226,7 @@ struct TableDecodeSink : DecodeSink {
   bool bad_code = false;  // a code word no table assigns, or a context without a table
   int32_t residual(SurfaceModels*, int ctx, int64_t) {
     int32_t r = 0;
-    if (!tables.has(ctx) || !tables.decode(bits, ctx, r)) bad_code = true;
+    if (!tables.decode(bits, ctx, r)) bad_code = true;  // also a context without a table
     return r;
   }
   bool truncated() const { return DecodeSink::truncated() || bits.overrun() || bad_code; }
@@ -306,14 +307,21 @@ struct Coder {
   // the context instead of the activity; null to use the activity.
   // normal: for the tangent step (scaled below 2^16 by tangent_normal), or
   // null; tan_set: which beta.
-  template <class Sink>
+  // kPlain: the caller knows there is no lattice, no tangent step (normal
+  // null), no spread context and no mixing (plain() below), so those
+  // branches are compiled out (the fast levels' gate predictor).
+  bool plain() const {
+    return !tangent && !mix && !spread_ctx && lattice.values[0].empty() && lattice.values[1].empty() &&
+           lattice.values[2].empty();
+  }
+  template <bool kPlain = false, class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
               const int64_t* spread = nullptr, const int64_t* normal = nullptr, int tan_set = 0) {
     uint64_t sum = 0, top = 0;
     int on_count = 0;
     int order[3] = {0, 1, 2};
     int kn = -1;  // the axis nearest the normal, coded last
-    if (normal) {
+    if (!kPlain && normal) {
       kn = 0;
       for (int a = 1; a < 3; ++a)
         if (std::abs(normal[a]) > std::abs(normal[kn])) kn = a;
@@ -323,12 +331,12 @@ struct Coder {
     int64_t res[3] = {0, 0, 0};  // x minus the clamped prediction, per axis coded so far
     for (int i = 0; i < 3; ++i) {
       const int a = order[i];
-      int ctx = spread ? bit_length(static_cast<uint64_t>(spread[a]))
-                       : i == 0 ? activity : (activity + bit_length(top) + 1) / 2;
+      int ctx = !kPlain && spread ? bit_length(static_cast<uint64_t>(spread[a]))
+                                  : i == 0 ? activity : (activity + bit_length(top) + 1) / 2;
       ctx = std::min(ctx, kActivity - 1);
       const int64_t p0 = std::clamp<int64_t>(pred[a], 0, qmax);  // clamped, before the tangent step
       int64_t p = p0;
-      if (a == kn) {
+      if (!kPlain && a == kn) {
         // Through the tangent plane: n . (x - p) = 0 solved for this axis.
         const int64_t sgn = normal[kn] < 0 ? -1 : 1;
         const int64_t num = -sgn * (normal[order[0]] * res[order[0]] + normal[order[1]] * res[order[1]]);
@@ -341,7 +349,7 @@ struct Coder {
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
       const std::vector<uint32_t>& L = lattice.values[a];
       bool coded = false;
-      if (!L.empty()) {
+      if (!kPlain && !L.empty()) {
         const size_t j = nearest_plane(a, static_cast<uint32_t>(p));
         size_t jx = 0;
         int on = 0;
@@ -363,7 +371,7 @@ struct Coder {
       }
       if (!coded) {
         int64_t r;
-        if (mix) {
+        if (!kPlain && mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
           r = s.sint_mixed(surface->m[(i * kClasses + cls) * kActivity + ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
                            static_cast<int64_t>(x) - p);
@@ -473,6 +481,7 @@ struct SurfaceCoder {
 
   // Codes the vertex at the origin of half-edge h0 (undecoded, not virtual);
   // multi: every triangle around it, else only h0's triangle.
+  template <bool kPlain = false>
   bool code(uint32_t h0, bool multi) {
     const uint32_t v = cv[h0];
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, pred[3];
@@ -536,7 +545,7 @@ struct SurfaceCoder {
     for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
     NormalSum ns;
-    if (c.tangent && npara > 0) {
+    if (!kPlain && c.tangent && npara > 0) {
       if (npair <= kPairs) {
         for (int i = 0; i < npair; ++i) ns.add(at(pu[i]), at(pw[i]), pred);
       } else {  // a wide fan: walk it again
@@ -544,12 +553,13 @@ struct SurfaceCoder {
       }
       normal = ns.finish();
     }
-    return point(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
-                 c.spread_ctx && npara >= 2 ? spread : nullptr, normal);
+    return point<kPlain>(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
+                         !kPlain && c.spread_ctx && npara >= 2 ? spread : nullptr, normal);
   }
+  template <bool kPlain = false>
   bool point(uint32_t v, const int64_t pred[3], int cls, int activity, const int64_t* spread = nullptr,
              const int64_t* normal = nullptr, int tan_set = 0) {
-    if (!c.vertex(s, q, v, pred, cls, activity, spread, normal, tan_set)) return false;
+    if (!c.template vertex<kPlain>(s, q, v, pred, cls, activity, spread, normal, tan_set)) return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = c.act[v];
     return true;
@@ -597,11 +607,15 @@ template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   const uint32_t H = static_cast<uint32_t>(sc.cv.size());
-  for (uint32_t h0 = 0; h0 < H; ++h0) {
-    if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
-    if (!sc.code(h0, multi)) return false;
-    if ((h0 & 4095) == 0 && s.truncated()) return false;
-  }
+  auto walk = [&](auto plain) {
+    for (uint32_t h0 = 0; h0 < H; ++h0) {
+      if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
+      if (!sc.template code<decltype(plain)::value>(h0, multi)) return false;
+      if ((h0 & 4095) == 0 && s.truncated()) return false;
+    }
+    return true;
+  };
+  if (!(c.plain() ? walk(std::true_type{}) : walk(std::false_type{}))) return false;
   return sc.isolated();
 }
 

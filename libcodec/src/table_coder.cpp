@@ -114,7 +114,12 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
     }
     slot_[c] = static_cast<int16_t>(used++);
   }
-  primary_.assign(static_cast<size_t>(used) << kTablePrimary, 0);
+  // One more primary table, all zeros (no code word), which the contexts
+  // without a table read: decode() refuses them without a check of its own.
+  primary_.assign(static_cast<size_t>(used + 1) << kTablePrimary, 0);
+  table_.resize(slot_.size());
+  for (size_t c = 0; c < slot_.size(); ++c)
+    table_[c] = static_cast<uint32_t>(slot_[c] < 0 ? used : slot_[c]) << kTablePrimary;
   secondary_.clear();
   for (int c = 0; c < contexts; ++c) {
     if (slot_[c] < 0) continue;

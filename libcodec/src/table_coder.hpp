@@ -144,11 +144,12 @@ class TableSet {
   // Reads the table block for `contexts` contexts; false with the reason.
   bool read(ByteReader& r, int contexts, std::string& why);
   bool has(int ctx) const { return ctx >= 0 && ctx < static_cast<int>(slot_.size()) && slot_[ctx] >= 0; }
-  // One residual of context ctx (which has a code); false on a code word
-  // the table does not assign.
+  // One residual of context ctx (0 <= ctx < the read's `contexts`); false
+  // on a code word the table does not assign, and for a context without a
+  // table.
   __attribute__((always_inline)) bool decode(BitReader& b, int ctx, int32_t& r) const {
     b.refill();
-    uint16_t e = primary_[(static_cast<size_t>(slot_[ctx]) << kTablePrimary) + b.peek(kTablePrimary)];
+    uint16_t e = primary_[table_[static_cast<size_t>(ctx)] + b.peek(kTablePrimary)];
     if (e & kSecondary)
       e = secondary_[(static_cast<size_t>(e & ~kSecondary) << kSecondaryBits) +
                      (b.peek(kTableMaxLength) & ((1u << kSecondaryBits) - 1))];
@@ -171,6 +172,7 @@ class TableSet {
   static constexpr int kSecondaryBits = kTableMaxLength - kTablePrimary;
   static constexpr uint16_t kSecondary = 0x8000;  // primary entry: index of a secondary table
   std::vector<int16_t> slot_;          // per context: its primary table, or -1
+  std::vector<uint32_t> table_;        // per context: where its primary table starts (the zero table if none)
   std::vector<uint16_t> primary_;      // (symbol + 1) << 4 | length, kSecondary | table, or 0: no code word
   std::vector<uint16_t> secondary_;    // (symbol + 1) << 4 | length, or 0
 };
