@@ -371,12 +371,13 @@ struct Coder {
       }
       if (!coded) {
         int64_t r;
+        const int rctx = (i * kClasses + cls) * kActivity + ctx;  // SurfaceModels' and the tables' numbering
         if (!kPlain && mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
-          r = s.sint_mixed(surface->m[(i * kClasses + cls) * kActivity + ctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
+          r = s.sint_mixed(surface->m[rctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
                            static_cast<int64_t>(x) - p);
         } else {
-          r = s.residual(surface.get(), (i * kClasses + cls) * kActivity + ctx, static_cast<int64_t>(x) - p);
+          r = s.residual(surface.get(), rctx, static_cast<int64_t>(x) - p);
         }
         if (p + r < 0 || p + r > qmax) return false;
         x = static_cast<uint32_t>(p + r);

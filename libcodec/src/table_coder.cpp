@@ -104,7 +104,7 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
     why = "table block is truncated";
     return false;
   }
-  slot_.assign(static_cast<size_t>(contexts), -1);
+  std::vector<int> slot(static_cast<size_t>(contexts), -1);  // per context: its primary table, or -1
   int used = 0;
   for (int c = 0; c < 8 * kTableMapBytes; ++c) {
     if (!((static_cast<uint8_t>(map[c >> 3]) >> (c & 7)) & 1)) continue;
@@ -112,17 +112,17 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
       why = "table for context " + std::to_string(c) + ", which does not exist";
       return false;
     }
-    slot_[c] = static_cast<int16_t>(used++);
+    slot[static_cast<size_t>(c)] = used++;
   }
   // One more primary table, all zeros (no code word), which the contexts
   // without a table read: decode() refuses them without a check of its own.
   primary_.assign(static_cast<size_t>(used + 1) << kTablePrimary, 0);
-  table_.resize(slot_.size());
-  for (size_t c = 0; c < slot_.size(); ++c)
-    table_[c] = static_cast<uint32_t>(slot_[c] < 0 ? used : slot_[c]) << kTablePrimary;
+  none_ = static_cast<uint32_t>(used) << kTablePrimary;
+  table_.resize(slot.size());
+  for (size_t c = 0; c < slot.size(); ++c) table_[c] = slot[c] < 0 ? none_ : static_cast<uint32_t>(slot[c]) << kTablePrimary;
   secondary_.clear();
   for (int c = 0; c < contexts; ++c) {
-    if (slot_[c] < 0) continue;
+    if (table_[static_cast<size_t>(c)] == none_) continue;
     uint8_t S;
     if (!r.u8(S)) {
       why = "table block is truncated";
@@ -161,7 +161,7 @@ bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
       return false;
     }
     const std::array<uint32_t, kTableSymbols> code = canonical_codes(len);
-    uint16_t* t = &primary_[static_cast<size_t>(slot_[c]) << kTablePrimary];
+    uint16_t* t = &primary_[table_[static_cast<size_t>(c)]];
     for (int s = 0; s < kTableSymbols; ++s) {
       if (!len[s]) continue;
       const uint16_t entry = static_cast<uint16_t>((s + 1) << 4 | len[s]);

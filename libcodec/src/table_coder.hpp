@@ -143,7 +143,9 @@ class TableSet {
  public:
   // Reads the table block for `contexts` contexts; false with the reason.
   bool read(ByteReader& r, int contexts, std::string& why);
-  bool has(int ctx) const { return ctx >= 0 && ctx < static_cast<int>(slot_.size()) && slot_[ctx] >= 0; }
+  bool has(int ctx) const {
+    return ctx >= 0 && ctx < static_cast<int>(table_.size()) && table_[static_cast<size_t>(ctx)] != none_;
+  }
   // One residual of context ctx (0 <= ctx < the read's `contexts`); false
   // on a code word the table does not assign, and for a context without a
   // table.
@@ -171,8 +173,8 @@ class TableSet {
  private:
   static constexpr int kSecondaryBits = kTableMaxLength - kTablePrimary;
   static constexpr uint16_t kSecondary = 0x8000;  // primary entry: index of a secondary table
-  std::vector<int16_t> slot_;          // per context: its primary table, or -1
-  std::vector<uint32_t> table_;        // per context: where its primary table starts (the zero table if none)
+  std::vector<uint32_t> table_;        // per context: where its primary table starts (none_ if it has none)
+  uint32_t none_ = 0;                  // where the all-zero primary table starts
   std::vector<uint16_t> primary_;      // (symbol + 1) << 4 | length, kSecondary | table, or 0: no code word
   std::vector<uint16_t> secondary_;    // (symbol + 1) << 4 | length, or 0
 };
