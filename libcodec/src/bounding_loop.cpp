@@ -116,31 +116,39 @@ bool tree_tour(const std::vector<uint32_t>& parent, std::vector<uint32_t>& loop,
   const uint32_t n = static_cast<uint32_t>(parent.size());
   loop.resize(2 * (static_cast<size_t>(n) - 1));
   loop_twin.resize(loop.size());
-  struct Step {
-    uint32_t vertex, down;  // a vertex on the path and the loop position of the edge down to it
-  };
-  std::vector<Step> path;
-  path.push_back({0, kNone});
+  // The path as two arrays indexed by depth (no push_back of a struct: the
+  // store-to-load forwarding of a pushed pair stalled this loop).
+  std::vector<uint32_t> path_vertex(n), path_down(n);
+  size_t depth = 0;  // index of the path's last vertex
+  path_vertex[0] = 0;
+  path_down[0] = kNone;
   uint32_t p = 0;
-  auto up = [&] {
-    const Step s = path.back();
-    path.pop_back();
-    loop[p] = s.vertex;
-    loop_twin[p] = s.down;
-    loop_twin[s.down] = p;
-    ++p;
-  };
+  uint32_t* const lp = loop.data();
+  uint32_t* const tw = loop_twin.data();
   for (uint32_t v = 1; v < n; ++v) {
     const uint32_t par = parent[v];
     if (par >= v) return false;
-    while (path.back().vertex != par) {
-      if (path.size() == 1) return false;
-      up();
+    while (path_vertex[depth] != par) {
+      if (depth == 0) return false;
+      const uint32_t down = path_down[depth];
+      lp[p] = path_vertex[depth];
+      tw[p] = down;
+      tw[down] = p;
+      ++p;
+      --depth;
     }
-    loop[p] = par;
-    path.push_back({v, p++});
+    lp[p] = par;
+    ++depth;
+    path_vertex[depth] = v;
+    path_down[depth] = p++;
   }
-  while (path.size() > 1) up();
+  for (; depth > 0; --depth) {
+    const uint32_t down = path_down[depth];
+    lp[p] = path_vertex[depth];
+    tw[p] = down;
+    tw[down] = p;
+    ++p;
+  }
   return true;
 }
 

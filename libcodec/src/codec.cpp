@@ -287,8 +287,9 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
         if (a != kNone) return corrupt("the first segment names values of segments before it");
   out.positions.resize(out.positions.size() + part.q.size());
   float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
-  for (size_t i = 0; i < part.q.size(); ++i)
-    pos[i] = static_cast<float>(grid_value(h, step, static_cast<int>(i % 3), part.q[i]));
+  const uint32_t* q = part.q.data();
+  for (size_t v = 0, nv = part.q.size() / 3; v < nv; ++v, q += 3, pos += 3)
+    for (int axis = 0; axis < 3; ++axis) pos[axis] = static_cast<float>(grid_value(h, step, axis, q[axis]));
   if (first) {  // the first part has no references: its faces as they are, no copy
     out.face_offsets = std::move(part.faces.face_offsets);
     out.indices = std::move(part.faces.indices);

@@ -482,11 +482,6 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       layout.parent[out_id[p]] = out_id[parent[p]];
     }
   }
-  // Triangle corners: pre-order positions -> output vertex ids (kNone:
-  // virtual); without virtual vertices and stitches they are the same.
-  if (nvirt != 0 || nstitch != 0)
-    for (uint32_t& x : corner) x = out_id[x];
-
   // Side faces: kept verbatim (the topology stream's last list).
   const uint32_t nside = om.count.decode(dop);
   if (nside > face_count) return corrupt("more side faces than faces");
@@ -500,6 +495,15 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     }
     side_start.push_back(static_cast<uint32_t>(side.size()));
   }
+
+  // Triangle corners: pre-order positions -> output vertex ids (kNone:
+  // virtual); without virtual vertices and stitches they are the same. When
+  // the triangles are copied to the output one by one (below), the copy does
+  // it on the way: one pass over the corners instead of two.
+  const bool remap = nvirt != 0 || nstitch != 0;
+  const bool copy_each = !polygons && (nvirt != 0 || nside != 0);
+  if (remap && !copy_each)
+    for (uint32_t& x : corner) x = out_id[x];
 
   // Faces: triangles in decode order, polygons glued along flagged edges.
   out.face_offsets.assign(1, 0);
@@ -530,7 +534,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     layout.corner_ref = &out.indices;
     out.face_offsets.resize(size_t{NT} + 1);
     for (uint32_t k = 0; k <= NT; ++k) out.face_offsets[k] = 3 * k;
-  } else if (!polygons) {
+  } else if (copy_each) {
     // Triangles, skipping virtual ones, straight into the output.
     const size_t max_faces = std::min<uint64_t>({face_count, NT, corner_count / 3});
     out.face_offsets.resize(max_faces + 1);
@@ -538,11 +542,20 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     uint32_t* fo = out.face_offsets.data();
     uint32_t* ix = out.indices.data();
     size_t nf = 0;
+    const uint32_t* id = out_id.data();
     for (uint32_t k = 0; k < NT; ++k) {
-      const uint32_t* c = &corner[3 * static_cast<size_t>(k)];
+      uint32_t* c = &corner[3 * static_cast<size_t>(k)];
+      if (remap) {
+        c[0] = id[c[0]];
+        c[1] = id[c[1]];
+        c[2] = id[c[2]];
+      }
       if (c[0] == kNone || c[1] == kNone || c[2] == kNone) continue;
       if (nf == max_faces) return corrupt("more faces than the header says");
-      std::copy(c, c + 3, ix + 3 * nf);
+      uint32_t* o = ix + 3 * nf;
+      o[0] = c[0];  // three stores: std::copy of three became a memmove call
+      o[1] = c[1];
+      o[2] = c[2];
       ++nf;
       fo[nf] = static_cast<uint32_t>(3 * nf);
     }

@@ -608,11 +608,28 @@ template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   const uint32_t H = static_cast<uint32_t>(sc.cv.size());
+  // Coding the vertex at h makes exactly that vertex known, so the half-edges
+  // to code are the first occurrences of each vertex in the corner list:
+  // listed first without branches (virtual corners map to the extra entry V,
+  // marked seen), so the coding loop below does not mispredict on them.
+  const uint32_t V = g.vertex_count;
+  std::vector<uint32_t> first(H);
+  uint32_t nfirst = 0;
+  {
+    std::vector<uint8_t> seen(size_t{V} + 1, 0);
+    seen[V] = 1;
+    const uint32_t* cv = sc.cv.data();
+    for (uint32_t h = 0; h < H; ++h) {
+      const uint32_t x = std::min(cv[h], V);
+      first[nfirst] = h;
+      nfirst += seen[x] ^ 1u;
+      seen[x] = 1;
+    }
+  }
   auto walk = [&](auto plain) {
-    for (uint32_t h0 = 0; h0 < H; ++h0) {
-      if (sc.cv[h0] == kNone || sc.known(h0) != kNone) continue;
-      if (!sc.template code<decltype(plain)::value>(h0, multi)) return false;
-      if ((h0 & 4095) == 0 && s.truncated()) return false;
+    for (uint32_t i = 0; i < nfirst; ++i) {
+      if (!sc.template code<decltype(plain)::value>(first[i], multi)) return false;
+      if ((i & 4095) == 0 && s.truncated()) return false;
     }
     return true;
   };
