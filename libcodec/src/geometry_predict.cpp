@@ -529,8 +529,11 @@ struct SurfaceCoder {
     if (npara) {
       cls = 1 + std::min(npara, 3);
       const int k = cls - 2;
+      // One parallelogram and one neighbour (the gate predictor's usual
+      // case): the averages are the sums themselves (div_round(x, 1) == x).
+      const bool single = npara == 1 && nnb == 1;
       for (int a = 0; a < 3; ++a) {
-        const int64_t P = div_round(para[a], npara), N = div_round(nb[a], nnb);
+        const int64_t P = single ? para[a] : div_round(para[a], npara), N = single ? nb[a] : div_round(nb[a], nnb);
         if constexpr (Sink::kEncoder)
           if (c.collect) c.samples[k].push_back({P - N, static_cast<int64_t>(at(v)[a]) - N});
         pred[a] = N + floor_shift(c.alpha[k] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
