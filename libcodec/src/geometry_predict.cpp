@@ -388,8 +388,9 @@ struct Coder {
       sum += ar;
       top = std::max(top, ar);
     }
-    act[v] = static_cast<uint8_t>(std::min(bit_length(sum), 254));
-    prev_act = act[v];
+    const uint8_t activity_v = static_cast<uint8_t>(std::min(bit_length(sum), 254));
+    act[v] = activity_v;
+    prev_act = activity_v;
     return true;
   }
 };

@@ -72,13 +72,20 @@ CodeLengths table_code_lengths(const std::array<uint32_t, kTableSymbols>& count)
 }
 
 std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length) {
+  // The first code of each length (the codes of length l follow those of
+  // length l - 1, shifted), then each symbol the next of its length, in
+  // symbol order: one pass over the symbols instead of one per length.
   std::array<uint32_t, kTableSymbols> code{};
-  uint32_t next = 0;
+  uint32_t count[kTableMaxLength + 1] = {}, next[kTableMaxLength + 1] = {};
+  for (int s = 0; s < kTableSymbols; ++s)
+    if (length[s] >= 1 && length[s] <= kTableMaxLength) ++count[length[s]];
+  uint32_t first = 0;
   for (int l = 1; l <= kTableMaxLength; ++l) {
-    for (int s = 0; s < kTableSymbols; ++s)
-      if (length[s] == l) code[s] = next++;
-    next <<= 1;
+    next[l] = first;
+    first = (first + count[l]) << 1;
   }
+  for (int s = 0; s < kTableSymbols; ++s)
+    if (length[s] >= 1 && length[s] <= kTableMaxLength) code[s] = next[length[s]]++;
   return code;
 }
 
