@@ -125,30 +125,27 @@ bool tree_tour(const std::vector<uint32_t>& parent, std::vector<uint32_t>& loop,
   uint32_t p = 0;
   uint32_t* const lp = loop.data();
   uint32_t* const tw = loop_twin.data();
+  auto up = [&] {  // walk up the edge above the path's last vertex
+    const uint32_t down = path_down[depth];
+    lp[p] = path_vertex[depth];
+    tw[p] = down;
+    tw[down] = p;
+    ++p;
+    --depth;
+  };
   for (uint32_t v = 1; v < n; ++v) {
     const uint32_t par = parent[v];
     if (par >= v) return false;
     while (path_vertex[depth] != par) {
       if (depth == 0) return false;
-      const uint32_t down = path_down[depth];
-      lp[p] = path_vertex[depth];
-      tw[p] = down;
-      tw[down] = p;
-      ++p;
-      --depth;
+      up();
     }
     lp[p] = par;
     ++depth;
     path_vertex[depth] = v;
     path_down[depth] = p++;
   }
-  for (; depth > 0; --depth) {
-    const uint32_t down = path_down[depth];
-    lp[p] = path_vertex[depth];
-    tw[p] = down;
-    tw[down] = p;
-    ++p;
-  }
+  while (depth > 0) up();
   return true;
 }
 

@@ -500,8 +500,11 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   // virtual); without virtual vertices and stitches they are the same. When
   // the triangles are copied to the output one by one (below), the copy does
   // it on the way: one pass over the corners instead of two.
+  // Three ways to the output faces (below): the corners are the indices as
+  // they are, or triangles are copied one by one, or polygons are glued.
   const bool remap = nvirt != 0 || nstitch != 0;
-  const bool copy_each = !polygons && (nvirt != 0 || nside != 0);
+  const bool corners_are_faces = !polygons && nvirt == 0 && nside == 0;
+  const bool copy_each = !polygons && !corners_are_faces;
   if (remap && !copy_each)
     for (uint32_t& x : corner) x = out_id[x];
 
@@ -525,7 +528,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     out.face_offsets.push_back(static_cast<uint32_t>(out.indices.size()));
     return true;
   };
-  if (!polygons && nvirt == 0 && nside == 0) {
+  if (corners_are_faces) {
     // Every triangle is a face: the corners are the indices (the layout
     // reads them there).
     if (NT > face_count || 3 * uint64_t{NT} > corner_count) return corrupt("more faces than the header says");
