@@ -74,12 +74,13 @@ int main(int argc, char** argv) {
                   "0 = default (262144)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   enc->add_option("--format-version", ea.format_version,
-                  "Write this format version: 8 (the newest; by default each file says the oldest version that "
-                  "reads it), 7 for decoders of version 7 (levels 0-2 without version 8's table-coded residuals: "
-                  "slower to decode, 1-2% smaller), 6 for decoders of version 6 (no lattice planes from the top: a few bytes more on "
+                  "Write this format version: 9 (the newest; by default each file says the oldest version that "
+                  "reads it), 8 for decoders of version 8 (levels 0-2 without version 9's table-coded connectivity "
+                  "run values: slower to decode, 0.2-1% smaller), 7 for decoders of version 7 (levels 0-2 without "
+                  "version 8's table-coded residuals either: slower to decode, 1-2% smaller), 6 for decoders of version 6 (no lattice planes from the top: a few bytes more on "
                   "boxes), 5 for decoders of version 5 (no residual mixing either, which only levels 7-9 use), "
                   "or 4 for decoders of version 4 (no tangent step either; usually slightly larger)")
-      ->check(CLI::Range(4, 8));
+      ->check(CLI::Range(4, 9));
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));

@@ -139,6 +139,21 @@ for bad in duplicate_key:02016100016100 empty_key:01000000 trailing_byte:0101610
 done
 
 # ---- forged attribute headers (§8.12): an integer type on a grid, f32 as exact integers
+# Version 9 run tables (§8.3.1): an asked-for version 9 with mode 0, and
+# forged modes and cut tables, which both decoders refuse.
+if "$tsm" encode "$work/mixed.obj" -o "$work/mixed_v9_l6.tsm" -q 12 -l 6 --format-version 9 -f --quiet; then
+  compare_file mixed_v9_l6
+else
+  echo "mixed_v9_l6: tsm failed"; result mixed_v9_l6 1
+fi
+if [ -f "$work/dragon_l0.tsm" ]; then
+  topo="$PY $here/test_meshes.py --forge-topology"
+  for forged in mode=2 mode=0 cut=1 cut=7 cut=40 cut=300; do
+    name="run_tables_$(echo "$forged" | tr = _)"
+    $topo "$work/dragon_l0.tsm" "$work/$name.tsm" "$forged" && refused "$name"
+  done
+fi
+
 forge="$PY $here/test_meshes.py --replace-in-mesh"
 $forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 056c6162656c000002010000 \
   056c6162656c000002010108000000000000000000000000 && refused forged_u16_grid

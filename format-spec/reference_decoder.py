@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 to 8), written from
+"""An independent decoder for .tsm files (format versions 3 to 9), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6, 7, 8):
+    if version not in (3, 4, 5, 6, 7, 8, 9):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -642,7 +642,25 @@ def triangle_walk(L, root, march, branch, loop, n, read_bit):
 
 # ---------------------------------------------------------------- §8.3 connectivity
 
-def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
+def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, version=4):
+    tables = rbits = None
+    if version >= 9:                                        # §8.3.1: the mode byte
+        if len(s5) < 1:
+            reject('topology stream is empty (no run coding mode)')
+        if s5[0] > 1:
+            reject('run coding mode %d' % s5[0])
+        if s5[0] == 1:
+            tables, rbits, p = read_tables(s5, 1, 8, 1, 'run values')
+            s5 = s5[p:]
+        else:
+            s5 = s5[1:]
+
+    def run_value(model, d, c):                             # §8.3.1: with mode 1 from the tables
+        if tables is None:
+            return model.decode(d)
+        v = table_residual(tables, rbits, c, 'run values')
+        return INVALID if v < 0 else v
+
     dv, dt, do = RangeDecoder(s3), RangeDecoder(s4), RangeDecoder(s5)
     # §8.2 models
     v_length = [UIntModel(), UIntModel()]
@@ -680,7 +698,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
         while True:
             if overrun():
                 reject('vertex tree truncated')
-            ln = v_length[prev_leaf].decode(dv)
+            ln = run_value(v_length[prev_leaf], dv, prev_leaf)
             if ln == INVALID or len(parent) + ln + 1 > max_positions:
                 reject('vertex run length')
             leaf = dv.bit(v_leaf, prev_leaf)
@@ -743,7 +761,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
             if overrun():
                 reject('triangle tree truncated')
             br = dt.bit(t_end[prev_end], prev_end2)
-            m = t_march[prev_end][br].decode(dt)
+            m = run_value(t_march[prev_end][br], dt, 2 + 2 * prev_end + br)
             if m == INVALID or total + m + 1 > L:
                 reject('march count')
             march.append(m)
@@ -800,7 +818,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     virtual = [0] * P
     at = 0
     for i in range(nvirt):
-        d = o_position.decode(do)
+        d = run_value(o_position, do, 6)
         if d > P or at + d >= P or (i > 0 and d == 0):
             reject('virtual position')
         at += d
@@ -811,8 +829,8 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     stitch_to = [NONE] * P
     at = 0
     for i in range(nstitch):
-        d = o_position.decode(do)
-        dist = o_distance.decode(do)
+        d = run_value(o_position, do, 6)
+        dist = run_value(o_distance, do, 7)
         if overrun() or at + d >= P or (i > 0 and d == 0):
             reject('stitch position')
         at += d
@@ -1032,8 +1050,9 @@ def decode_geometry_raw(payload, vc, qbits, top=False):
 
 class BitReader:
     """§8.5.11: bits most significant first; reading past the end is corrupt."""
-    def __init__(self, data):
+    def __init__(self, data, what='geometry'):
         self.data = data
+        self.what = what
         self.pos = 0                                      # in bits
 
     def read(self, n):
@@ -1041,44 +1060,46 @@ class BitReader:
         for _ in range(n):
             byte = self.pos >> 3
             if byte >= len(self.data):
-                reject('geometry: table-coded bit stream is truncated')
+                reject(self.what + ': table-coded bit stream is truncated')
             v = (v << 1) | ((self.data[byte] >> (7 - (self.pos & 7))) & 1)
             self.pos += 1
         return v
 
 
-def read_tables(payload, pos):
+def read_tables(payload, pos, contexts=210, map_bytes=27, what='geometry'):
     """§8.5.11: bit stream length, used-context map, code lengths; returns
-    ({context: {(length, code word): symbol}}, BitReader, offset of the range-coded stream)."""
-    if len(payload) < pos + 4 + 27:
-        reject('geometry: table block truncated')
+    ({context: {(length, code word): symbol}}, BitReader, offset of the range-coded stream).
+    The geometry residuals have 210 contexts and a 27-byte map; the run values
+    of §8.3.1 8 contexts and a 1-byte map."""
+    if len(payload) < pos + 4 + map_bytes:
+        reject(what + ': table block truncated')
     nbytes = struct.unpack_from('<I', payload, pos)[0]
-    used = [c for c in range(216) if payload[pos + 4 + (c >> 3)] >> (c & 7) & 1]
-    p = pos + 4 + 27
+    used = [c for c in range(8 * map_bytes) if payload[pos + 4 + (c >> 3)] >> (c & 7) & 1]
+    p = pos + 4 + map_bytes
     tables = {}
     for c in used:
-        if c >= 210:
-            reject('geometry: table for a context that does not exist')
+        if c >= contexts:
+            reject(what + ': table for a context that does not exist')
         if p >= len(payload):
-            reject('geometry: table block truncated')
+            reject(what + ': table block truncated')
         S = payload[p]
         p += 1
         if not 1 <= S <= 63:
-            reject('geometry: table symbol count')
+            reject(what + ': table symbol count')
         if p + (S + 1) // 2 > len(payload):
-            reject('geometry: table block truncated')
+            reject(what + ': table block truncated')
         lengths = []
         for j in range((S + 1) // 2):
             lengths += [payload[p + j] >> 4, payload[p + j] & 15]
         p += (S + 1) // 2
         if S % 2 and lengths[S]:
-            reject('geometry: table padding nibble')
+            reject(what + ': table padding nibble')
         lengths = lengths[:S]
         if max(lengths) > 11:
-            reject('geometry: code length above 11')
+            reject(what + ': code length above 11')
         kraft = sum(1 << (11 - l) for l in lengths if l)
         if kraft == 0 or kraft > 2048:
-            reject('geometry: table is empty or over-subscribed')
+            reject(what + ': table is empty or over-subscribed')
         code, words = 0, {}                                  # canonical: by length, then symbol
         for l in range(1, 12):
             for sym in range(S):
@@ -1088,19 +1109,19 @@ def read_tables(payload, pos):
             code <<= 1
         tables[c] = words
     if nbytes > len(payload) - p:
-        reject('geometry: table-coded bit stream longer than the section')
-    return tables, BitReader(payload[p:p + nbytes]), p + nbytes
+        reject(what + ': table-coded bit stream longer than the section')
+    return tables, BitReader(payload[p:p + nbytes], what), p + nbytes
 
 
-def table_residual(tables, bits, c):
-    """§8.5.11: one residual of context c."""
+def table_residual(tables, bits, c, what='geometry'):
+    """§8.5.11: one residual (or run value, §8.3.1) of context c."""
     if c not in tables:
-        reject('geometry: residual in a context without a table')
+        reject(what + ': residual in a context without a table')
     words = tables[c]
     word, length = 0, 0
     while (length, word) not in words:
         if length == 11:
-            reject('geometry: code word in no table')
+            reject(what + ': code word in no table')
         word = (word << 1) | bits.read(1)
         length += 1
     sym = words[(length, word)]
@@ -2115,7 +2136,7 @@ def decode_part(streams, counts, bits, earlier, trace, version=4):
         reject('stream budget')
     if sr is not None and vc > D(sr):
         reject('references budget')
-    faces, layout, info = decode_connectivity(s3, s4, s5, vc, fc, cc)   # step 29
+    faces, layout, info = decode_connectivity(s3, s4, s5, vc, fc, cc, version)   # step 29
     glob = [NONE] * vc
     if sr is not None:                                               # §8.11
         ids, tri = layout['id'], layout['tri']

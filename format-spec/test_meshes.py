@@ -35,6 +35,9 @@ Usage: test_meshes.py DIR
        test_meshes.py --add-metadata SRC.tsm DST.tsm --raw HEX   (a malformed payload)
          (with --zstd: the section zstd-coded, by the zstd command)
        test_meshes.py --replace-in-mesh SRC.tsm DST.tsm OLD_HEX NEW_HEX   (a forged mesh section)
+       test_meshes.py --forge-topology SRC.tsm DST.tsm mode=N | cut=K
+         (the mesh section's topology stream with its first byte, the
+         version 9 run coding mode, set to N, or cut to its first K bytes)
 """
 import math
 import os
@@ -529,7 +532,7 @@ def replace_in_mesh(src, dst, old, new):
     section's lengths and checksum rewritten to match (a forged file that
     only the payload rules can refuse)."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reference_decoder import xxh32, read_varint
+    from reference_decoder import read_varint
     data = open(src, 'rb').read()
     hlen, p = read_varint(data, 8, len(data))
     p += hlen + 4
@@ -543,15 +546,65 @@ def replace_in_mesh(src, dst, old, new):
         if sid == 10 and codec == 0:
             if old not in payload:
                 sys.exit('%s: %s not in the mesh section' % (src, old.hex()))
-            payload = payload.replace(old, new, 1)
-            section = (struct.pack('<HB', 10, 0) + varint(len(payload)) + varint(len(payload))
-                       + struct.pack('<I', xxh32(payload)) + payload)
-            open(dst, 'wb').write(data[:p] + section + data[q + 4 + stored_len:])
+            replace_section(data, p, q + 4 + stored_len, payload.replace(old, new, 1), dst)
             return
         p = q + 4 + stored_len
 
 
+def forge_topology(src, dst, op):
+    """Copies the one-segment .tsm file src to dst with its mesh section's
+    topology stream (the third of §4.7) changed by op: 'mode=N' sets its first
+    byte (version 9: the run coding mode, §8.3.1), 'cut=K' keeps its first K
+    bytes; the stream lengths, the section's lengths and its checksum are
+    rewritten to match."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from reference_decoder import read_varint
+    data = open(src, 'rb').read()
+    hlen, p = read_varint(data, 8, len(data))
+    p += hlen + 4
+    while True:
+        sid, codec = struct.unpack_from('<HB', data, p)
+        if sid == 0:
+            sys.exit('%s: no raw mesh section' % src)
+        stored_len, q = read_varint(data, p + 3, len(data))
+        _, q = read_varint(data, q, len(data))
+        payload = data[q + 4:q + 4 + stored_len]
+        if sid == 10 and codec == 0:
+            lengths, r = [], 0
+            for _ in range(4):
+                n, r = read_varint(payload, r, len(payload))
+                lengths.append(n)
+            streams = []
+            for n in lengths:
+                streams.append(payload[r:r + n])
+                r += n
+            topo = bytearray(streams[2])
+            key, value = op.split('=')
+            if key == 'mode':
+                topo[0] = int(value)
+            else:
+                topo = topo[:int(value)]
+            streams[2] = bytes(topo)
+            payload = b''.join(varint(len(x)) for x in streams) + b''.join(streams) + payload[r:]
+            replace_section(data, p, q + 4 + stored_len, payload, dst)
+            return
+        p = q + 4 + stored_len
+
+
+def replace_section(data, start, end, payload, dst):
+    """data with its section at [start, end) replaced by a raw mesh section
+    (id 10) holding payload, written to dst."""
+    from reference_decoder import xxh32
+    section = (struct.pack('<HB', 10, 0) + varint(len(payload)) + varint(len(payload))
+               + struct.pack('<I', xxh32(payload)) + payload)
+    open(dst, 'wb').write(data[:start] + section + data[end:])
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == '--forge-topology':
+        # --forge-topology SRC DST mode=N | cut=K
+        forge_topology(sys.argv[2], sys.argv[3], sys.argv[4])
+        return
     if len(sys.argv) > 1 and sys.argv[1] == '--replace-in-mesh':
         # --replace-in-mesh SRC DST OLD_HEX NEW_HEX
         replace_in_mesh(sys.argv[2], sys.argv[3], bytes.fromhex(sys.argv[4]), bytes.fromhex(sys.argv[5]))

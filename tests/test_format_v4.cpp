@@ -176,8 +176,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 9 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 9, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 10 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 10, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -394,20 +394,22 @@ TEST(FormatV7, LatticePlanesFromTheTopOnlyWhereTheyPay) {
 }
 
 // Version 8 codes the residuals of levels 0-2 with static prefix codes per
-// context (FORMAT.md §8.5.11): those files say version 8 and round trip
-// exactly and canonically; an asked-for version 7 codes them adaptively;
-// the default level keeps version 5; the table flag in a version 7 file is
-// an unknown predictor.
+// context (FORMAT.md §8.5.11): those files round trip exactly and
+// canonically (they say version 9 since the run values are table-coded too,
+// FormatV9 below); an asked-for version 7 codes them adaptively; the
+// default level keeps version 5; the table flag in a version 7 file is an
+// unknown predictor.
 TEST(FormatV8, TablesAtTheFastLevelsAndVersion8OnlyThere) {
   const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
   auto tables = [](const std::string& bytes) { return predictor_of(bytes).find("+tables") != std::string::npos; };
   for (int level : {0, 1, 2}) {
     SCOPED_TRACE("level " + std::to_string(level));
-    const std::string v8 = encode_as(noisy, 14, level, 0);
+    const std::string v8 = encode_as(noisy, 14, level, 8);
     EXPECT_EQ(version_of(v8), 8u);
     EXPECT_TRUE(tables(v8)) << predictor_of(v8);
     expect_round_trip(noisy, v8, 14, "tables");
-    EXPECT_EQ(encode_as(decode_ok(v8), 14, level, 0), v8);
+    EXPECT_EQ(encode_as(decode_ok(v8), 14, level, 8), v8);
+    EXPECT_EQ(version_of(encode_as(noisy, 14, level, 0)), 9u);  // with the run tables of version 9
     const std::string v7 = encode_as(noisy, 14, level, 7);
     EXPECT_EQ(version_of(v7), 7u);  // an asked-for version is written as asked
     EXPECT_FALSE(tables(v7));
@@ -423,7 +425,180 @@ TEST(FormatV8, TablesAtTheFastLevelsAndVersion8OnlyThere) {
   tsm::EncodeOptions o;
   o.level = 0;
   o.segment_faces = 1000;
+  o.format_version = 8;
   ASSERT_TRUE(tsm::encode(noisy, o, seg).ok());
   EXPECT_EQ(version_of(seg), 8u);
   expect_round_trip(noisy, seg, 14, "tables in segments");
+}
+
+// The topology stream of a one-segment file (FORMAT.md §4.7, §8.3.1).
+std::string topology_of(const std::string& bytes) {
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  EXPECT_TRUE(tsm::read_container(bytes, h, parsed).ok());
+  tsm::MeshPayload p;
+  EXPECT_TRUE(!parsed.empty() && tsm::read_mesh_payload(parsed[0].data, p).ok());
+  return std::string(p.topology);
+}
+
+// How many parts of a file have table-coded run values (tsm info).
+uint64_t run_table_parts(const std::string& bytes) {
+  tsm::FileInfo fi;
+  EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+  return fi.run_table_parts;
+}
+
+// The same file with another topology stream.
+std::string with_topology(const std::string& bytes, const std::string& topology) {
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  EXPECT_TRUE(tsm::read_container(bytes, h, parsed).ok());
+  tsm::MeshPayload p;
+  EXPECT_TRUE(tsm::read_mesh_payload(parsed[0].data, p).ok());
+  p.topology = topology;
+  return rebuild(bytes, h.version, {{tsm::kSectionMesh, tsm::write_mesh_payload(p)}});
+}
+
+// A grid of n x n vertices, each quad split along a random diagonal, every
+// 7th quad left out (holes), and a fin of three faces on every 11th
+// horizontal edge (edges of three faces: stitches): irregular valences and
+// runs that do not repeat, as on a scan.
+Mesh irregular_grid(int n, uint32_t seed) {
+  Mesh m;
+  std::mt19937 rng(seed);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      m.add_vertex(static_cast<float>(x), static_cast<float>(y), static_cast<float>(rng() % 100) * 0.001f);
+  int quad = 0;
+  for (int y = 0; y + 1 < n; ++y)
+    for (int x = 0; x + 1 < n; ++x, ++quad) {
+      const uint32_t a = static_cast<uint32_t>(y * n + x), b = a + 1, c = a + static_cast<uint32_t>(n), d = c + 1;
+      if (quad % 7 == 3) continue;
+      if (rng() & 1) {
+        m.add_triangle(a, b, d);
+        m.add_triangle(a, d, c);
+      } else {
+        m.add_triangle(a, b, c);
+        m.add_triangle(b, d, c);
+      }
+      if (quad % 11 == 5) {
+        const uint32_t tip = static_cast<uint32_t>(m.vertex_count());
+        m.add_vertex(static_cast<float>(x) + 0.5f, static_cast<float>(y), 1.0f);
+        m.add_triangle(a, b, tip);
+      }
+    }
+  return m;
+}
+
+// Version 9 codes the connectivity's run values (vertex-run lengths, march
+// counts, stitch and virtual-vertex positions, stitch distances) of levels
+// 0-2 through static prefix codes (FORMAT.md §8.3.1) behind a mode byte at
+// the start of the topology stream: meshes of 256 faces or more at those
+// levels say version 9 and round trip exactly and canonically, whatever
+// their topology. Irregular meshes use the tables (mode 1) for a few percent
+// of their run values' bytes; regular ones, whose repeating runs the
+// adaptive models code in a fraction of a bit, keep the models (mode 0: the
+// version-8 streams and one byte). Smaller meshes and other levels keep the
+// version-8 layout and bytes; an asked-for version 9 writes mode 0 where
+// tables are not used; a forged mode or cut tables are refused.
+TEST(FormatV9, RunTablesAtTheFastLevels) {
+  const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
+  const std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"irregular grid", irregular_grid(40, 3)},
+      {"irregular grid 2", irregular_grid(60, 4)},
+      {"sphere", noisy},                                                // the regular ones from here
+      {"grid with holes", tsm_test::grid_with_holes(24, 6)},            // virtual vertices
+      {"books", tsm_test::copies(tsm_test::book(6), 50)},             // edges of six faces: stitches
+      {"genus 3", tsm_test::genus_surface(3)},                          // jump edges
+      {"moebius", tsm_test::moebius(150)},
+      {"soup", tsm_test::random_soup(300, 700, 7)},
+      {"flipped", tsm_test::flipped_face_sphere(3)},
+  };
+  for (const auto& [name, m] : meshes) {
+    ASSERT_GE(m.face_count(), 256u) << name;
+    for (int level : {0, 2}) {
+      SCOPED_TRACE(name + ", level " + std::to_string(level));
+      const bool irregular = name.rfind("irregular", 0) == 0;
+      const std::string v9 = encode_as(m, 12, level, 0);
+      EXPECT_EQ(version_of(v9), 9u);
+      EXPECT_EQ(topology_of(v9).substr(0, 1), std::string(1, irregular ? '\x01' : '\0'));
+      EXPECT_EQ(run_table_parts(v9), irregular ? 1u : 0u);
+      expect_round_trip(m, v9, 12, name);
+      EXPECT_TRUE(encode_as(decode_ok(v9), 12, level, 0) == v9);
+      const std::string v8 = encode_as(m, 12, level, 8);
+      EXPECT_EQ(version_of(v8), 8u);
+      expect_round_trip(m, v8, 12, name + " as version 8");
+      // Tables cost a few percent of the file at most; mode 0 one byte.
+      if (irregular)
+        EXPECT_LT(v9.size(), v8.size() * 104 / 100) << v8.size() << " -> " << v9.size();
+      else
+        EXPECT_EQ(v9.size(), v8.size() + 1);
+    }
+  }
+  // Small meshes and the other levels: the version-8 layout (the same
+  // bytes but for the version field, which says the oldest that reads them).
+  const Mesh small = tsm_test::icosphere(1);
+  for (const auto& [m, level] : {std::pair<const Mesh*, int>{&small, 0}, {&noisy, 6}}) {
+    const std::string auto_version = encode_as(*m, 12, level, 0), as_v8 = encode_as(*m, 12, level, 8);
+    EXPECT_LE(version_of(auto_version), 8u);
+    tsm::Header ha, hb;
+    std::vector<tsm::Section> sa, sb;
+    ASSERT_TRUE(tsm::read_container(auto_version, ha, sa).ok() && tsm::read_container(as_v8, hb, sb).ok());
+    ASSERT_EQ(sa.size(), sb.size());
+    for (size_t i = 0; i < sa.size(); ++i) EXPECT_TRUE(sa[i].data == sb[i].data) << level;
+  }
+  // Asked for: version 9 with mode 0 where no tables are used.
+  for (int level : {0, 6}) {
+    const Mesh& m = level == 0 ? small : noisy;
+    const std::string v9 = encode_as(m, 12, level, 9);
+    EXPECT_EQ(version_of(v9), 9u);
+    EXPECT_EQ(topology_of(v9).substr(0, 1), std::string(1, '\0'));
+    expect_round_trip(m, v9, 12, "mode 0");
+    EXPECT_EQ(encode_as(decode_ok(v9), 12, level, 9), v9);
+  }
+  // Segments of a version 9 file: every one has the mode byte, the small
+  // ones mode 0.
+  const Mesh grid = irregular_grid(60, 4);
+  for (uint32_t faces : {4000u, 300u}) {
+    std::string seg;
+    tsm::EncodeOptions o;
+    o.level = 0;
+    o.segment_faces = faces;
+    ASSERT_TRUE(tsm::encode(grid, o, seg).ok());
+    EXPECT_EQ(version_of(seg), 9u);
+    if (faces > 1000) {
+      EXPECT_GE(run_table_parts(seg), 1u);
+    }
+    expect_round_trip(grid, seg, 14, "run tables in segments of " + std::to_string(faces));
+    std::string again;
+    ASSERT_TRUE(tsm::encode(decode_ok(seg), o, again).ok());
+    EXPECT_EQ(again, seg);
+  }
+  // Forged: a mode above 1, an empty stream, tables cut short, the bit
+  // stream longer than the stream, the tables read as mode 0.
+  const std::string v9 = encode_as(grid, 12, 0, 0);
+  const std::string topo = topology_of(v9);
+  ASSERT_GT(topo.size(), 16u);
+  ASSERT_EQ(topo[0], 1);
+  std::string bad = topo;
+  bad[0] = 2;
+  EXPECT_EQ(decode_code(with_topology(v9, bad)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(decode_code(with_topology(v9, "")), tsm::ErrorCode::corrupt_data);
+  for (size_t cut : {size_t{1}, size_t{3}, size_t{5}, size_t{6}, size_t{9}})
+    EXPECT_EQ(decode_code(with_topology(v9, topo.substr(0, cut))), tsm::ErrorCode::corrupt_data) << cut;
+  bad = topo;
+  bad[4] = static_cast<char>(0x7F);  // bit stream length's top byte
+  EXPECT_EQ(decode_code(with_topology(v9, bad)), tsm::ErrorCode::corrupt_data);
+  bad = topo;
+  bad[0] = 0;
+  EXPECT_EQ(decode_code(with_topology(v9, bad)), tsm::ErrorCode::corrupt_data);
+  // Every byte after the bit stream's length flipped in turn (the map, the
+  // tables, the bit stream, the range-coded rest): refused or decoded,
+  // never a crash (the ASan build checks the reads).
+  for (size_t i = 5; i < topo.size(); ++i) {
+    bad = topo;
+    bad[i] = static_cast<char>(bad[i] ^ 0x5A);
+    Mesh out;
+    (void)tsm::decode(with_topology(v9, bad), out);
+  }
 }

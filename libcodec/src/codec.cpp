@@ -120,6 +120,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   cs.vertex_tree.assign(s.vertex_tree);
   cs.triangle_tree.assign(s.triangle_tree);
   cs.topology.assign(s.topology);
+  cs.mode_byte = s.version >= 9;
   GeometryLayout layout;
   const PartCounts& c = out.counts;
   TSM_RETURN_IF_ERROR(
@@ -330,7 +331,14 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
 // The oldest format version that reads a geometry stream: 8 for residuals
 // through tables, 7 for lattice planes coded from the top, 6 for residual
 // mixing, else 5.
-uint16_t needed_version(const std::string& geometry) {
+// encode()'s options as its parts see them, with what every part of the
+// file must agree on: whether their topology streams have the mode byte.
+struct PartOptions : EncodeOptions {
+  bool mode_byte = false;
+};
+
+uint16_t needed_version(const ConnectivityStreams& streams, const std::string& geometry) {
+  if (streams.mode_byte) return 9;
   const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
   return kind & kTableFlag ? 8 : kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
 }
@@ -408,6 +416,26 @@ bool in_anchor_order(const ConnectivityEncoding& ce, const std::vector<uint32_t>
   return true;
 }
 
+// Version 9 (FORMAT.md §8.3.1): at the fast levels, a part of
+// kRunTableFaces faces or more codes its run values through tables (every
+// value is below 2^30 when vertices + 2 corners are below 2^28); smaller
+// parts keep the adaptive models, whose few values cost less than tables.
+// Every part of a file has the mode byte or none (the file's version says
+// which): a mesh of that many faces at a fast level, or any mesh when
+// version 9 is asked for, has it (and says version 9); others keep the
+// version-8 layout and their bytes.
+constexpr size_t kRunTableFaces = 256;
+bool file_has_mode_byte(const Mesh& mesh, const EncodeOptions& options) {
+  return written_version(options) >= 9 &&
+         (options.format_version >= 9 || (options.level <= kTableLevel && mesh.face_count() >= kRunTableFaces));
+}
+RunCoding run_coding(const Mesh& part, const PartOptions& options) {
+  if (!options.mode_byte) return RunCoding::v8;
+  const bool fits = part.vertex_count() + 2 * part.corner_count() < (size_t{1} << 28);
+  return options.level <= kTableLevel && fits && part.face_count() >= kRunTableFaces ? RunCoding::tables
+                                                                                     : RunCoding::adaptive;
+}
+
 // How a part's vertex trees are built (encode_part tries several).
 struct TreeChoice {
   int root_rule = 0;      // CutHints::root_rule
@@ -418,11 +446,12 @@ struct TreeChoice {
 // triangle have a nearby surface vertex to predict them (their anchor), a
 // second pass that orders them by it.
 Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                         const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+                         const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
   CutHints hints;
   hints.qpos = &qin;
   hints.root_rule = tree.root_rule;
   hints.midpoint_tree = tree.midpoint;
+  hints.runs = run_coding(mesh, options);
   TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
   view = own_view(ce, qin, is_ref);
   std::vector<uint32_t> anchor = find_anchors(view.layout, view.q, options.quantization_bits);
@@ -465,7 +494,7 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 constexpr int kCanonicalRounds = 4;
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                              const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+                              const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
   TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, tree, ce, view));
   if (tree.root_rule != 0) return Status::Ok();  // only tried on parts without stitches (encode_part)
   if (ce.stats.stitches == 0) return Status::Ok();
@@ -526,7 +555,7 @@ bool same_streams(const ConnectivityStreams& a, const ConnectivityStreams& b) {
 // qin: grid indices per part input vertex; is_ref: per part input vertex,
 // 1 when an earlier segment holds it (empty: none).
 Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                        const std::vector<AttributeHeader>& headers, const EncodeOptions& options, TreeChoice tree,
+                        const std::vector<AttributeHeader>& headers, const PartOptions& options, TreeChoice tree,
                         EncodedPart& out, bool& usable, bool& stitched, TriedCodings* tried) {
   const int bits = options.quantization_bits;
   ConnectivityEncoding ce;
@@ -597,7 +626,7 @@ size_t part_bytes(const EncodedPart& p) {
 }
 
 Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                   const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
+                   const std::vector<AttributeHeader>& headers, const PartOptions& options, EncodedPart& out) {
   bool usable = true, stitched = false;
   TriedCodings tried;
   const bool small = options.level >= kSmallSearchLevel && is_ref.empty() && mesh.face_count() <= kSmallSearchFaces;
@@ -764,7 +793,7 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const EncodeOptions& options, ContainerWriter& cw, uint16_t& needed) {
+                       const PartOptions& options, ContainerWriter& cw, uint16_t& needed) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -857,7 +886,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     sp.geometry = p.geometry;
     sp.attributes = p.attributes;
     cw.add_section(kSectionSegment, write_segment(sp), 0);
-    needed = std::max(needed, needed_version(p.geometry));
+    needed = std::max(needed, needed_version(p.streams, p.geometry));
     p = EncodedPart();
   }
   return Status::Ok();
@@ -927,14 +956,17 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
   }
   uint16_t needed = 5;
+  PartOptions po;
+  static_cast<EncodeOptions&>(po) = options;
+  po.mode_byte = file_has_mode_byte(mesh, options);
   if (segments.size() == 1) {
     EncodedPart p;
-    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
+    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, po, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
-    needed = needed_version(p.geometry);
+    needed = needed_version(p.streams, p.geometry);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, needed));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, po, cw, needed));
   }
   // Unless asked for a version: the oldest that holds what was coded (version
   // 6 only adds residual mixing, 7 the lattice planes from the top), so that
@@ -1000,6 +1032,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     info.virtual_vertices += st.virtual_vertices;
     info.side_faces += st.side_faces;
     info.marching_bits += st.marching_bits;
+    info.run_table_parts += st.run_tables;
     info.references += parts[k].counts.reference_count;
     SegmentSummary sum;
     sum.vertices = parts[k].counts.vertex_count;

@@ -7,11 +7,17 @@
 //                  count), marching bits, polygon-edge flags
 //   topology:      component count, jump edges, virtual vertices, stitches,
 //                  side faces (degenerate faces kept verbatim)
+// At the fast levels (format version 9, FORMAT.md §8.3.1) the run values
+// (vertex-run lengths, march counts, stitch and virtual-vertex positions,
+// stitch distances) go through static prefix codes instead (table_coder),
+// stored at the start of the topology stream: one lookup per value.
 // The decoder reverses it and reassembles the exact input faces.
 #include <algorithm>
 
+#include "byte_io.hpp"
 #include "connectivity.hpp"
 #include "range_coder.hpp"
+#include "table_coder.hpp"
 
 namespace tsm {
 
@@ -42,6 +48,55 @@ struct TopologyModels {
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
 
+// Run-value contexts of the tables (FORMAT.md §8.3.1).
+constexpr int kRunLengthCtx = 0;    // + previous run's end (vertex-run length)
+constexpr int kRunMarchCtx = 2;     // + 2 * previous run's end + this run's end (march count)
+constexpr int kRunPositionCtx = 6;  // virtual and stitched vertices' position gaps
+constexpr int kRunDistanceCtx = 7;  // stitch distances
+
+// The encoder's run values (RunCoding): through their adaptive models into
+// the stream they belong to, or, with tables, listed in the order the
+// decoder reads them and coded at the end; then also coded adaptively into
+// a stream of their own (`adaptive`), whose length is what they would have
+// cost in the streams (their models code nothing else).
+struct RunEncoder {
+  bool tables = false;
+  std::vector<std::pair<uint8_t, uint32_t>> values;  // (context, value)
+  RangeEncoder adaptive;
+  void put(RangeEncoder& e, UIntModel& m, int ctx, uint32_t v) {
+    if (tables) {
+      values.emplace_back(static_cast<uint8_t>(ctx), v);
+      m.encode(adaptive, v);
+    } else {
+      m.encode(e, v);
+    }
+  }
+  // The topology stream's prefix with tables: mode byte 1, the bit
+  // stream's length, the table block, the bit stream.
+  std::string block() const {
+    std::vector<std::array<uint32_t, kTableSymbols>> count(kRunContexts, std::array<uint32_t, kTableSymbols>{});
+    for (auto [c, v] : values) ++count[c][table_symbol(v).symbol];
+    std::vector<CodeLengths> length(kRunContexts);
+    std::vector<std::array<uint32_t, kTableSymbols>> code(kRunContexts);
+    for (int c = 0; c < kRunContexts; ++c) {
+      length[c] = table_code_lengths(count[c]);  // all zero for a context never used: no table
+      code[c] = canonical_codes(length[c]);
+    }
+    BitWriter w;
+    for (auto [c, v] : values) {
+      const TableSymbol t = table_symbol(v);
+      w.put(code[c][t.symbol], length[c][t.symbol]);
+      if (t.raw_bits) w.put(t.raw, t.raw_bits);
+    }
+    const std::string bits = w.finish();
+    std::string out;
+    ByteWriter bw(out);
+    bw.u8(1);
+    bw.u32(static_cast<uint32_t>(bits.size()));
+    return out + write_tables(length, kRunMapBytes) + bits;
+  }
+};
+
 }  // namespace
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
@@ -56,6 +111,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       build_vertex_tree(m, hints.qpos, hints.midpoint_tree && hints.qpos, by_position, &out.root_tie);
 
   RangeEncoder ev, et, eo;
+  RunEncoder runs;
+  runs.tables = hints.runs == RunCoding::tables;
   VertexTreeModels vm;
   TriangleTreeModels tm;
   TopologyModels om;
@@ -96,7 +153,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       uint32_t j = i;
       while (f.child_count[j] == 1) ++j;
       const int leaf = f.child_count[j] == 0;
-      vm.length[prev_leaf].encode(ev, j - i);
+      runs.put(ev, vm.length[prev_leaf], kRunLengthCtx + prev_leaf, j - i);
       ev.bit(vm.leaf[prev_leaf], leaf);
       if (i != start) {
         const uint32_t idx = kids_seen[f.parent[i]]++;
@@ -142,7 +199,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     int prev_end = 1, prev_end2 = 1;
     for (size_t r = 0; r < tr.march.size(); ++r) {
       et.bit(tm.end[prev_end][prev_end2], tr.branch[r]);
-      tm.march[prev_end][tr.branch[r]].encode(et, tr.march[r]);
+      runs.put(et, tm.march[prev_end][tr.branch[r]], kRunMarchCtx + 2 * prev_end + tr.branch[r], tr.march[r]);
       prev_end2 = prev_end;
       prev_end = tr.branch[r];
     }
@@ -234,14 +291,14 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   om.count.encode(eo, static_cast<uint32_t>(virtual_pos.size()));
   uint32_t prev = 0;
   for (uint32_t p : virtual_pos) {
-    om.position.encode(eo, p - prev);
+    runs.put(eo, om.position, kRunPositionCtx, p - prev);
     prev = p;
   }
   om.count.encode(eo, static_cast<uint32_t>(stitches.size()));
   prev = 0;
   for (auto [dup, orig] : stitches) {
-    om.position.encode(eo, dup - prev);
-    om.distance.encode(eo, dup - orig - 1);
+    runs.put(eo, om.position, kRunPositionCtx, dup - prev);
+    runs.put(eo, om.distance, kRunDistanceCtx, dup - orig - 1);
     prev = dup;
   }
   // Side faces, corners as output vertex ids.
@@ -260,6 +317,24 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   out.streams.vertex_tree = ev.finish();
   out.streams.triangle_tree = et.finish();
   out.streams.topology = eo.finish();
+  if (hints.runs != RunCoding::v8) {  // version 9: the mode byte (and the tables) first
+    const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
+    if (runs.tables) {
+      // Tables where they cost at most a quarter more than the adaptive
+      // models (the corpus scans: 3-11% more, tables included). On regular
+      // meshes, whose runs repeat, the models learn the values down to a
+      // small fraction of a bit while a prefix code spends at least one bit
+      // on each (40-500% more): those are coded again without tables.
+      const size_t adaptive = runs.adaptive.finish().size();
+      if (block.size() > adaptive + adaptive / 4) {
+        CutHints again = hints;
+        again.runs = RunCoding::adaptive;
+        return encode_connectivity(mesh, out, again);
+      }
+    }
+    out.streams.mode_byte = true;
+    out.streams.topology = block + out.streams.topology;
+  }
   st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
   return Status::Ok();
 }
@@ -267,19 +342,53 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
                            uint64_t corner_count, Mesh& out, GeometryLayout& layout,
                            ConnectivityStats* stats) {
-  RangeDecoder dv(in.vertex_tree), dt(in.triangle_tree), dop(in.topology);
+  // Version 9 (§8.3.1): the mode byte, and with tables the bit stream's
+  // length, the run tables and the bit stream before the range-coded rest.
+  std::string_view topology = in.topology;
+  bool tables = false;
+  TableSet run_tables;
+  BitReader run_bits;
+  if (in.mode_byte) {
+    ByteReader r(topology);
+    uint8_t mode;
+    if (!r.u8(mode)) return corrupt("topology stream is empty (no run coding mode)");
+    if (mode > 1) return corrupt("run coding mode " + std::to_string(mode) + " (0 adaptive or 1 tables)");
+    if (mode == 1) {
+      uint32_t bit_bytes;
+      std::string why;
+      std::string_view bitstream;
+      if (!r.u32(bit_bytes)) return corrupt("run tables are truncated");
+      if (!run_tables.read(r, kRunContexts, why, kRunMapBytes)) return corrupt("run tables: " + why);
+      if (!r.bytes(bit_bytes, bitstream))
+        return corrupt("the run values' bit stream has " + std::to_string(bit_bytes) + " bytes, the topology stream " +
+                       std::to_string(r.remaining()) + " after its tables");
+      run_bits.init(bitstream);
+      tables = true;
+    }
+    topology = topology.substr(r.offset());
+  }
+  RangeDecoder dv(in.vertex_tree), dt(in.triangle_tree), dop(topology);
   VertexTreeModels vm;
   TriangleTreeModels tm;
   TopologyModels om;
   ConnectivityStats st;
   auto overrun = [&] {
     return dv.overrun() > RangeDecoder::kMaxOverrun || dt.overrun() > RangeDecoder::kMaxOverrun ||
-           dop.overrun() > RangeDecoder::kMaxOverrun;
+           dop.overrun() > RangeDecoder::kMaxOverrun || run_bits.overrun();
+  };
+  // A run value: from its model, or with tables from the bit stream
+  // (0xFFFFFFFF, which every caller refuses, for a code word no table has
+  // or a negative value).
+  auto run_value = [&](UIntModel& m, RangeDecoder& d, int ctx) -> uint32_t {
+    if (!tables) return m.decode(d);
+    int32_t r;
+    if (!run_tables.decode(run_bits, ctx, r) || r < 0) return 0xFFFFFFFFu;
+    return static_cast<uint32_t>(r);
   };
   // Pre-order vertices: real + duplicates + virtual; the latter two are at
   // most one per corner each.
   const uint64_t max_positions = vertex_count + 2 * corner_count;
-  const uint64_t max_jumps = max_decisions(in.topology.size()) / 6;
+  const uint64_t max_jumps = max_decisions(topology.size()) / 6;
   const uint32_t C = om.count.decode(dop);
   const bool polygons = dop.bit(om.has_polygons);
   if (C > max_positions) return corrupt("more components than vertices");
@@ -315,7 +424,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     bool root_run = true;
     for (;;) {
       if (overrun()) return corrupt("vertex tree stream is truncated");
-      uint32_t len = vm.length[prev_leaf].decode(dv);
+      uint32_t len = run_value(vm.length[prev_leaf], dv, kRunLengthCtx + prev_leaf);
       if (len == 0xFFFFFFFFu || parent.size() + len + 1 > max_positions) return corrupt("vertex tree run too long");
       int leaf = dv.bit(vm.leaf[prev_leaf]);
       prev_leaf = leaf;
@@ -374,7 +483,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     for (;;) {
       if (overrun()) return corrupt("triangle tree stream is truncated");
       const int br = dt.bit(tm.end[prev_end][prev_end2]);
-      uint32_t march = tm.march[prev_end][br].decode(dt);
+      uint32_t march = run_value(tm.march[prev_end][br], dt, kRunMarchCtx + 2 * prev_end + br);
       if (march == 0xFFFFFFFFu || total + static_cast<uint64_t>(march) + 1 > L) return corrupt("triangle run too long");
       tr.march.push_back(march);
       tr.branch.push_back(static_cast<uint8_t>(br));
@@ -440,7 +549,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (nvirt > P) return corrupt("more virtual vertices than vertices");
   uint32_t at = 0;
   for (uint32_t i = 0; i < nvirt; ++i) {
-    uint32_t d = om.position.decode(dop);
+    uint32_t d = run_value(om.position, dop, kRunPositionCtx);
     if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("virtual vertex position out of range");
     at += d;
     is_virtual[at] = 1;
@@ -450,7 +559,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   std::vector<uint32_t> stitch_to(P, kNone);
   at = 0;
   for (uint32_t i = 0; i < nstitch; ++i) {
-    uint32_t d = om.position.decode(dop), dist = om.distance.decode(dop);
+    const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
+    const uint32_t dist = run_value(om.distance, dop, kRunDistanceCtx);
     if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
     at += d;
     if (dist >= at) return corrupt("stitch target out of range");
@@ -648,6 +758,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   st.virtual_vertices = nvirt;
   st.stitches = nstitch;
   st.side_faces = nside;
+  st.run_tables = tables;
   if (stats) *stats = st;
   return Status::Ok();
 }

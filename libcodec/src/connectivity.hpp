@@ -46,6 +46,17 @@ struct UnionFind {
   }
 };
 
+// The connectivity's run values (vertex-run lengths, march counts, the
+// positions of virtual and stitched vertices and the stitch distances):
+// v8: adaptive models, the topology stream as in version 8 and before;
+// adaptive: the same, behind a mode byte 0 (version 9); tables: mode byte
+// 1, static prefix codes per context in a bit stream (version 9, the fast
+// levels: one table lookup per value instead of about eight adaptive
+// decisions).
+enum class RunCoding : uint8_t { v8 = 0, adaptive = 1, tables = 2 };
+constexpr int kRunContexts = 8;   // 2 vertex-run lengths, 4 march counts, position, distance
+constexpr int kRunMapBytes = 1;   // the run tables' used-context map
+
 enum class VertexKind : uint8_t { real = 0, duplicate = 1, virtual_ = 2 };
 
 // Stage 1 output: closed, oriented, manifold triangle components.
@@ -98,6 +109,8 @@ struct CutHints {
   // mesh has the same positions, so a rule picks the same roots and edges
   // there (the encoder tries several and keeps the smallest file).
   int root_rule = 0;
+  // How the run values are coded (format version 9, FORMAT.md §8.3.1).
+  RunCoding runs = RunCoding::v8;
 };
 
 // Lexicographic order of quantized positions (3 per input vertex), from
@@ -241,6 +254,7 @@ Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, cons
 struct ConnectivityStats {
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, polygons = 0, marching_bits = 0;
+  uint64_t run_tables = 0;  // 1 when the run values were table-coded (version 9, mode 1)
   uint64_t bytes = 0;
 };
 
@@ -249,6 +263,9 @@ struct ConnectivityStreams {
   std::string vertex_tree;    // VST runs per component
   std::string triangle_tree;  // root, runs, marching bits, polygon-edge flags per component
   std::string topology;       // components, jumps, virtual vertices, stitches, side faces
+  // Version 9 and later: the topology stream starts with the run coding's
+  // mode byte (0 adaptive, 1 tables; FORMAT.md §8.3.1).
+  bool mode_byte = false;
 };
 
 struct ConnectivityEncoding {

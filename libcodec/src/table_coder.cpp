@@ -89,8 +89,8 @@ std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length) {
   return code;
 }
 
-std::string write_tables(const std::vector<CodeLengths>& lengths) {
-  std::string out(kTableMapBytes, '\0');
+std::string write_tables(const std::vector<CodeLengths>& lengths, int map_bytes) {
+  std::string out(static_cast<size_t>(map_bytes), '\0');
   ByteWriter w(out);
   for (size_t c = 0; c < lengths.size(); ++c) {
     int S = 0;
@@ -105,15 +105,15 @@ std::string write_tables(const std::vector<CodeLengths>& lengths) {
   return out;
 }
 
-bool TableSet::read(ByteReader& r, int contexts, std::string& why) {
+bool TableSet::read(ByteReader& r, int contexts, std::string& why, int map_bytes) {
   std::string_view map;
-  if (contexts > 8 * kTableMapBytes || !r.bytes(kTableMapBytes, map)) {
+  if (contexts > 8 * map_bytes || !r.bytes(static_cast<size_t>(map_bytes), map)) {
     why = "table block is truncated";
     return false;
   }
   std::vector<int> slot(static_cast<size_t>(contexts), -1);  // per context: its primary table, or -1
   int used = 0;
-  for (int c = 0; c < 8 * kTableMapBytes; ++c) {
+  for (int c = 0; c < 8 * map_bytes; ++c) {
     if (!((static_cast<uint8_t>(map[c >> 3]) >> (c & 7)) & 1)) continue;
     if (c >= contexts) {
       why = "table for context " + std::to_string(c) + ", which does not exist";

@@ -1,5 +1,6 @@
 // Static prefix codes per context (entropy coding stage, format version 8;
-// FORMAT.md §8.5.11). The fast levels code the geometry residuals with one
+// FORMAT.md §8.5.11; version 9 codes the connectivity's run values with
+// them too, §8.3.1). The fast levels code the geometry residuals with one
 // canonical prefix code per residual context, stored in the file, instead
 // of the adaptive binary models of range_coder.hpp: one table lookup per
 // value instead of about ten adaptive decisions (6-9x faster to decode,
@@ -50,9 +51,11 @@ CodeLengths table_code_lengths(const std::array<uint32_t, kTableSymbols>& count)
 // §8.5.11: by length, then by symbol).
 std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length);
 
-// The table block: the used-context map, then per used context its symbol
-// count and 4-bit code lengths. contexts <= 8 * kTableMapBytes.
-std::string write_tables(const std::vector<CodeLengths>& lengths);
+// The table block: the used-context map (map_bytes bytes: kTableMapBytes for
+// the geometry residuals, kRunMapBytes for the connectivity's run values),
+// then per used context its symbol count and 4-bit code lengths.
+// lengths.size() <= 8 * map_bytes.
+std::string write_tables(const std::vector<CodeLengths>& lengths, int map_bytes = kTableMapBytes);
 
 class BitWriter {
  public:
@@ -141,8 +144,9 @@ class BitReader {
 constexpr int kTablePrimary = 7;
 class TableSet {
  public:
-  // Reads the table block for `contexts` contexts; false with the reason.
-  bool read(ByteReader& r, int contexts, std::string& why);
+  // Reads the table block for `contexts` contexts (its map map_bytes
+  // long); false with the reason.
+  bool read(ByteReader& r, int contexts, std::string& why, int map_bytes = kTableMapBytes);
   bool has(int ctx) const {
     return ctx >= 0 && ctx < static_cast<int>(table_.size()) && table_[static_cast<size_t>(ctx)] != none_;
   }

@@ -35,11 +35,14 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (8; the file says the oldest
+  // The format version to write: 0 = the newest (9; the file says the oldest
   // version that reads it: 5 unless it uses residual mixing, 6, lattice
-  // planes coded from the top, 7, or residuals through tables, which levels
-  // 0-2 use, 8); 7 writes files that decoders of version 7 read (levels 0-2
-  // then code residuals adaptively: slower to decode); 6 or 5 write files that decoders of that
+  // planes coded from the top, 7, residuals through tables, 8, or the
+  // connectivity's run values through tables, which levels 0-2 use on
+  // meshes of 256 faces or more, 9); 8 writes files that decoders of
+  // version 8 read (levels 0-2 then code run values adaptively); 7 files
+  // that decoders of version 7 read (levels 0-2 then code residuals
+  // adaptively too: slower to decode); 6 or 5 write files that decoders of that
   // version read (without version 7's planes from the top, a few bytes on a
   // box; 5 also without residual mixing, which only levels 7-9 use); 4 files
   // that decoders of version 4 read (without version 5's tangent step
@@ -115,6 +118,9 @@ struct FileInfo {
   // Topology figures (from decoding the connectivity streams).
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, marching_bits = 0;
+  // Parts (segments) whose connectivity run values are table-coded (format
+  // version 9, the fast levels; FORMAT.md §8.3.1).
+  uint64_t run_table_parts = 0;
   // Stored bytes by kind; other = header, framing, references, side data.
   uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;
   uint64_t reference_bytes = 0;  // part of other: the segments' references streams
