@@ -434,6 +434,10 @@ int main(int argc, char** argv) {
   // ... and at level 0: table-coded residuals (format version 8), at 30 bits too
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(3), 0.004f, 5), 14, 0);
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(2), 0.004f, 5), 30, 0);
+  // table-coded connectivity run values (format version 9, mode 1): an
+  // irregular grid with holes and fins (the noisy sphere above has mode 0)
+  encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(20, 3), 11, 0);
+  encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(24, 3), 11, 0, 400);
   encode_seed(decode_dir, "quads", quad_grid(6), 1, 6);
   // Files of several segments (FORMAT.md §4.5).
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 12, 6, 40);

@@ -242,6 +242,37 @@ Mesh ngon(int n) {
   return m;
 }
 
+// A grid of n x n vertices, each quad split along a random diagonal, every
+// 7th quad left out (holes), and a fin of three faces on the lower edge of
+// every 11th quad (edges of three faces: stitches): irregular valences and
+// runs that do not repeat, as on a scan.
+Mesh irregular_grid(int n, uint32_t seed) {
+  Mesh m;
+  std::mt19937 rng(seed);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      m.add_vertex(static_cast<float>(x), static_cast<float>(y), static_cast<float>(rng() % 100) * 0.001f);
+  int quad = 0;
+  for (int y = 0; y + 1 < n; ++y)
+    for (int x = 0; x + 1 < n; ++x, ++quad) {
+      const uint32_t a = static_cast<uint32_t>(y * n + x), b = a + 1, c = a + static_cast<uint32_t>(n), d = c + 1;
+      if (quad % 7 == 3) continue;
+      if (rng() & 1) {
+        m.add_triangle(a, b, d);
+        m.add_triangle(a, d, c);
+      } else {
+        m.add_triangle(a, b, c);
+        m.add_triangle(b, d, c);
+      }
+      if (quad % 11 == 5) {
+        const uint32_t tip = static_cast<uint32_t>(m.vertex_count());
+        m.add_vertex(static_cast<float>(x) + 0.5f, static_cast<float>(y), 1.0f);
+        m.add_triangle(a, b, tip);
+      }
+    }
+  return m;
+}
+
 Mesh jittered(Mesh m, float amplitude, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> offset(-amplitude, amplitude);

@@ -40,4 +40,9 @@ tsm::Mesh copies(const tsm::Mesh& m, int count);
 // [-amplitude, amplitude] (std::mt19937 seeded with `seed`): a noisy surface.
 tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);
 
+// n x n vertices, each quad split along a random diagonal, every 7th quad
+// left out (holes) and a fin of three faces on every 11th quad's lower edge
+// (stitches): irregular runs, as on a scan (format version 9's run tables).
+tsm::Mesh irregular_grid(int n, uint32_t seed);
+
 }  // namespace tsm_test

@@ -459,37 +459,6 @@ std::string with_topology(const std::string& bytes, const std::string& topology)
   return rebuild(bytes, h.version, {{tsm::kSectionMesh, tsm::write_mesh_payload(p)}});
 }
 
-// A grid of n x n vertices, each quad split along a random diagonal, every
-// 7th quad left out (holes), and a fin of three faces on every 11th
-// horizontal edge (edges of three faces: stitches): irregular valences and
-// runs that do not repeat, as on a scan.
-Mesh irregular_grid(int n, uint32_t seed) {
-  Mesh m;
-  std::mt19937 rng(seed);
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      m.add_vertex(static_cast<float>(x), static_cast<float>(y), static_cast<float>(rng() % 100) * 0.001f);
-  int quad = 0;
-  for (int y = 0; y + 1 < n; ++y)
-    for (int x = 0; x + 1 < n; ++x, ++quad) {
-      const uint32_t a = static_cast<uint32_t>(y * n + x), b = a + 1, c = a + static_cast<uint32_t>(n), d = c + 1;
-      if (quad % 7 == 3) continue;
-      if (rng() & 1) {
-        m.add_triangle(a, b, d);
-        m.add_triangle(a, d, c);
-      } else {
-        m.add_triangle(a, b, c);
-        m.add_triangle(b, d, c);
-      }
-      if (quad % 11 == 5) {
-        const uint32_t tip = static_cast<uint32_t>(m.vertex_count());
-        m.add_vertex(static_cast<float>(x) + 0.5f, static_cast<float>(y), 1.0f);
-        m.add_triangle(a, b, tip);
-      }
-    }
-  return m;
-}
-
 // Version 9 codes the connectivity's run values (vertex-run lengths, march
 // counts, stitch and virtual-vertex positions, stitch distances) of levels
 // 0-2 through static prefix codes (FORMAT.md §8.3.1) behind a mode byte at
@@ -504,8 +473,8 @@ Mesh irregular_grid(int n, uint32_t seed) {
 TEST(FormatV9, RunTablesAtTheFastLevels) {
   const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
   const std::vector<std::pair<std::string, Mesh>> meshes = {
-      {"irregular grid", irregular_grid(40, 3)},
-      {"irregular grid 2", irregular_grid(60, 4)},
+      {"irregular grid", tsm_test::irregular_grid(40, 3)},
+      {"irregular grid 2", tsm_test::irregular_grid(60, 4)},
       {"sphere", noisy},                                                // the regular ones from here
       {"grid with holes", tsm_test::grid_with_holes(24, 6)},            // virtual vertices
       {"books", tsm_test::copies(tsm_test::book(6), 50)},             // edges of six faces: stitches
@@ -558,7 +527,7 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
   }
   // Segments of a version 9 file: every one has the mode byte, the small
   // ones mode 0.
-  const Mesh grid = irregular_grid(60, 4);
+  const Mesh grid = tsm_test::irregular_grid(60, 4);
   for (uint32_t faces : {4000u, 300u}) {
     std::string seg;
     tsm::EncodeOptions o;
