@@ -423,7 +423,7 @@ FileResult info_one(const std::string& input) {
                 "\"connectivity_bits_per_vertex\": %.4f, \"geometry_bits_per_vertex\": %.4f, "
                 "\"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
                 "\"triangle_runs\": %llu, \"marching_bits\": %llu, \"jump_edges\": %llu, \"stitches\": %llu, "
-                "\"virtual_vertices\": %llu, \"side_faces\": %llu, \"run_table_parts\": %llu, \"geometry_predictor\": \"%s\", "
+                "\"virtual_vertices\": %llu, \"side_faces\": %llu, \"run_table_parts\": %llu, \"table_coded_attributes\": %llu, \"geometry_predictor\": \"%s\", "
                 "\"ancestors\": %d, \"lattice_planes\": [%u, %u, %u], \"sections\": [",
                 json_escape(input).c_str(), fi.format_version, static_cast<ull>(fi.file_bytes),
                 static_cast<ull>(fi.vertex_count), static_cast<ull>(fi.face_count), static_cast<ull>(fi.corner_count),
@@ -432,7 +432,7 @@ FileResult info_one(const std::string& input) {
                 static_cast<ull>(fi.components), static_cast<ull>(fi.vertex_runs), static_cast<ull>(fi.triangle_runs),
                 static_cast<ull>(fi.marching_bits), static_cast<ull>(fi.jump_edges), static_cast<ull>(fi.stitches),
                 static_cast<ull>(fi.virtual_vertices), static_cast<ull>(fi.side_faces), static_cast<ull>(fi.run_table_parts),
-                json_escape(fi.geometry_predictor).c_str(), fi.ancestors, fi.lattice_planes[0], fi.lattice_planes[1],
+                static_cast<ull>(fi.table_coded_attributes), json_escape(fi.geometry_predictor).c_str(), fi.ancestors, fi.lattice_planes[0], fi.lattice_planes[1],
                 fi.lattice_planes[2]);
   for (size_t i = 0; i < fi.sections.size(); ++i) {
     const SectionInfo& si = fi.sections[i];
@@ -454,9 +454,10 @@ FileResult info_one(const std::string& input) {
             thousands(fi.components).c_str(), thousands(fi.vertex_runs).c_str(), thousands(fi.triangle_runs).c_str(),
             thousands(fi.marching_bits).c_str(), thousands(fi.jump_edges).c_str(), thousands(fi.stitches).c_str(),
             thousands(fi.virtual_vertices).c_str(), thousands(fi.side_faces).c_str());
-  if (fi.run_table_parts)
-    t += strf("  run values: table-coded in %s of %s parts\n", thousands(fi.run_table_parts).c_str(),
-              thousands(fi.segments.size()).c_str());
+  if (fi.run_table_parts || fi.table_coded_attributes)
+    t += strf("  tables: run values in %s of %s parts, residuals of %s attributes (summed over the parts)\n",
+              thousands(fi.run_table_parts).c_str(), thousands(fi.segments.size()).c_str(),
+              thousands(fi.table_coded_attributes).c_str());
   t += strf("  geometry: %s predictor", fi.geometry_predictor.c_str());
   if (fi.ancestors) t += strf(" (K = %d)", fi.ancestors);
   if (fi.lattice_planes[0] + fi.lattice_planes[1] + fi.lattice_planes[2])

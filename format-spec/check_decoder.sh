@@ -119,6 +119,11 @@ acheck uv_vertex "$work/uv_vertex.ply" 12 6
 acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150
 acheck uv_corner "$work/uv_corner.obj" 12 6
 acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
+# version 9, the fast level: table-coded attribute residuals (§8.12.1) for
+# predictor 2 in both domains, and in segments with values shared across borders
+acheck uv_vertex_l0 "$work/uv_vertex.ply" 12 0
+acheck uv_corner_l0 "$work/uv_corner.obj" 12 0
+acheck uv_corner_segments_l0 "$work/uv_corner.obj" 12 0 600
 corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
 corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # version 8 tables, the fast level
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000

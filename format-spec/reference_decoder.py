@@ -1711,6 +1711,7 @@ class AttrModels:
         self.imported = [UIntModel(2), UIntModel(2)]     # [the corner's vertex is a reference]
         self.import_id = SIntModel(4)
         self.last_zero = [1, 1, 1, 1]
+        self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
 
 def faces_around(faces, n):
@@ -1932,7 +1933,11 @@ def decode_value(d, m, walk, item, segmented=False):
         walk.alias.append(None)
     x = []
     for c in range(h.ints()):
-        r = m.res[cls][c][m.last_zero[c]].decode(d)
+        if m.table is not None:                              # §8.12.1
+            tables, bits, base = m.table
+            r = table_residual(tables, bits, base + 8 * cls + 2 * c + m.last_zero[c], 'attributes')
+        else:
+            r = m.res[cls][c][m.last_zero[c]].decode(d)
         v = pred[c] + r
         if not h.in_range(v):
             reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
@@ -1953,7 +1958,7 @@ def predictor_allowed(h, pr):
     return False
 
 
-def decode_attributes(payload, faces, glob, q, segmented=False):
+def decode_attributes(payload, faces, glob, q, segmented=False, version=4):
     """§8.12 for one part. faces: the part's faces (part-local ids); glob: per part
     vertex NONE (own) or a reference; q: the own vertices' grid indices;
     segmented: a segment of a segmented file (new corner values may stand for an
@@ -1970,15 +1975,22 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
     for _ in range(A):
         h, p = read_attribute_header(payload, p)
         headers.append(h)
-    predictors = []
+    predictors, tabled = [], []
     for h in headers:
         if p >= len(payload):
             reject('attributes: bad predictor')
         pr = payload[p]
         p += 1
+        t = version >= 9 and pr & 0x08 != 0                  # §8.12.1: table-coded residuals
+        if t:
+            pr &= ~0x08
         if not predictor_allowed(h, pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
+        tabled.append(t)
+    tables = bits = None
+    if any(tabled):                                          # §8.12.1
+        tables, bits, p = read_tables(payload, p, 24 * A, 3 * A, 'attributes')
     coded = payload[p:]
     rank = [NONE] * len(glob)
     own_vertex = []
@@ -1990,9 +2002,11 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
     around = faces_around(faces, len(glob)) if 2 in predictors else None
     d = RangeDecoder(coded)
     out = []
-    for h, pr in zip(headers, predictors):
+    for i, (h, pr) in enumerate(zip(headers, predictors)):
         m = AttrModels()
         m.last_import = 0
+        if tabled[i]:                                        # §8.12.1: this attribute's contexts
+            m.table = (tables, bits, 24 * i)
         walk = AttrWalk(h, pr, faces, rank, q, around)
         indices = alias = None
         if h.domain == 0:                                    # vertex: own vertices in output order
@@ -2183,7 +2197,7 @@ def decode_part(streams, counts, bits, earlier, trace, version=4):
         layout = own
     q, ginfo = decode_geometry(s6, layout, bits, trace, version)    # step 30
     info.update(ginfo)
-    attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 31
+    attrs = decode_attributes(sa, faces, glob, q, sr is not None, version)   # step 31
     return faces, q, glob, info, attrs
 
 

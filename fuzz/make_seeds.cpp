@@ -352,6 +352,36 @@ void corpus_seeds(const fs::path& corpus, const fs::path& decode_dir, const fs::
 // seam where u wraps; values shared by the corners of a vertex otherwise),
 // a face attribute, and metadata: seeds for the attribute decoder's
 // predictors, values of earlier segments and the metadata section.
+// An irregular grid with random vertex values, face labels and corner
+// values (a seam on every fifth corner): attributes whose residuals the
+// fast levels table-code.
+tsm::Mesh noisy_attributes() {
+  tsm::Mesh m = tsm_test::irregular_grid(20, 5);
+  std::mt19937 rng(17);
+  tsm::Attribute v, f, c;
+  v.name = "noise";
+  v.components = 2;
+  for (size_t i = 0; i < 2 * m.vertex_count(); ++i) v.values.push_back(static_cast<float>(rng() % 1000) / 999.0f);
+  f.name = "label";
+  f.domain = tsm::AttributeDomain::face;
+  f.type = tsm::AttributeType::i32;
+  for (size_t i = 0; i < m.face_count(); ++i) f.values.push_back(static_cast<float>(rng() % 40));
+  c.name = "texcoord";
+  c.kind = tsm::AttributeKind::texcoord;
+  c.domain = tsm::AttributeDomain::corner;
+  c.components = 2;
+  for (size_t k = 0; k < m.corner_count(); ++k) {
+    const uint32_t at = k % 5 == 0 ? static_cast<uint32_t>(m.vertex_count() + k) : m.indices[k];
+    c.indices.push_back(at);
+  }
+  for (size_t i = 0; i < m.vertex_count() + m.corner_count(); ++i) {
+    c.values.push_back(static_cast<float>(rng() % 4096) / 4095.0f);
+    c.values.push_back(static_cast<float>(rng() % 4096) / 4095.0f);
+  }
+  m.attributes = {v, f, c};
+  return m;
+}
+
 tsm::Mesh with_attributes(bool per_corner) {
   tsm::Mesh m = tsm_test::icosphere(2);
   tsm::Attribute t, f;
@@ -448,6 +478,10 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "uv_vertex", with_attributes(false), 12, 6);
   encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6);
   encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6, 60);
+  // table-coded attribute residuals (format version 9): noisy values on an
+  // irregular grid at level 0, whole and in segments
+  encode_seed(decode_dir, "noisy_attributes", noisy_attributes(), 12, 0);
+  encode_seed(decode_dir, "noisy_attributes", noisy_attributes(), 12, 0, 300);
   handwritten(read_dir);
   corpus_seeds(TSM_CORPUS_DIR, decode_dir, read_dir);
   std::printf("fuzz_seeds: %d seed files in %s\n", written, out.string().c_str());

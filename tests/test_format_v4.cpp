@@ -314,7 +314,8 @@ std::string encode_as(const Mesh& m, int bits, int level, int version) {
   o.quantization_bits = bits;
   o.level = level;
   o.format_version = version;
-  EXPECT_TRUE(tsm::encode(m, o, out).ok());
+  const tsm::Status s = tsm::encode(m, o, out);
+  EXPECT_TRUE(s.ok()) << s.to_string();
   return out;
 }
 
@@ -570,4 +571,120 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
     Mesh out;
     (void)tsm::decode(with_topology(v9, bad), out);
   }
+}
+
+namespace {
+
+// An attribute of `count` values of `components` components, value j's
+// components from gen(j, c).
+template <class Gen>
+tsm::Attribute attribute(const std::string& name, tsm::AttributeDomain domain, tsm::AttributeType type,
+                         uint32_t components, size_t count, Gen gen) {
+  tsm::Attribute a;
+  a.name = name;
+  a.kind = tsm::AttributeKind::generic;
+  a.domain = domain;
+  a.type = type;
+  a.components = components;
+  for (size_t j = 0; j < count; ++j)
+    for (uint32_t c = 0; c < components; ++c) a.values.push_back(gen(j, c));
+  return a;
+}
+
+uint64_t table_coded_attributes(const std::string& bytes) {
+  tsm::FileInfo fi;
+  EXPECT_TRUE(tsm::inspect(bytes, fi).ok());
+  return fi.table_coded_attributes;
+}
+
+}  // namespace
+
+// Version 9 also codes the attribute residuals of levels 0-2 through static
+// prefix codes (FORMAT.md §8.12.1), per attribute where they cost at most
+// 9/8 of the adaptive models: noisy values use them, a constant attribute
+// (which the models code in a fraction of a bit per value) does not. The
+// files decode to the same attributes as version 8's and re-encode to
+// their own bytes; damaged files are refused or decoded, never a crash.
+TEST(FormatV9, AttributeTablesAtTheFastLevels) {
+  Mesh m = tsm_test::irregular_grid(40, 3);
+  std::mt19937 rng(9);
+  const size_t V = m.vertex_count(), F = m.face_count();
+  using tsm::AttributeDomain;
+  using tsm::AttributeType;
+  m.attributes.push_back(attribute("noise", AttributeDomain::vertex, AttributeType::f32, 1, V,
+                                   [&](size_t, uint32_t) { return static_cast<float>(rng() % 1000) / 1000.0f; }));
+  m.attributes.push_back(attribute("rgb", AttributeDomain::vertex, AttributeType::u8, 3, V,
+                                   [&](size_t, uint32_t) { return static_cast<float>(rng() % 256); }));
+  m.attributes.push_back(attribute("label", AttributeDomain::face, AttributeType::i32, 1, F,
+                                   [&](size_t, uint32_t) { return static_cast<float>(rng() % 50) - 25.0f; }));
+  m.attributes.push_back(
+      attribute("constant", AttributeDomain::vertex, AttributeType::f32, 2, V, [](size_t, uint32_t) { return 0.25f; }));
+  // Huge integers (the largest floats below 2^30): residuals beyond the
+  // symbols' range (|r| >= 2^30) keep the models.
+  const float top = static_cast<float>((1 << 30) - 64);
+  m.attributes.push_back(attribute("huge", AttributeDomain::vertex, AttributeType::i32, 1, V,
+                                   [&](size_t j, uint32_t) { return j % 2 ? top : -top; }));
+  for (int level : {0, 2}) {
+    SCOPED_TRACE("level " + std::to_string(level));
+    const std::string v9 = encode_as(m, 12, level, 0), v8 = encode_as(m, 12, level, 8);
+    EXPECT_EQ(version_of(v9), 9u);
+    EXPECT_EQ(table_coded_attributes(v9), 3u);  // noise, rgb, label
+    EXPECT_EQ(table_coded_attributes(v8), 0u);
+    expect_round_trip(m, v9, 12, "attribute tables");
+    const Mesh a = decode_ok(v9), b = decode_ok(v8);
+    ASSERT_EQ(a.attributes.size(), b.attributes.size());
+    for (size_t i = 0; i < a.attributes.size(); ++i) EXPECT_TRUE(a.attributes[i].values == b.attributes[i].values) << i;
+    EXPECT_TRUE(encode_as(a, 12, level, 0) == v9);
+    // Tables cost a few percent: within 5% of the adaptive file.
+    EXPECT_LT(v9.size(), v8.size() * 105 / 100) << v8.size() << " -> " << v9.size();
+  }
+  // Integers of magnitude 2^30 are refused (their differences need 33 bits),
+  // with the attribute's name; before, the encoder failed inside.
+  {
+    Mesh big = m;
+    big.attributes.back().values[1] = static_cast<float>(1 << 30);
+    std::string out;
+    const tsm::Status s = tsm::encode(big, tsm::EncodeOptions{}, out);
+    EXPECT_EQ(s.code(), tsm::ErrorCode::invalid_argument);
+    EXPECT_NE(s.message().find("'huge'"), std::string::npos) << s.to_string();
+  }
+  // The other levels and small meshes: no tables.
+  EXPECT_EQ(table_coded_attributes(encode_as(m, 12, 6, 0)), 0u);
+  Mesh small = tsm_test::icosphere(1);
+  small.attributes.push_back(attribute("noise", AttributeDomain::vertex, AttributeType::f32, 1, small.vertex_count(),
+                                       [&](size_t, uint32_t) { return static_cast<float>(rng() % 1000) / 1000.0f; }));
+  EXPECT_EQ(table_coded_attributes(encode_as(small, 12, 0, 0)), 0u);
+  // In segments, each with its own tables.
+  std::string seg;
+  tsm::EncodeOptions o;
+  o.level = 0;
+  o.quantization_bits = 12;
+  o.segment_faces = 1200;
+  ASSERT_TRUE(tsm::encode(m, o, seg).ok());
+  EXPECT_GE(table_coded_attributes(seg), 3u);
+  expect_round_trip(m, seg, 12, "attribute tables in segments");
+  // Damaged: every byte of the attribute payload flipped in turn, and the
+  // payload cut at every length: refused or decoded, never a crash (the
+  // ASan build checks the reads); cutting into the bit stream is refused.
+  const std::string v9 = encode_as(m, 12, 0, 0);
+  tsm::Header h;
+  std::vector<tsm::Section> parsed;
+  ASSERT_TRUE(tsm::read_container(v9, h, parsed).ok());
+  tsm::MeshPayload p;
+  ASSERT_TRUE(tsm::read_mesh_payload(parsed[0].data, p).ok());
+  const std::string attributes(p.attributes);
+  auto with_attributes = [&](const std::string& payload) {
+    tsm::MeshPayload q = p;
+    q.attributes = payload;
+    return rebuild(v9, h.version, {{tsm::kSectionMesh, tsm::write_mesh_payload(q)}});
+  };
+  size_t refused = 0;
+  for (size_t i = 0; i < attributes.size(); i += 7) {
+    std::string bad = attributes;
+    bad[i] = static_cast<char>(bad[i] ^ 0x24);
+    refused += decode_code(with_attributes(bad)) != tsm::ErrorCode::ok;
+    refused += decode_code(with_attributes(attributes.substr(0, i))) != tsm::ErrorCode::ok;
+  }
+  EXPECT_GT(refused, attributes.size() / 7);
+  EXPECT_EQ(decode_code(with_attributes(attributes.substr(0, attributes.size() / 2))), tsm::ErrorCode::corrupt_data);
 }

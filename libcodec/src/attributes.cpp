@@ -23,6 +23,7 @@
 #include "byte_io.hpp"
 #include "connectivity.hpp"
 #include "range_coder.hpp"
+#include "table_coder.hpp"
 
 namespace tsm {
 
@@ -31,6 +32,13 @@ namespace {
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, "attributes: " + what); }
 
 constexpr int kMaxAttributes = 64;
+
+// Version 9 (FORMAT.md §8.12.1): an attribute's residuals through static
+// prefix codes, one per residual model res[cls][c][z], at context
+// 24 i + 8 cls + 2 c + z of attribute i (bit 3 of its predictor byte).
+constexpr uint8_t kAttributeTableFlag = 0x08;
+constexpr int kAttributeTableContexts = 24;  // per attribute
+int table_context(int cls, uint32_t c, int zero) { return 8 * cls + 2 * static_cast<int>(c) + zero; }
 
 // Octahedral mapping of a direction onto [0, 2^bits - 1]^2.
 void oct_encode(double x, double y, double z, int bits, int32_t out[2]) {
@@ -138,7 +146,8 @@ struct ValueCoder {
   bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls = 0) {
     const uint32_t n = int_components(h);
     for (uint32_t c = 0; c < n; ++c) {
-      int32_t r = io.sint(m.res[cls][c][last_zero[c]], static_cast<int64_t>(x[c]) - pred[c]);
+      int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]),
+                              static_cast<int64_t>(x[c]) - pred[c]);
       const int64_t v = static_cast<int64_t>(pred[c]) + r;
       if (!in_range(h, v)) return false;
       x[c] = static_cast<int32_t>(v);
@@ -148,11 +157,67 @@ struct ValueCoder {
   }
 };
 
+// The encoder's table-coded residuals of one attribute: counted in a first
+// pass, coded with the codes built from the counts in a second.
+struct TableResiduals {
+  bool counting = true;
+  bool fits = true;  // every residual within the symbols' range (|r| < 2^30)
+  std::array<std::array<uint32_t, kTableSymbols>, kAttributeTableContexts> count{};
+  std::array<CodeLengths, kAttributeTableContexts> length{};
+  std::array<std::array<uint32_t, kTableSymbols>, kAttributeTableContexts> code{};
+  BitWriter* bits = nullptr;
+  void put(int ctx, int64_t v) {
+    if (v <= -(int64_t{1} << 30) || v >= (int64_t{1} << 30)) {
+      fits = false;
+      return;
+    }
+    const TableSymbol t = table_symbol(v);
+    if (counting) {
+      ++count[ctx][t.symbol];
+      return;
+    }
+    bits->put(code[ctx][t.symbol], length[ctx][t.symbol]);
+    if (t.raw_bits) bits->put(t.raw, t.raw_bits);
+  }
+  void build() {
+    for (int c = 0; c < kAttributeTableContexts; ++c) {
+      length[c] = table_code_lengths(count[c]);
+      code[c] = canonical_codes(length[c]);
+    }
+    counting = false;
+  }
+  // Bytes of the bit stream and of the tables (FORMAT.md §8.5.11's layout
+  // without the map) from the counts.
+  size_t bytes() const {
+    uint64_t bits_total = 0;
+    size_t table_bytes = 0;
+    for (int c = 0; c < kAttributeTableContexts; ++c) {
+      int S = 0;
+      for (int s = 0; s < kTableSymbols; ++s) {
+        if (!count[c][s]) continue;
+        S = s + 1;
+        const int raw = s <= 2 * kTableDirect ? 0 : (s - (2 * kTableDirect + 1)) / 2 + kTableEscapeLength - 1;
+        bits_total += uint64_t{count[c][s]} * (length[c][s] + raw);
+      }
+      if (S) table_bytes += 1 + (S + 1) / 2;
+    }
+    return static_cast<size_t>((bits_total + 7) / 8) + table_bytes;
+  }
+};
+
 struct Enc {
   RangeEncoder e;
+  TableResiduals* tables = nullptr;  // version 9: this attribute's residuals through tables
   int32_t sint(SIntModelT<4>& m, int64_t v) {
     m.encode(e, static_cast<int32_t>(v));
     return static_cast<int32_t>(v);
+  }
+  int32_t residual(SIntModelT<4>& m, int ctx, int64_t v) {
+    if (tables) {
+      tables->put(ctx, v);
+      return static_cast<int32_t>(v);
+    }
+    return sint(m, v);
   }
   uint32_t uint(UIntModel& m, uint32_t v) {
     m.encode(e, v);
@@ -163,7 +228,19 @@ struct Enc {
 
 struct Dec {
   RangeDecoder d;
+  // Version 9: the attribute tables and their bit stream; `base` is the
+  // current attribute's first context, -1 when its residuals are range coded.
+  const TableSet* tables = nullptr;
+  BitReader bits;
+  int base = -1;
+  bool bad_code = false;  // a code word no table has: the attribute is refused
   int32_t sint(SIntModelT<4>& m, int64_t) { return m.decode(d); }
+  int32_t residual(SIntModelT<4>& m, int ctx, int64_t) {
+    if (base < 0) return m.decode(d);
+    int32_t r = 0;
+    if (!tables->decode(bits, base + ctx, r)) bad_code = true;
+    return r;
+  }
   uint32_t uint(UIntModel& m, uint32_t) { return m.decode(d); }
   static constexpr bool kEncoder = false;
 };
@@ -842,8 +919,12 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   w.varint(headers.size());
   for (const AttributeHeader& h : headers) write_header(w, h);
   // Per attribute: the predictor that codes it smallest (each tried alone),
-  // its byte in the header, then its values into the one stream.
+  // at the fast levels whether tables pay (§8.12.1), its byte in the header,
+  // then its values into the one stream (and its residuals into the bit
+  // stream of the tables).
   Enc enc;
+  BitWriter table_bits;
+  std::vector<CodeLengths> table_lengths;  // every attribute's contexts once one has tables
   if (in.own_values) in.own_values->assign(headers.size(), {});
   for (size_t i = 0; i < headers.size(); ++i) {
     const AttributeHeader& h = headers[i];
@@ -852,19 +933,52 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     int predictor = 0;
     size_t best = SIZE_MAX;
     own_values = nullptr;
-    for (int p = 0; p < 3 && choices != 1; ++p) {
-      if (!(choices >> p & 1)) continue;
+    auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
-      if (!code(trial, i, p)) return Status(ErrorCode::internal, "attributes: values out of range");
-      const size_t size = trial.e.finish().size();
+      if (!code(trial, i, p)) return false;
+      size = trial.e.finish().size();
+      return true;
+    };
+    for (int p = 0; p < 3 && choices != 1; ++p) {
+      size_t size = 0;
+      if (!(choices >> p & 1)) continue;
+      if (!adaptive_size(p, size)) return Status(ErrorCode::internal, "attributes: values out of range");
       if (size < best) {
         best = size;
         predictor = p;
       }
     }
-    w.u8(static_cast<uint8_t>(predictor));
+    TableResiduals residuals;
+    bool tables = false;
+    if (in.tables) {
+      Enc trial;
+      trial.tables = &residuals;
+      if (!code(trial, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+      if (residuals.fits) {
+        residuals.build();
+        if (best == SIZE_MAX && !adaptive_size(predictor, best))
+          return Status(ErrorCode::internal, "attributes: values out of range");
+        // At most 1/8 more than the models (the bunny's scalars 1.01-1.05,
+        // spherical texture coordinates 1.05; its geometry-predicted
+        // normals, small residuals the models learn well, 1.19 keep them).
+        tables = trial.e.finish().size() + residuals.bytes() <= best + best / 8;
+      }
+    }
+    w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
+    if (tables) {
+      residuals.bits = &table_bits;
+      enc.tables = &residuals;
+      table_lengths.resize(kAttributeTableContexts * headers.size());
+      std::copy(residuals.length.begin(), residuals.length.end(), table_lengths.begin() + kAttributeTableContexts * i);
+    }
     if (!code(enc, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+    enc.tables = nullptr;
+  }
+  if (!table_lengths.empty()) {  // §8.12.1: the bit stream's length, the tables, the bit stream
+    const std::string bits = table_bits.finish();
+    w.u32(static_cast<uint32_t>(bits.size()));
+    body += write_tables(table_lengths, 3 * static_cast<int>(headers.size())) + bits;
   }
   out = body + enc.e.finish();
   return Status::Ok();
@@ -883,11 +997,35 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   std::vector<AttributeHeader> headers(static_cast<size_t>(count));
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
+  std::vector<uint8_t> tabled(headers.size(), 0);
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
-    if (!r.u8(p) || p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
+    if (!r.u8(p)) return corrupt("bad predictor");
+    if (in.version >= 9 && (p & kAttributeTableFlag)) {
+      tabled[i] = 1;
+      p = static_cast<uint8_t>(p & ~kAttributeTableFlag);
+    }
+    if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
+  // Version 9 (§8.12.1): with a table-coded attribute, the bit stream's
+  // length, the tables of every attribute's contexts, the bit stream.
+  Dec dec;
+  TableSet tables;
+  if (std::find(tabled.begin(), tabled.end(), 1) != tabled.end()) {
+    uint32_t bit_bytes;
+    std::string why;
+    std::string_view bitstream;
+    if (!r.u32(bit_bytes)) return corrupt("tables are truncated");
+    if (!tables.read(r, kAttributeTableContexts * static_cast<int>(count), why, 3 * static_cast<int>(count)))
+      return corrupt("tables: " + why);
+    if (!r.bytes(bit_bytes, bitstream))
+      return corrupt("the table-coded bit stream has " + std::to_string(bit_bytes) + " bytes, " +
+                     std::to_string(r.remaining()) + " remain");
+    dec.tables = &tables;
+    dec.bits.init(bitstream);
+  }
+  if (in.table_coded) *in.table_coded = static_cast<uint32_t>(std::count(tabled.begin(), tabled.end(), 1));
   std::string_view coded;
   r.bytes(r.remaining(), coded);
   const size_t V = global.size();
@@ -898,10 +1036,10 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   VertexFaces around;
   for (size_t i = 0; i < headers.size(); ++i)
     if (predictor[i] == 2 && around.start.empty()) around.build(faces, V);
-  Dec dec;
   dec.d.init(coded);
   for (size_t i = 0; i < headers.size(); ++i) {
     const AttributeHeader& h = headers[i];
+    dec.base = tabled[i] ? kAttributeTableContexts * static_cast<int>(i) : -1;
     const uint32_t n = int_components(h);
     std::vector<int32_t> gn;
     std::vector<uint8_t> gh;
@@ -934,6 +1072,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       }
     }
     if (dec.d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("stream is truncated");
+    if (dec.bad_code) return corrupt("a residual of '" + h.name + "' is a code word no table has");
+    if (dec.bits.overrun()) return corrupt("the table-coded bit stream is truncated");
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));
     for (size_t j = 0; j < x.size() / n; ++j) from_ints(h, &x[n * j], &a.values[h.components * j]);
     out.push_back(std::move(a));

@@ -111,6 +111,7 @@ struct DecodedPart {
   std::vector<std::vector<uint32_t>> alias;  // per attribute, per corner value: an earlier segment's value, or kNone
   ConnectivityStats cstats;
   GeometryStats gstats;
+  uint32_t table_coded_attributes = 0;  // version 9: attributes whose residuals are table-coded
   Status status;
 };
 
@@ -139,6 +140,8 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.global = &out.global;
   ap.q = &out.q;
   ap.segmented = s.segmented;
+  ap.version = s.version;
+  ap.table_coded = &out.table_coded_attributes;
   return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
 }
 
@@ -337,6 +340,10 @@ struct PartOptions : EncodeOptions {
   bool mode_byte = false;
 };
 
+// Version 9 (FORMAT.md §8.12.1): the fast levels' attribute residuals
+// through tables where they pay, in files that say version 9 anyway.
+bool attribute_tables(const PartOptions& options) { return options.mode_byte && options.level <= kTableLevel; }
+
 uint16_t needed_version(const ConnectivityStreams& streams, const std::string& geometry) {
   if (streams.mode_byte) return 9;
   const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
@@ -364,7 +371,7 @@ struct EncodedPart {
 // `own_values`: see AttributeInput; null for a whole mesh).
 Status encode_part_attributes(const Mesh& part, const std::vector<AttributeHeader>& headers,
                               const std::vector<std::vector<uint32_t>>* imported,
-                              std::vector<std::vector<uint32_t>>* own_values, EncodedPart& p) {
+                              std::vector<std::vector<uint32_t>>* own_values, bool tables, EncodedPart& p) {
   AttributeInput ai;
   ai.part = &part;
   ai.order = &p.order;
@@ -374,6 +381,7 @@ Status encode_part_attributes(const Mesh& part, const std::vector<AttributeHeade
   ai.segmented = imported != nullptr;
   ai.imported = imported;
   ai.own_values = own_values;
+  ai.tables = tables;
   return encode_attributes(headers, ai, p.attributes);
 }
 
@@ -589,7 +597,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
   if (!headers.empty() && is_ref.empty())  // a whole mesh: its attributes now
-    TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, out));
+    TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, attribute_tables(options), out));
   return Status::Ok();
 }
 
@@ -867,7 +875,7 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       for (size_t i = 0; i < headers.size(); ++i)
         if (!value_id[i].empty())
           for (uint32_t x : p.value_origin[i]) imported[i].push_back(value_id[i][x]);
-      TSM_RETURN_IF_ERROR(encode_part_attributes(p.part, headers, &imported, &own_values, p));
+      TSM_RETURN_IF_ERROR(encode_part_attributes(p.part, headers, &imported, &own_values, attribute_tables(options), p));
       for (size_t i = 0; i < headers.size(); ++i)
         if (!value_id[i].empty())
           for (uint32_t local : own_values[i]) value_id[i][p.value_origin[i][local]] = value_count[i]++;
@@ -936,9 +944,10 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   for (const Attribute& a : mesh.attributes)
     if (a.type != AttributeType::f32)
       for (float x : a.values)
-        if (x != std::floor(x) || std::fabs(x) > static_cast<float>(1 << 30))
-          return Status(ErrorCode::invalid_argument, "attribute '" + a.name + "' is of an integer type but holds " +
-                                                         std::to_string(x) + " (integers up to 2^30 only)");
+        if (x != std::floor(x) || std::fabs(x) >= static_cast<float>(1 << 30))
+          return Status(ErrorCode::invalid_argument,
+                        "attribute '" + a.name + "' is of an integer type but holds " + std::to_string(x) +
+                            " (integers of magnitude below 2^30 only: the difference of two must fit in 32 bits)");
   if (mesh.attributes.size() > 64)
     return Status(ErrorCode::invalid_argument, "more than 64 attributes");
   const AttributeQuantization& ab = options.attribute_bits;
@@ -1033,6 +1042,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     info.side_faces += st.side_faces;
     info.marching_bits += st.marching_bits;
     info.run_table_parts += st.run_tables;
+    info.table_coded_attributes += parts[k].table_coded_attributes;
     info.references += parts[k].counts.reference_count;
     SegmentSummary sum;
     sum.vertices = parts[k].counts.vertex_count;

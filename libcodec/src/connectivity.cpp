@@ -320,13 +320,13 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   if (hints.runs != RunCoding::v8) {  // version 9: the mode byte (and the tables) first
     const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
     if (runs.tables) {
-      // Tables where they cost at most a quarter more than the adaptive
-      // models (the corpus scans: 3-11% more, tables included). On regular
-      // meshes, whose runs repeat, the models learn the values down to a
-      // small fraction of a bit while a prefix code spends at least one bit
-      // on each (40-500% more): those are coded again without tables.
+      // Tables where they cost at most 1/8 more than the adaptive models
+      // (the corpus scans: 3-11% more, tables included). On regular meshes,
+      // whose runs repeat, the models learn the values down to a small
+      // fraction of a bit while a prefix code spends at least one bit on
+      // each (40-500% more): those are coded again without tables.
       const size_t adaptive = runs.adaptive.finish().size();
-      if (block.size() > adaptive + adaptive / 4) {
+      if (block.size() > adaptive + adaptive / 8) {
         CutHints again = hints;
         again.runs = RunCoding::adaptive;
         return encode_connectivity(mesh, out, again);

@@ -121,6 +121,9 @@ struct FileInfo {
   // Parts (segments) whose connectivity run values are table-coded (format
   // version 9, the fast levels; FORMAT.md §8.3.1).
   uint64_t run_table_parts = 0;
+  // Attributes whose residuals are table-coded, summed over the parts
+  // (format version 9, the fast levels; FORMAT.md §8.12.1).
+  uint64_t table_coded_attributes = 0;
   // Stored bytes by kind; other = header, framing, references, side data.
   uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;
   uint64_t reference_bytes = 0;  // part of other: the segments' references streams
