@@ -2050,7 +2050,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False, version=4):
                     o = walk.face_offsets[g]
                     walk.update_sigma([walk.values[indices[o + i]] for i in range(len(f))])
             U = m.unused.decode(d)
-            if U == INVALID or U > 2843 * (len(coded) + 8):
+            if U == INVALID or U > 2843 * (len(coded) + 8) + (8 * len(bits.data) if bits else 0):
                 reject('attributes: corner values of %r are invalid' % h.name)
             for _ in range(U):
                 decode_value(d, m, walk, ('unused',))

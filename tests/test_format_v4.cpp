@@ -688,3 +688,20 @@ TEST(FormatV9, AttributeTablesAtTheFastLevels) {
   EXPECT_GT(refused, attributes.size() / 7);
   EXPECT_EQ(decode_code(with_attributes(attributes.substr(0, attributes.size() / 2))), tsm::ErrorCode::corrupt_data);
 }
+
+// A corner attribute whose values no corner uses are many (they follow the
+// used ones, §8.12) and table-coded: the decoder's bound on their number
+// counts the bit stream's bits too (each table-coded residual takes at least
+// one), else such a file, whose range-coded stream holds little, was refused.
+TEST(FormatV9, ManyUnusedTableCodedValuesDecode) {
+  Mesh m = tsm_test::irregular_grid(14, 3);
+  ASSERT_GE(m.face_count(), 256u);
+  std::mt19937 rng(4);
+  const size_t unused = 100000;
+  m.attributes.push_back(attribute("many", tsm::AttributeDomain::corner, tsm::AttributeType::f32, 1, unused + 1,
+                                   [&](size_t, uint32_t) { return static_cast<float>(rng() % 65536) / 65535.0f; }));
+  m.attributes.back().indices.assign(m.corner_count(), 0);
+  const std::string bytes = encode_as(m, 12, 0, 0);
+  EXPECT_EQ(table_coded_attributes(bytes), 1u);
+  expect_round_trip(m, bytes, 12, "many unused values");
+}

@@ -1012,6 +1012,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   // length, the tables of every attribute's contexts, the bit stream.
   Dec dec;
   TableSet tables;
+  uint32_t table_bytes = 0;  // the bit stream's
   if (std::find(tabled.begin(), tabled.end(), 1) != tabled.end()) {
     uint32_t bit_bytes;
     std::string why;
@@ -1024,6 +1025,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
                      std::to_string(r.remaining()) + " remain");
     dec.tables = &tables;
     dec.bits.init(bitstream);
+    table_bytes = bit_bytes;
   }
   if (in.table_coded) *in.table_coded = static_cast<uint32_t>(std::count(tabled.begin(), tabled.end(), 1));
   std::string_view coded;
@@ -1063,7 +1065,9 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     } else {
       std::vector<uint32_t> none, aliases, in_of;
       std::vector<int32_t> no_ints;
-      const uint64_t budget = max_decisions(coded.size());
+      // Each unused value costs a decision in the range-coded stream or,
+      // table-coded, at least a bit in the bit stream.
+      const uint64_t budget = max_decisions(coded.size()) + 8 * uint64_t{table_bytes};
       if (!walk.corners(predictor[i], in.segmented, nullptr, none, no_ints, 0, budget, x, a.indices, aliases, in_of))
         return corrupt("corner values of '" + h.name + "' are invalid");
       if (alias) {
