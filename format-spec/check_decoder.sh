@@ -124,6 +124,7 @@ acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
 acheck uv_vertex_l0 "$work/uv_vertex.ply" 12 0
 acheck uv_corner_l0 "$work/uv_corner.obj" 12 0
 acheck uv_corner_segments_l0 "$work/uv_corner.obj" 12 0 600
+acheck unused_vt_l0 "$work/unused_vt.obj" 12 0
 corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
 corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # version 8 tables, the fast level
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000

@@ -17,6 +17,9 @@
   box.obj       a box of 6 quads, each with its own 4 corners (24 vertices on 2
                 planes per axis, the far ones at qmax: version 7 codes them
                 from the top)
+  unused_vt.obj  an irregular grid of 338 triangles on one texture coordinate,
+                and 100,000 texture coordinates no corner uses (version 9:
+                table-coded, they test the decoder's bound on unused values)
 
   attributes.obj  mixed(12, 20) with vertex colours, corner `vt u v w` (a
                 3-component generic 'texcoord3') and corner `vn` with seams,
@@ -59,6 +62,29 @@ def fan(n=300):
         a = 2 * math.pi * i / n
         V.append((math.cos(a), math.sin(a), 0.2 * math.sin(3 * a)))
     return V, [[0, 1 + i, 1 + (i + 1) % n] for i in range(n)]
+
+
+def unused_vt(path, n=14, unused=100000):
+    """An n x n grid, quads split along random diagonals (irregular runs: at
+    level 0 the run values take tables), every corner on texture coordinate 1,
+    then `unused` random ones no corner uses: table-coded (format version 9,
+    §8.12.1) they fill the bit stream while the range-coded stream stays
+    short, which the decoder's bound on unused values has to allow."""
+    import random
+    rng = random.Random(7)
+    with open(path, 'w') as f:
+        for y in range(n):
+            for x in range(n):
+                f.write('v %d %d %.3f\n' % (x, y, rng.randrange(100) / 1000))
+        f.write('vt 0.5 0.5\n')
+        for _ in range(unused):
+            f.write('vt %.4f %.4f\n' % (rng.randrange(4096) / 4095, rng.randrange(4096) / 4095))
+        for y in range(n - 1):
+            for x in range(n - 1):
+                a, b, c, d = y * n + x + 1, y * n + x + 2, (y + 1) * n + x + 1, (y + 1) * n + x + 2
+                tris = [(a, b, d), (a, d, c)] if rng.randrange(2) else [(a, b, c), (b, d, c)]
+                for t in tris:
+                    f.write('f %d/1 %d/1 %d/1\n' % t)
 
 
 def box():
@@ -627,6 +653,7 @@ def main():
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
     write_obj(os.path.join(out, 'fan.obj'), *fan())
     write_obj(os.path.join(out, 'box.obj'), *box())
+    unused_vt(os.path.join(out, 'unused_vt.obj'))
     attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
