@@ -19,7 +19,8 @@ mkdir -p "$OUT"
 # name:source (relative to the corpus)[:faces per segment, when the encoder has --segment-faces]
 MESHES="bunny:bun_zipper.ply dragon_res4:dragon_vrip_res4.ply dragon_res3:dragon_vrip_res3.ply
 dragon_res2:dragon_vrip_res2.ply dragon:dragon_vrip.ply cube_quads:edge/cube_quads.obj
-dragon_seg16k:dragon_vrip.ply:16384 bunny_seg4k:bun_zipper.ply:4096"
+dragon_seg16k:dragon_vrip.ply:16384 bunny_seg4k:bun_zipper.ply:4096
+dragon_res4_l0:dragon_vrip_res4.ply::0 bunny_l0:bun_zipper.ply::0"
 SEGMENTS=0
 "$TSM" encode --help 2>/dev/null | grep -q -- --segment-faces && SEGMENTS=1
 
@@ -40,13 +41,16 @@ make_ref() {  # NAME: NAME.ref.json from the native decoder's output
 want=("$@")
 list=()
 for entry in $MESHES; do
-  IFS=: read -r name rel segfaces <<<"$entry"
+  IFS=: read -r name rel segfaces level <<<"$entry"
   src="$CORPUS/$rel"
   extra="${TSM_ENCODE_ARGS:-}"
   if [ -n "$segfaces" ]; then
     [ "$SEGMENTS" = 1 ] || continue  # no segments in this encoder: the variant would be the same file
     extra="$extra --segment-faces $segfaces"
   fi
+  # A level (the fast ones: format version 9's table-coded run values and
+  # attribute residuals) for a variant of a mesh listed whole.
+  [ -n "$level" ] && extra="$extra -l $level"
   if [ "${#want[@]}" -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
   [ -f "$src" ] || { echo "prepare-data: $src missing, skipped" >&2; continue; }
   list+=("$name")
@@ -59,7 +63,7 @@ for entry in $MESHES; do
     rm -f "$ref"
   fi
   make_ref "$name"
-  if [ -n "$segfaces" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
+  if [ -n "$segfaces" ] || [ -n "$level" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
   elif [ "$HAVE_DRACO" = 1 ] && { [ ! -f "$drc" ] || [ "$src" -nt "$drc" ]; }; then
     draco_encoder -i "$src" -o "$drc" -cl 10 -qp 14 >/dev/null
   fi
