@@ -160,48 +160,17 @@ struct ValueCoder {
 // The encoder's table-coded residuals of one attribute: counted in a first
 // pass, coded with the codes built from the counts in a second.
 struct TableResiduals {
-  bool counting = true;
-  bool fits = true;  // every residual within the symbols' range (|r| < 2^30)
-  std::array<std::array<uint32_t, kTableSymbols>, kAttributeTableContexts> count{};
-  std::array<CodeLengths, kAttributeTableContexts> length{};
-  std::array<std::array<uint32_t, kTableSymbols>, kAttributeTableContexts> code{};
-  BitWriter* bits = nullptr;
+  TableEncoder tables{kAttributeTableContexts};
+  bool fits = true;           // every residual within the symbols' range (|r| < 2^30)
+  BitWriter* bits = nullptr;  // null: counting (the first pass)
   void put(int ctx, int64_t v) {
     if (v <= -(int64_t{1} << 30) || v >= (int64_t{1} << 30)) {
       fits = false;
-      return;
+    } else if (bits) {
+      tables.put(*bits, ctx, v);
+    } else {
+      tables.count(ctx, v);
     }
-    const TableSymbol t = table_symbol(v);
-    if (counting) {
-      ++count[ctx][t.symbol];
-      return;
-    }
-    bits->put(code[ctx][t.symbol], length[ctx][t.symbol]);
-    if (t.raw_bits) bits->put(t.raw, t.raw_bits);
-  }
-  void build() {
-    for (int c = 0; c < kAttributeTableContexts; ++c) {
-      length[c] = table_code_lengths(count[c]);
-      code[c] = canonical_codes(length[c]);
-    }
-    counting = false;
-  }
-  // Bytes of the bit stream and of the tables (FORMAT.md §8.5.11's layout
-  // without the map) from the counts.
-  size_t bytes() const {
-    uint64_t bits_total = 0;
-    size_t table_bytes = 0;
-    for (int c = 0; c < kAttributeTableContexts; ++c) {
-      int S = 0;
-      for (int s = 0; s < kTableSymbols; ++s) {
-        if (!count[c][s]) continue;
-        S = s + 1;
-        const int raw = s <= 2 * kTableDirect ? 0 : (s - (2 * kTableDirect + 1)) / 2 + kTableEscapeLength - 1;
-        bits_total += uint64_t{count[c][s]} * (length[c][s] + raw);
-      }
-      if (S) table_bytes += 1 + (S + 1) / 2;
-    }
-    return static_cast<size_t>((bits_total + 7) / 8) + table_bytes;
   }
 };
 
@@ -955,13 +924,13 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       trial.tables = &residuals;
       if (!code(trial, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
       if (residuals.fits) {
-        residuals.build();
+        residuals.tables.build();
         if (best == SIZE_MAX && !adaptive_size(predictor, best))
           return Status(ErrorCode::internal, "attributes: values out of range");
         // At most 1/8 more than the models (the bunny's scalars 1.01-1.05,
         // spherical texture coordinates 1.05; its geometry-predicted
         // normals, small residuals the models learn well, 1.19 keep them).
-        tables = trial.e.finish().size() + residuals.bytes() <= best + best / 8;
+        tables = trial.e.finish().size() + residuals.tables.coded_bytes() <= best + best / 8;
       }
     }
     w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0)));
@@ -970,16 +939,14 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       residuals.bits = &table_bits;
       enc.tables = &residuals;
       table_lengths.resize(kAttributeTableContexts * headers.size());
-      std::copy(residuals.length.begin(), residuals.length.end(), table_lengths.begin() + kAttributeTableContexts * i);
+      const std::vector<CodeLengths>& lengths = residuals.tables.lengths();
+      std::copy(lengths.begin(), lengths.end(), table_lengths.begin() + kAttributeTableContexts * i);
     }
     if (!code(enc, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
     enc.tables = nullptr;
   }
-  if (!table_lengths.empty()) {  // §8.12.1: the bit stream's length, the tables, the bit stream
-    const std::string bits = table_bits.finish();
-    w.u32(static_cast<uint32_t>(bits.size()));
-    body += write_tables(table_lengths, 3 * static_cast<int>(headers.size())) + bits;
-  }
+  if (!table_lengths.empty())  // §8.12.1: the bit stream's length, the tables, the bit stream
+    body += write_table_block(table_lengths, 3 * static_cast<int>(headers.size()), table_bits.finish());
   out = body + enc.e.finish();
   return Status::Ok();
 }
@@ -1014,18 +981,11 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   TableSet tables;
   uint32_t table_bytes = 0;  // the bit stream's
   if (std::find(tabled.begin(), tabled.end(), 1) != tabled.end()) {
-    uint32_t bit_bytes;
     std::string why;
-    std::string_view bitstream;
-    if (!r.u32(bit_bytes)) return corrupt("tables are truncated");
-    if (!tables.read(r, kAttributeTableContexts * static_cast<int>(count), why, 3 * static_cast<int>(count)))
-      return corrupt("tables: " + why);
-    if (!r.bytes(bit_bytes, bitstream))
-      return corrupt("the table-coded bit stream has " + std::to_string(bit_bytes) + " bytes, " +
-                     std::to_string(r.remaining()) + " remain");
+    if (!read_table_block(r, kAttributeTableContexts * static_cast<int>(count), 3 * static_cast<int>(count), tables,
+                          dec.bits, why, &table_bytes))
+      return corrupt(why);
     dec.tables = &tables;
-    dec.bits.init(bitstream);
-    table_bytes = bit_bytes;
   }
   if (in.table_coded) *in.table_coded = static_cast<uint32_t>(std::count(tabled.begin(), tabled.end(), 1));
   std::string_view coded;

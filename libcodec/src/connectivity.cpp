@@ -74,26 +74,12 @@ struct RunEncoder {
   // The topology stream's prefix with tables: mode byte 1, the bit
   // stream's length, the table block, the bit stream.
   std::string block() const {
-    std::vector<std::array<uint32_t, kTableSymbols>> count(kRunContexts, std::array<uint32_t, kTableSymbols>{});
-    for (auto [c, v] : values) ++count[c][table_symbol(v).symbol];
-    std::vector<CodeLengths> length(kRunContexts);
-    std::vector<std::array<uint32_t, kTableSymbols>> code(kRunContexts);
-    for (int c = 0; c < kRunContexts; ++c) {
-      length[c] = table_code_lengths(count[c]);  // all zero for a context never used: no table
-      code[c] = canonical_codes(length[c]);
-    }
+    TableEncoder codes(kRunContexts);
+    for (auto [c, v] : values) codes.count(c, v);
+    codes.build();
     BitWriter w;
-    for (auto [c, v] : values) {
-      const TableSymbol t = table_symbol(v);
-      w.put(code[c][t.symbol], length[c][t.symbol]);
-      if (t.raw_bits) w.put(t.raw, t.raw_bits);
-    }
-    const std::string bits = w.finish();
-    std::string out;
-    ByteWriter bw(out);
-    bw.u8(1);
-    bw.u32(static_cast<uint32_t>(bits.size()));
-    return out + write_tables(length, kRunMapBytes) + bits;
+    for (auto [c, v] : values) codes.put(w, c, v);
+    return std::string(1, '\x01') + write_table_block(codes.lengths(), kRunMapBytes, w.finish());
   }
 };
 
@@ -354,15 +340,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     if (!r.u8(mode)) return corrupt("topology stream is empty (no run coding mode)");
     if (mode > 1) return corrupt("run coding mode " + std::to_string(mode) + " (0 adaptive or 1 tables)");
     if (mode == 1) {
-      uint32_t bit_bytes;
       std::string why;
-      std::string_view bitstream;
-      if (!r.u32(bit_bytes)) return corrupt("run tables are truncated");
-      if (!run_tables.read(r, kRunContexts, why, kRunMapBytes)) return corrupt("run tables: " + why);
-      if (!r.bytes(bit_bytes, bitstream))
-        return corrupt("the run values' bit stream has " + std::to_string(bit_bytes) + " bytes, the topology stream " +
-                       std::to_string(r.remaining()) + " after its tables");
-      run_bits.init(bitstream);
+      if (!read_table_block(r, kRunContexts, kRunMapBytes, run_tables, run_bits, why))
+        return corrupt("run values: " + why);
       tables = true;
     }
     topology = topology.substr(r.offset());

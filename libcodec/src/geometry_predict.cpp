@@ -186,20 +186,19 @@ struct CollectSink {
 // per context, everything else through the range coder as before. The
 // encoder counts the symbols in a first pass, builds the codes, then codes.
 struct TableCountSink : CollectSink {
-  std::vector<std::array<uint32_t, kTableSymbols>> count = std::vector<std::array<uint32_t, kTableSymbols>>(kTableContexts);
+  TableEncoder& tables;
+  explicit TableCountSink(TableEncoder& t) : tables(t) {}
   int32_t residual(SurfaceModels*, int ctx, int64_t v) {
-    ++count[ctx][table_symbol(v).symbol];
+    tables.count(ctx, v);
     return static_cast<int32_t>(v);
   }
 };
 struct TableEncodeSink : EncodeSink {
-  std::vector<CodeLengths> length;
-  std::vector<std::array<uint32_t, kTableSymbols>> code;
+  const TableEncoder& tables;
   BitWriter bits;
+  explicit TableEncodeSink(const TableEncoder& t) : tables(t) {}
   int32_t residual(SurfaceModels*, int ctx, int64_t v) {
-    const TableSymbol t = table_symbol(v);
-    bits.put(code[ctx][t.symbol], length[ctx][t.symbol]);
-    if (t.raw_bits) bits.put(t.raw, t.raw_bits);
+    tables.put(bits, ctx, v);
     return static_cast<int32_t>(v);
   }
 };
@@ -1037,17 +1036,13 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   }
   // Tables (FORMAT.md §8.5.11): count, build the codes, code; then the
   // bit stream's length, the table block, the bit stream, the range stream.
-  TableCountSink counts;
+  TableEncoder codes(kTableContexts);
+  TableCountSink counts(codes);
   pass(counts);
-  TableEncodeSink s;
-  for (const auto& count : counts.count) {
-    s.length.push_back(table_code_lengths(count));
-    s.code.push_back(canonical_codes(s.length.back()));
-  }
+  codes.build();
+  TableEncodeSink s(codes);
   pass(s);
-  const std::string bitstream = s.bits.finish();
-  w.u32(static_cast<uint32_t>(bitstream.size()));
-  return head + write_tables(s.length) + bitstream + s.e.finish();
+  return head + write_table_block(codes.lengths(), kTableMapBytes, s.bits.finish()) + s.e.finish();
 }
 
 
@@ -1344,16 +1339,9 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   }
   // Version 8 (§8.5.11): the bit stream's length, the tables, the bit
   // stream, then the range-coded stream.
-  uint32_t bit_bytes;
-  if (!r.u32(bit_bytes)) return corrupt("truncated predictor header");
   auto s = std::make_unique<TableDecodeSink>();
   std::string why;
-  if (!s->tables.read(r, kTableContexts, why)) return corrupt(why);
-  std::string_view bitstream;
-  if (!r.bytes(bit_bytes, bitstream))
-    return corrupt("the table-coded bit stream has " + std::to_string(bit_bytes) + " bytes, the section holds " +
-                   std::to_string(r.remaining()));
-  s->bits.init(bitstream);
+  if (!read_table_block(r, kTableContexts, kTableMapBytes, s->tables, s->bits, why)) return corrupt(why);
   s->d.init(bytes.substr(r.offset()));
   return run(*s);
 }

@@ -105,6 +105,61 @@ std::string write_tables(const std::vector<CodeLengths>& lengths, int map_bytes)
   return out;
 }
 
+void TableEncoder::build() {
+  for (size_t c = 0; c < count_.size(); ++c) {
+    length_[c] = table_code_lengths(count_[c]);  // all zero for a context never counted: no table
+    code_[c] = canonical_codes(length_[c]);
+  }
+}
+
+void TableEncoder::put(BitWriter& w, int ctx, int64_t r) const {
+  const TableSymbol t = table_symbol(r);
+  const size_t c = static_cast<size_t>(ctx);
+  w.put(code_[c][t.symbol], length_[c][t.symbol]);
+  if (t.raw_bits) w.put(t.raw, t.raw_bits);
+}
+
+size_t TableEncoder::coded_bytes() const {
+  uint64_t bits = 0;
+  size_t table_bytes = 0;
+  for (size_t c = 0; c < count_.size(); ++c) {
+    int S = 0;
+    for (int s = 0; s < kTableSymbols; ++s) {
+      if (!count_[c][s]) continue;
+      S = s + 1;
+      const int raw = s <= 2 * kTableDirect ? 0 : (s - (2 * kTableDirect + 1)) / 2 + kTableEscapeLength - 1;
+      bits += uint64_t{count_[c][s]} * (length_[c][s] + raw);
+    }
+    if (S) table_bytes += 1 + (S + 1) / 2;
+  }
+  return static_cast<size_t>((bits + 7) / 8) + table_bytes;
+}
+
+std::string write_table_block(const std::vector<CodeLengths>& lengths, int map_bytes, const std::string& bits) {
+  std::string out;
+  ByteWriter(out).u32(static_cast<uint32_t>(bits.size()));
+  return out + write_tables(lengths, map_bytes) + bits;
+}
+
+bool read_table_block(ByteReader& r, int contexts, int map_bytes, TableSet& tables, BitReader& bits,
+                      std::string& why, uint32_t* bit_bytes_out) {
+  uint32_t bit_bytes;
+  std::string_view bitstream;
+  if (!r.u32(bit_bytes)) {
+    why = "table block is truncated";
+    return false;
+  }
+  if (!tables.read(r, contexts, why, map_bytes)) return false;
+  if (!r.bytes(bit_bytes, bitstream)) {
+    why = "the table-coded bit stream has " + std::to_string(bit_bytes) + " bytes, " +
+          std::to_string(r.remaining()) + " remain";
+    return false;
+  }
+  bits.init(bitstream);
+  if (bit_bytes_out) *bit_bytes_out = bit_bytes;
+  return true;
+}
+
 bool TableSet::read(ByteReader& r, int contexts, std::string& why, int map_bytes) {
   std::string_view map;
   if (contexts > 8 * map_bytes || !r.bytes(static_cast<size_t>(map_bytes), map)) {

@@ -57,6 +57,39 @@ std::array<uint32_t, kTableSymbols> canonical_codes(const CodeLengths& length);
 // lengths.size() <= 8 * map_bytes.
 std::string write_tables(const std::vector<CodeLengths>& lengths, int map_bytes = kTableMapBytes);
 
+class BitWriter;
+class BitReader;
+class TableSet;
+
+// The encoder's side of one table-coded stream over `contexts` contexts:
+// count() every value in a first pass, build() the codes from the counts,
+// then put() the values in the same order. Values must satisfy |r| < 2^30.
+class TableEncoder {
+ public:
+  explicit TableEncoder(int contexts) : count_(static_cast<size_t>(contexts)), length_(count_.size()), code_(count_.size()) {}
+  void count(int ctx, int64_t r) { ++count_[static_cast<size_t>(ctx)][table_symbol(r).symbol]; }
+  void build();
+  void put(BitWriter& w, int ctx, int64_t r) const;
+  // The code lengths, per context (all zero for a context never counted).
+  const std::vector<CodeLengths>& lengths() const { return length_; }
+  // After build(): bytes of the bit stream the counted values take and of
+  // their tables without the used-context map.
+  size_t coded_bytes() const;
+
+ private:
+  std::vector<std::array<uint32_t, kTableSymbols>> count_;
+  std::vector<CodeLengths> length_;
+  std::vector<std::array<uint32_t, kTableSymbols>> code_;
+};
+
+// The layout every table-coded stream shares (FORMAT.md §8.5.11, §8.3.1,
+// §8.12.1): u32 bit-stream length, the table block, the bit stream.
+std::string write_table_block(const std::vector<CodeLengths>& lengths, int map_bytes, const std::string& bits);
+// Reads it (the table block over `contexts` contexts) and points `bits` at
+// the bit stream (its length in *bit_bytes, if given); false with the reason.
+bool read_table_block(ByteReader& r, int contexts, int map_bytes, TableSet& tables, BitReader& bits,
+                      std::string& why, uint32_t* bit_bytes = nullptr);
+
 class BitWriter {
  public:
   void put(uint32_t value, int n) {  // n <= 32
