@@ -552,11 +552,9 @@ def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
     open(dst, 'wb').write(data[:at] + section + data[at:])
 
 
-def replace_in_mesh(src, dst, old, new):
-    """Copies the .tsm file src to dst with the first occurrence of the bytes
-    old in its raw mesh section (id 10, §4.7) replaced by new, and that
-    section's lengths and checksum rewritten to match (a forged file that
-    only the payload rules can refuse)."""
+def mesh_section(src):
+    """The .tsm file src's bytes, where its raw mesh section (id 10, §4.7)
+    starts and ends, and its payload."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from reference_decoder import read_varint
     data = open(src, 'rb').read()
@@ -568,52 +566,8 @@ def replace_in_mesh(src, dst, old, new):
             sys.exit('%s: no raw mesh section' % src)
         stored_len, q = read_varint(data, p + 3, len(data))
         _, q = read_varint(data, q, len(data))
-        payload = data[q + 4:q + 4 + stored_len]
         if sid == 10 and codec == 0:
-            if old not in payload:
-                sys.exit('%s: %s not in the mesh section' % (src, old.hex()))
-            replace_section(data, p, q + 4 + stored_len, payload.replace(old, new, 1), dst)
-            return
-        p = q + 4 + stored_len
-
-
-def forge_topology(src, dst, op):
-    """Copies the one-segment .tsm file src to dst with its mesh section's
-    topology stream (the third of §4.7) changed by op: 'mode=N' sets its first
-    byte (version 9: the run coding mode, §8.3.1), 'cut=K' keeps its first K
-    bytes; the stream lengths, the section's lengths and its checksum are
-    rewritten to match."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reference_decoder import read_varint
-    data = open(src, 'rb').read()
-    hlen, p = read_varint(data, 8, len(data))
-    p += hlen + 4
-    while True:
-        sid, codec = struct.unpack_from('<HB', data, p)
-        if sid == 0:
-            sys.exit('%s: no raw mesh section' % src)
-        stored_len, q = read_varint(data, p + 3, len(data))
-        _, q = read_varint(data, q, len(data))
-        payload = data[q + 4:q + 4 + stored_len]
-        if sid == 10 and codec == 0:
-            lengths, r = [], 0
-            for _ in range(4):
-                n, r = read_varint(payload, r, len(payload))
-                lengths.append(n)
-            streams = []
-            for n in lengths:
-                streams.append(payload[r:r + n])
-                r += n
-            topo = bytearray(streams[2])
-            key, value = op.split('=')
-            if key == 'mode':
-                topo[0] = int(value)
-            else:
-                topo = topo[:int(value)]
-            streams[2] = bytes(topo)
-            payload = b''.join(varint(len(x)) for x in streams) + b''.join(streams) + payload[r:]
-            replace_section(data, p, q + 4 + stored_len, payload, dst)
-            return
+            return data, p, q + 4 + stored_len, data[q + 4:q + 4 + stored_len]
         p = q + 4 + stored_len
 
 
@@ -624,6 +578,44 @@ def replace_section(data, start, end, payload, dst):
     section = (struct.pack('<HB', 10, 0) + varint(len(payload)) + varint(len(payload))
                + struct.pack('<I', xxh32(payload)) + payload)
     open(dst, 'wb').write(data[:start] + section + data[end:])
+
+
+def replace_in_mesh(src, dst, old, new):
+    """Copies the .tsm file src to dst with the first occurrence of the bytes
+    old in its raw mesh section (id 10, §4.7) replaced by new, and that
+    section's lengths and checksum rewritten to match (a forged file that
+    only the payload rules can refuse)."""
+    data, start, end, payload = mesh_section(src)
+    if old not in payload:
+        sys.exit('%s: %s not in the mesh section' % (src, old.hex()))
+    replace_section(data, start, end, payload.replace(old, new, 1), dst)
+
+
+def forge_topology(src, dst, op):
+    """Copies the one-segment .tsm file src to dst with its mesh section's
+    topology stream (the third of §4.7) changed by op: 'mode=N' sets its first
+    byte (version 9: the run coding mode, §8.3.1), 'cut=K' keeps its first K
+    bytes; the stream lengths, the section's lengths and its checksum are
+    rewritten to match."""
+    from reference_decoder import read_varint
+    data, start, end, payload = mesh_section(src)
+    lengths, r = [], 0
+    for _ in range(4):
+        n, r = read_varint(payload, r, len(payload))
+        lengths.append(n)
+    streams = []
+    for n in lengths:
+        streams.append(payload[r:r + n])
+        r += n
+    topo = bytearray(streams[2])
+    key, value = op.split('=')
+    if key == 'mode':
+        topo[0] = int(value)
+    else:
+        topo = topo[:int(value)]
+    streams[2] = bytes(topo)
+    payload = b''.join(varint(len(x)) for x in streams) + b''.join(streams) + payload[r:]
+    replace_section(data, start, end, payload, dst)
 
 
 def main():

@@ -308,12 +308,15 @@ namespace {
 
 // A file of the given quantization, level and asked-for format version (0:
 // the encoder's choice).
-std::string encode_as(const Mesh& m, int bits, int level, int version) {
+// segment_faces: EncodeOptions::segment_faces (0, the default: the mesh
+// whole unless it is larger than 2^18 faces).
+std::string encode_as(const Mesh& m, int bits, int level, int version, uint32_t segment_faces = 0) {
   std::string out;
   tsm::EncodeOptions o;
   o.quantization_bits = bits;
   o.level = level;
   o.format_version = version;
+  o.segment_faces = segment_faces;
   const tsm::Status s = tsm::encode(m, o, out);
   EXPECT_TRUE(s.ok()) << s.to_string();
   return out;
@@ -422,12 +425,7 @@ TEST(FormatV8, TablesAtTheFastLevelsAndVersion8OnlyThere) {
   EXPECT_EQ(version_of(l6), 5u);
   EXPECT_FALSE(tables(l6));
   // Segments: each codes its own tables.
-  std::string seg;
-  tsm::EncodeOptions o;
-  o.level = 0;
-  o.segment_faces = 1000;
-  o.format_version = 8;
-  ASSERT_TRUE(tsm::encode(noisy, o, seg).ok());
+  const std::string seg = encode_as(noisy, 14, 0, 8, 1000);
   EXPECT_EQ(version_of(seg), 8u);
   expect_round_trip(noisy, seg, 14, "tables in segments");
 }
@@ -530,19 +528,13 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
   // ones mode 0.
   const Mesh grid = tsm_test::irregular_grid(60, 4);
   for (uint32_t faces : {4000u, 300u}) {
-    std::string seg;
-    tsm::EncodeOptions o;
-    o.level = 0;
-    o.segment_faces = faces;
-    ASSERT_TRUE(tsm::encode(grid, o, seg).ok());
+    const std::string seg = encode_as(grid, 14, 0, 0, faces);
     EXPECT_EQ(version_of(seg), 9u);
     if (faces > 1000) {
       EXPECT_GE(run_table_parts(seg), 1u);
     }
     expect_round_trip(grid, seg, 14, "run tables in segments of " + std::to_string(faces));
-    std::string again;
-    ASSERT_TRUE(tsm::encode(decode_ok(seg), o, again).ok());
-    EXPECT_EQ(again, seg);
+    EXPECT_TRUE(encode_as(decode_ok(seg), 14, 0, 0, faces) == seg);
   }
   // Forged: a mode above 1, an empty stream, tables cut short, the bit
   // stream longer than the stream, the tables read as mode 0.
@@ -655,12 +647,7 @@ TEST(FormatV9, AttributeTablesAtTheFastLevels) {
                                        [&](size_t, uint32_t) { return static_cast<float>(rng() % 1000) / 1000.0f; }));
   EXPECT_EQ(table_coded_attributes(encode_as(small, 12, 0, 0)), 0u);
   // In segments, each with its own tables.
-  std::string seg;
-  tsm::EncodeOptions o;
-  o.level = 0;
-  o.quantization_bits = 12;
-  o.segment_faces = 1200;
-  ASSERT_TRUE(tsm::encode(m, o, seg).ok());
+  const std::string seg = encode_as(m, 12, 0, 0, 1200);
   EXPECT_GE(table_coded_attributes(seg), 3u);
   expect_round_trip(m, seg, 12, "attribute tables in segments");
   // Damaged: every byte of the attribute payload flipped in turn, and the
