@@ -37,7 +37,7 @@ struct TriangleTreeModels {
   UIntModel root;
   UIntModel march[2][2];  // [previous run's end type][this run's end type]
   Prob end[2][2];         // [previous run's end][the end of the run before it]
-  Prob bit[kMarchContexts];  // see MarchBitSource
+  Prob bit[kMarchContexts];  // see MarchBitDecoder
   Prob diagonal[2];    // by previous flag
 };
 
@@ -190,19 +190,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       prev_end = tr.branch[r];
     }
     {  // Marching bits, coded during the same walk the decoder makes.
-      struct Source : MarchBitSource {
-        RangeEncoder& e;
-        Prob* probs;
-        const std::vector<uint8_t>& bits;
-        size_t next = 0;
-        Source(RangeEncoder& enc, Prob* p, const std::vector<uint8_t>& b) : e(enc), probs(p), bits(b) {}
-        int bit(int ctx) override {
-          int b = next < bits.size() ? bits[next] : 0;
-          ++next;
-          e.bit(probs[ctx], b);
-          return b;
-        }
-      } source(et, tm.bit, tr.bits);
+      MarchBitEncoder source{et, tm.bit, tr.bits};
       std::vector<uint32_t> local_loop(cl.loop.size());
       for (size_t p = 0; p < cl.loop.size(); ++p) local_loop[p] = pos_of[cl.loop[p]] - start;
       uint64_t used = 0;
@@ -475,12 +463,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       if (leaves == branches + 1) break;
     }
     st.triangle_runs += tr.march.size();
-    struct Source : MarchBitSource {
-      RangeDecoder& d;
-      Prob* probs;
-      Source(RangeDecoder& dec, Prob* p) : d(dec), probs(p) {}
-      int bit(int ctx) override { return d.bit(probs[ctx]); }
-    } source(dt, tm.bit);
+    MarchBitDecoder source{dt, tm.bit};
     const uint32_t T = L - 2, base = static_cast<uint32_t>(corner.size() / 3);
     if (uint64_t{base} + T > corner_count + max_positions) return corrupt("more triangles than the header allows");
     corner.resize(3 * (size_t{base} + T));

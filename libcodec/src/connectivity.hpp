@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "geometry_predict.hpp"
+#include "range_coder.hpp"
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
@@ -219,9 +220,25 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
 // degree in the cut, capped at 3). The encoder answers from its bits, the
 // decoder from the range coder.
 constexpr int kMarchContexts = 8 * 8 * 3 * 3 * 3;
-struct MarchBitSource {
-  virtual int bit(int ctx) = 0;
-  virtual ~MarchBitSource() = default;
+// The two sources of marching bits (concrete types, so that the walk
+// inlines the range coder: a virtual call per bit cost 4% of a fast-level
+// decode). Both adapt probs[ctx].
+struct MarchBitDecoder {
+  RangeDecoder& d;
+  Prob* probs;
+  int bit(int ctx) { return d.bit(probs[ctx]); }
+};
+struct MarchBitEncoder {  // answers from the encoder's bits, coding each
+  RangeEncoder& e;
+  Prob* probs;
+  const std::vector<uint8_t>& bits;
+  size_t next = 0;
+  int bit(int ctx) {
+    const int b = next < bits.size() ? bits[next] : 0;
+    ++next;
+    e.bit(probs[ctx], b);
+    return b;
+  }
 };
 
 // Where decode_triangle_tree writes the triangles it walks, in decode order
@@ -247,8 +264,10 @@ struct TriangleTreeOut {
 // Decoder (and encoder, to share the contexts): the walk of the triangle
 // tree. runs.bits is unused: bits come from `bits`; loop maps loop positions
 // to the component's local vertices (n of them), for the valence contexts.
+// Instantiated for MarchBitDecoder and MarchBitEncoder.
+template <class Bits>
 Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, const std::vector<uint32_t>& loop,
-                            uint32_t n, MarchBitSource& bits, const TriangleTreeOut& out, uint64_t& bit_count);
+                            uint32_t n, Bits& bits, const TriangleTreeOut& out, uint64_t& bit_count);
 
 // Stage 5: the whole connectivity, coded.
 struct ConnectivityStats {

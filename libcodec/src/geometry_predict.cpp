@@ -606,6 +606,81 @@ struct SurfaceCoder {
   }
 };
 
+// The fast levels' decoder: the gate predictor in march order without a
+// lattice, tangent step or mixing, residuals from tables (FORMAT.md
+// §8.5.11). It is SurfaceCoder::code<true> with multi false followed by
+// Coder::vertex<true>, written out for that one case: the gate's three
+// corners looked up once, the averages of one or two values as sums and
+// shifts, the table lookup inline. Same arithmetic as the general walk,
+// which the encoder runs (every level-0 round trip in the tests compares
+// the two). first: the half-edges to code, in order.
+bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                        const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
+  const uint32_t* cv = g.corners().data();
+  const uint32_t* twin = g.twin.data();
+  uint8_t* act = c.act.data();
+  uint32_t* Q = q.data();
+  const int64_t qmax = c.qmax, alpha = c.alpha[0];
+  auto known = [&](uint32_t h) {
+    const uint32_t v = cv[h];
+    return v != kNone && act[v] != kUnknown ? v : kNone;
+  };
+  for (uint32_t i = 0; i < nfirst; ++i) {
+    const uint32_t h0 = first[i], v = cv[h0], hn = he_next(h0);
+    const uint32_t u = known(hn), w = known(he_prev(h0));
+    int64_t pred[3];
+    int cls = 1, activity;
+    if (u != kNone) {
+      const uint32_t* U = Q + 3 * size_t{u};
+      const uint32_t o = w != kNone ? known(he_prev(twin[hn])) : kNone;
+      if (o != kNone) {  // the parallelogram u + w - o against the neighbour u
+        const uint32_t *W = Q + 3 * size_t{w}, *O = Q + 3 * size_t{o};
+        for (int a = 0; a < 3; ++a)
+          pred[a] = U[a] + floor_shift(alpha * (int64_t{W[a]} - O[a]) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+        cls = 2;
+        activity = act[u];
+      } else if (w != kNone) {  // the average of u and w, rounded half up
+        const uint32_t* W = Q + 3 * size_t{w};
+        for (int a = 0; a < 3; ++a) pred[a] = (int64_t{U[a]} + W[a] + 1) >> 1;
+        activity = (act[u] + act[w] + 1) >> 1;
+      } else {
+        for (int a = 0; a < 3; ++a) pred[a] = U[a];
+        activity = act[u];
+      }
+    } else if (w != kNone) {
+      const uint32_t* W = Q + 3 * size_t{w};
+      for (int a = 0; a < 3; ++a) pred[a] = W[a];
+      activity = act[w];
+    } else {
+      for (int a = 0; a < 3; ++a) pred[a] = last[a];
+      cls = 0;
+      activity = last_act;
+    }
+    uint64_t sum = 0, top = 0;
+    uint32_t* X = Q + 3 * size_t{v};
+    for (int a = 0; a < 3; ++a) {
+      const int ctx = std::min(a == 0 ? activity : (activity + bit_length(top) + 1) / 2, kActivity - 1);
+      const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
+      int32_t r;
+      if (!s.tables.decode(s.bits, (a * kClasses + cls) * kActivity + ctx, r)) {
+        s.bad_code = true;
+        return false;
+      }
+      if (p + r < 0 || p + r > qmax) return false;
+      X[a] = static_cast<uint32_t>(p + r);
+      const uint64_t ar = static_cast<uint64_t>(r < 0 ? -int64_t{r} : int64_t{r});
+      sum += ar;
+      top = std::max(top, ar);
+    }
+    act[v] = static_cast<uint8_t>(std::min(bit_length(sum), 254));
+    for (int a = 0; a < 3; ++a) last[a] = X[a];
+    last_act = act[v];
+    if ((i & 4095) == 0 && s.truncated()) return false;
+  }
+  c.prev_act = last_act;
+  return true;
+}
+
 // March order: vertices as the triangle tree first reaches them.
 template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
@@ -629,6 +704,11 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
       seen[x] = 1;
     }
   }
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
+    if (!multi && c.plain()) {
+      if (!decode_gate_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+      return sc.isolated();
+    }
   auto walk = [&](auto plain) {
     for (uint32_t i = 0; i < nfirst; ++i) {
       if (!sc.template code<decltype(plain)::value>(first[i], multi)) return false;

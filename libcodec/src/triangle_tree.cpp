@@ -85,8 +85,9 @@ Status encode_triangle_tree(const CutMesh& m, const ComponentLoop& cl, std::vect
   return Status::Ok();
 }
 
+template <class Bits>
 Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vector<uint32_t>& loop, uint32_t n,
-                            MarchBitSource& bits, const TriangleTreeOut& out, uint64_t& bit_count) {
+                            Bits& bits, const TriangleTreeOut& out, uint64_t& bit_count) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "triangle tree: " + what); };
   const size_t nr = runs.march.size();
   if (L < 4 || runs.root >= L) return corrupt("bad loop length or root position");
@@ -210,5 +211,10 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   if (twice) return corrupt("a loop edge belongs to two triangles");
   return Status::Ok();
 }
+
+template Status decode_triangle_tree<MarchBitDecoder>(uint32_t, const TriangleRuns&, const std::vector<uint32_t>&,
+                                                      uint32_t, MarchBitDecoder&, const TriangleTreeOut&, uint64_t&);
+template Status decode_triangle_tree<MarchBitEncoder>(uint32_t, const TriangleRuns&, const std::vector<uint32_t>&,
+                                                      uint32_t, MarchBitEncoder&, const TriangleTreeOut&, uint64_t&);
 
 }  // namespace tsm
