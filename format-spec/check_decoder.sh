@@ -98,8 +98,9 @@ for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
 for q in 11 16; do check box_q$q "$work/box.obj" $q 6; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50
+for l in 1 2; do check mixed_l$l "$work/mixed.obj" 16 $l; done  # levels 1-2 where the gate still wins (its planes)
 dragon=$corpus/dragon_vrip_res4.ply
-for l in 0 6 9; do corpus_case check dragon_l$l "$dragon" 11 $l; done
+for l in 0 1 2 6 9; do corpus_case check dragon_l$l "$dragon" 11 $l; done
 corpus_case check dragon_segments "$dragon" 11 6 2000
 
 # ---- attributes (§8.12)
@@ -127,6 +128,8 @@ acheck uv_corner_segments_l0 "$work/uv_corner.obj" 12 0 600
 acheck unused_vt_l0 "$work/unused_vt.obj" 12 0
 corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
 corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # version 8 tables, the fast level
+corpus_case check bunny_l2 "$corpus/bun_zipper.ply" 14 2  # version 10: fan with the tangent step
+corpus_case check bunny_segments_l1 "$corpus/bun_zipper.ply" 12 1 20000  # version 10: fan in segments
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000
 
 # ---- metadata (§4.6)
@@ -158,6 +161,11 @@ if [ -f "$work/dragon_l0.tsm" ]; then
     name="run_tables_$(echo "$forged" | tr = _)"
     $topo "$work/dragon_l0.tsm" "$work/$name.tsm" "$forged" && refused "$name"
   done
+fi
+
+# Version 10's fan predictor (§8.5.1) in a file that says version 9: refused.
+if [ -f "$work/dragon_l1.tsm" ]; then
+  $PY "$here/test_meshes.py" --set-version "$work/dragon_l1.tsm" "$work/fan_as_v9.tsm" 9 && refused fan_as_v9
 fi
 
 forge="$PY $here/test_meshes.py --replace-in-mesh"

@@ -122,7 +122,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6, 7, 8, 9):
+    if version not in (3, 4, 5, 6, 7, 8, 9, 10):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -983,7 +983,7 @@ def floordiv(a, b):
     return a // b    # Python's // is floor division for any sign
 
 
-PREDICTOR_NAMES = ['ancestors', 'parallelograms', 'gate', 'spread', 'raw']
+PREDICTOR_NAMES = ['ancestors', 'parallelograms', 'gate', 'spread', 'raw', 'fan']
 
 
 def decode_lattice(d, qmax, vc, top=False):
@@ -1156,17 +1156,18 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     if version >= 6 and predictor & 0x20:                           # §8.5.1, version 6
         predictor &= 0xDF
         mix = True
-        if (predictor & 0x3F) > 3:
+        if (predictor & 0x3F) > 3 and (predictor & 0x3F) != 5:
             reject('geometry: predictor without residual models to mix')
-    if version >= 5 and predictor in (0x41, 0x42, 0x43, 0xC1, 0xC2, 0xC3):   # §8.5.1, version 5
+    if version >= 5 and predictor in (0x41, 0x42, 0x43, 0xC1, 0xC2, 0xC3) or \
+            version >= 10 and predictor in (0x45, 0xC5):              # §8.5.1, versions 5 and 10
         predictor &= 0xBF
         tangent = True
     if version >= 4 and predictor & 0x80 and predictor != 0x80:      # §8.5.1, version 4
         predictor &= 0x7F
         default_weights = True
-        if predictor > 3:
+        if predictor > 3 and predictor != 5:
             reject('geometry: predictor without weights')
-    if predictor > (4 if version >= 4 else 3):
+    if predictor > (5 if version >= 10 else 4 if version >= 4 else 3):
         reject('geometry: predictor')
     if table_flag and (predictor == 4 or mix):
         reject('geometry: tables with the raw predictor or with mixing')
@@ -1393,7 +1394,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             pred = list(st['last'])
             cls = 0
         activity = (cnt['actsum'] + nnb // 2) // nnb if nnb > 0 else st['last_act']
-        spread = [hi[a] - lo[a] for a in range(3)] if predictor == 3 and npara >= 2 else None
+        spread = [hi[a] - lo[a] for a in range(3)] if predictor in (3, 5) and npara >= 2 else None
         normal = tangent_normal(pred, T) if tangent and npara > 0 else None
         return pred, cls, activity, spread, normal        # set 0
 
@@ -1446,12 +1447,12 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             if v % 4096 == 0 and d.truncated():
                 reject('geometry: truncated')
 
-    if predictor == 2:                                       # §8.5.5
+    if predictor in (2, 5):                                  # §8.5.5 (5: version 10)
         for h0 in range(H):
             p = tri[h0]
             if ids[p] == NONE or act[ids[p]] != UNKNOWN:
                 continue
-            point(ids[p], *predict(h0, False))
+            point(ids[p], *predict(h0, predictor == 5))
             if h0 % 4096 == 0 and d.truncated():
                 reject('geometry: truncated')
         on_no_triangle()

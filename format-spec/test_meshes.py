@@ -618,7 +618,24 @@ def forge_topology(src, dst, op):
     replace_section(data, start, end, payload, dst)
 
 
+def set_version(src, dst, version):
+    """Copies the .tsm file src to dst saying format version `version`, with
+    the header checksum (§3) rewritten to match: a file that only the
+    version's payload rules can refuse."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from reference_decoder import read_varint, xxh32
+    data = bytearray(open(src, 'rb').read())
+    struct.pack_into('<H', data, 4, version)
+    hlen, p = read_varint(bytes(data), 8, len(data))
+    struct.pack_into('<I', data, p + hlen, xxh32(bytes(data[:p + hlen])))
+    open(dst, 'wb').write(bytes(data))
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == '--set-version':
+        # --set-version SRC DST N
+        set_version(sys.argv[2], sys.argv[3], int(sys.argv[4]))
+        return
     if len(sys.argv) > 1 and sys.argv[1] == '--forge-topology':
         # --forge-topology SRC DST mode=N | cut=K
         forge_topology(sys.argv[2], sys.argv[3], sys.argv[4])

@@ -468,6 +468,12 @@ int main(int argc, char** argv) {
   // irregular grid with holes and fins (the noisy sphere above has mode 0)
   encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(20, 3), 11, 0);
   encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(24, 3), 11, 0, 400);
+  // the fan predictor (format version 10): levels 1 and 2 (with the tangent
+  // step), whole and in segments
+  const tsm::Mesh fan_sphere = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
+  encode_seed(decode_dir, "fan_sphere", fan_sphere, 12, 1);
+  encode_seed(decode_dir, "fan_sphere", fan_sphere, 12, 2);
+  encode_seed(decode_dir, "fan_sphere", fan_sphere, 12, 2, 1500);
   encode_seed(decode_dir, "quads", quad_grid(6), 1, 6);
   // Files of several segments (FORMAT.md §4.5).
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 12, 6, 40);

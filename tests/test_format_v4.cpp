@@ -176,8 +176,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 10 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 10, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 11 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 11, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -487,12 +487,14 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
     for (int level : {0, 2}) {
       SCOPED_TRACE(name + ", level " + std::to_string(level));
       const bool irregular = name.rfind("irregular", 0) == 0;
-      const std::string v9 = encode_as(m, 12, level, 0);
+      // Level 2 says version 10 where its fan predictor wins (FormatV10
+      // below): asked for version 9 here, the file it wrote before.
+      const std::string v9 = encode_as(m, 12, level, level == 0 ? 0 : 9);
       EXPECT_EQ(version_of(v9), 9u);
       EXPECT_EQ(topology_of(v9).substr(0, 1), std::string(1, irregular ? '\x01' : '\0'));
       EXPECT_EQ(run_table_parts(v9), irregular ? 1u : 0u);
       expect_round_trip(m, v9, 12, name);
-      EXPECT_TRUE(encode_as(decode_ok(v9), 12, level, 0) == v9);
+      EXPECT_TRUE(encode_as(decode_ok(v9), 12, level, level == 0 ? 0 : 9) == v9);
       const std::string v8 = encode_as(m, 12, level, 8);
       EXPECT_EQ(version_of(v8), 8u);
       expect_round_trip(m, v8, 12, name + " as version 8");
@@ -691,4 +693,53 @@ TEST(FormatV9, ManyUnusedTableCodedValuesDecode) {
   const std::string bytes = encode_as(m, 12, 0, 0);
   EXPECT_EQ(table_coded_attributes(bytes), 1u);
   expect_round_trip(m, bytes, 12, "many unused values");
+}
+
+// Version 10 adds the fan predictor (FORMAT.md §8.5.5): march order as the
+// gate's, each vertex predicted from every triangle around it, residual
+// contexts from the parallelograms' spread. Levels 1-2 try it in files
+// whose parts have the mode byte (level 2 also with the tangent step) and
+// say version 10 only where it wins; it is exact and canonical, smaller
+// than level 0 on a noisy sphere, refused as version 9, and never written
+// when version 9 is asked for or into a file without the mode byte.
+TEST(FormatV10, FanPredictorAtLevels1And2) {
+  const Mesh noisy = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
+  const Mesh smooth = tsm_test::jittered(tsm_test::icosphere(5), 0.0005f, 6);
+  for (const auto& [name, m] : {std::pair<std::string, const Mesh*>{"noisy sphere", &noisy}, {"sphere", &smooth}}) {
+    const std::string l0 = encode_as(*m, 12, 0, 0);
+    EXPECT_EQ(predictor_of(l0).rfind("gate", 0), 0u) << predictor_of(l0);
+    std::string previous = l0;
+    for (int level : {1, 2}) {
+      SCOPED_TRACE(name + ", level " + std::to_string(level));
+      const std::string fan = encode_as(*m, 12, level, 0);
+      EXPECT_EQ(predictor_of(fan).rfind("fan", 0), 0u) << predictor_of(fan);
+      EXPECT_EQ(version_of(fan), 10u);
+      EXPECT_LE(fan.size(), previous.size());  // each level tries what the one before did, and more
+      previous = fan;
+      expect_round_trip(*m, fan, 12, name);
+      EXPECT_TRUE(encode_as(decode_ok(fan), 12, level, 0) == fan);
+      expect_needs_version(fan, 10);
+      // Asked for version 9: the gate, as before version 10.
+      const std::string v9 = encode_as(*m, 12, level, 9);
+      EXPECT_EQ(version_of(v9), 9u);
+      EXPECT_EQ(predictor_of(v9).rfind("gate", 0), 0u) << predictor_of(v9);
+      expect_round_trip(*m, v9, 12, name + " as version 9");
+    }
+    EXPECT_LT(previous.size(), l0.size()) << name;
+  }
+  // Level 2 on the noisy sphere takes the tangent step too.
+  EXPECT_EQ(predictor_of(encode_as(smooth, 12, 2, 0)).rfind("fan+tangent", 0), 0u);
+  // Without the mode byte (under 256 faces), levels 1-2 keep the gate and version 8.
+  const Mesh small = tsm_test::jittered(tsm_test::icosphere(1), 0.003f, 5);
+  ASSERT_LT(small.face_count(), 256u);
+  for (int level : {1, 2}) {
+    const std::string s = encode_as(small, 12, level, 0);
+    EXPECT_LE(version_of(s), 8u);
+    EXPECT_EQ(predictor_of(s).find("fan"), std::string::npos) << predictor_of(s);
+  }
+  // Segments choose their predictors each; the file says version 10.
+  const std::string seg = encode_as(smooth, 12, 1, 0, 3000);
+  EXPECT_EQ(version_of(seg), 10u);
+  expect_round_trip(smooth, seg, 12, "fan in segments");
+  EXPECT_TRUE(encode_as(decode_ok(seg), 12, 1, 0, 3000) == seg);
 }

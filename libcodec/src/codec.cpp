@@ -345,9 +345,17 @@ struct PartOptions : EncodeOptions {
 bool attribute_tables(const PartOptions& options) { return options.mode_byte && options.level <= kTableLevel; }
 
 uint16_t needed_version(const ConnectivityStreams& streams, const std::string& geometry) {
-  if (streams.mode_byte) return 9;
   const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
+  if ((kind & 7) == static_cast<uint8_t>(Predictor::fan)) return kFanVersion;
+  if (streams.mode_byte) return 9;
   return kind & kTableFlag ? 8 : kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
+}
+// The newest geometry features a part may use: version 10's fan predictor
+// only in a file whose parts have the mode byte (every file of version 9 or
+// newer has it), else at most version 8's.
+int geometry_version(const PartOptions& options) {
+  const int v = written_version(options);
+  return options.mode_byte ? v : std::min(v, 8);
 }
 
 // Encoder: one part (the whole mesh or a segment) coded.
@@ -582,7 +590,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, written_version(options));
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, geometry_version(options));
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -1056,6 +1064,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
                             : gs.predictor == Predictor::gate    ? "gate"
                             : gs.predictor == Predictor::spread  ? "spread"
+                            : gs.predictor == Predictor::fan     ? "fan"
                             : gs.predictor == Predictor::raw     ? "raw"
                                                                  : "parallelograms";
   if (gs.tangent) info.geometry_predictor += "+tangent";

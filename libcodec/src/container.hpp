@@ -11,7 +11,7 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 9;        // what the encoder writes
+constexpr uint16_t kFormatVersion = 10;       // what the encoder writes
 constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 9
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };

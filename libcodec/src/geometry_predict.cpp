@@ -64,11 +64,15 @@ constexpr int kMantissa = 6;  // modelled mantissa bits of a residual
 using ResidualModel = SIntModelT<kMantissa>;
 constexpr int kMixCtx = 8;    // weight sets of residual mixing per coding position and decision
 
-// Predictors 1, 2 and 3, which predict from the triangles around a vertex
+// Predictors 1, 2, 3 and 5, which predict from the triangles around a vertex
 // (parallelogram weights, the tangent step).
 bool surface_predictor(Predictor p) {
-  return p == Predictor::parallelograms || p == Predictor::gate || p == Predictor::spread;
+  return p == Predictor::parallelograms || p == Predictor::gate || p == Predictor::spread || p == Predictor::fan;
 }
+// Predictors 1 and 3 visit the vertices in greedy order, 2 and 5 in march
+// order; 3 and 5 take residual contexts from the parallelograms' spread.
+bool greedy_order(Predictor p) { return p == Predictor::parallelograms || p == Predictor::spread; }
+bool spread_contexts(Predictor p) { return p == Predictor::spread || p == Predictor::fan; }
 
 // floor(x / 2^s): an arithmetic shift (GCC, Clang and MSVC shift signed
 // values arithmetically; C++20 requires it). No branch on the sign, which
@@ -950,10 +954,10 @@ void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predi
   fit.collect = true;
   CollectSink cs;
   std::vector<uint32_t> work = q;
-  if (pred == Predictor::parallelograms || pred == Predictor::spread)
+  if (greedy_order(pred))
     code_greedy(g, fit, cs, work);
   else
-    code_march_order(g, false, fit, cs, work);
+    code_march_order(g, pred == Predictor::fan, fit, cs, work);
 }
 
 // The parallelogram weights for a predictor: fitted per class by least
@@ -1090,7 +1094,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   // One coding pass with a given sink (the table encoder makes two).
   auto pass = [&](auto& s) {
     Coder c(g.vertex_count, bits, !tables);
-    c.spread_ctx = pred == Predictor::spread;
+    c.spread_ctx = spread_contexts(pred);
     if (mix) c.mix = std::make_unique<MixModels>();
     std::copy(alpha, alpha + 3, c.alpha);
     if (tangent) {
@@ -1104,10 +1108,10 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
     std::vector<uint32_t> work = q;
     if (pred == Predictor::ancestors)
       code_ancestors(g, K, lambda, c, s, work);
-    else if (pred == Predictor::parallelograms || pred == Predictor::spread)
+    else if (greedy_order(pred))
       code_greedy(g, c, s, work);
     else
-      code_march_order(g, false, c, s, work);
+      code_march_order(g, pred == Predictor::fan, c, s, work);
   };
   if (!tables) {
     EncodeSink s;
@@ -1254,6 +1258,19 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
         }
     }
   }
+  // Levels 1-2 (version 10): the prediction from every triangle around the
+  // new vertex, still in march order (predictor fan), and at level 2 the
+  // tangent step on whichever of gate and fan is smaller; each kept only
+  // where it makes the file smaller.
+  int32_t fan_lsq[3], fan_est[3];
+  if ((level == 1 || level == 2) && version >= kFanVersion) {
+    fit_alphas(g, q, bits, Predictor::fan, fan_lsq, fan_est);
+    consider(Predictor::fan, 0, st.lattice, fan_est);
+    if (level == 2 && tangent) {
+      fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
+      consider(st.predictor, 0, st.lattice, weights, beta);
+    }
+  }
   // The least-squares weights instead of the size estimate's.
   if (level >= 3 && std::memcmp(lsq, est, sizeof lsq) != 0) consider(st.predictor, 0, st.lattice, lsq);
   // Residual contexts from the parallelograms' spread instead of the activity.
@@ -1311,7 +1328,9 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   GeometryStats st;
   uint8_t kind;
   if (!r.u8(kind)) return corrupt("empty section");
-  const uint8_t newest = static_cast<uint8_t>(version >= 4 ? Predictor::raw : Predictor::spread);
+  const uint8_t newest = static_cast<uint8_t>(version >= kFanVersion ? Predictor::fan
+                                              : version >= 4           ? Predictor::raw
+                                                                       : Predictor::spread);
   bool default_weights = false;
   if (version >= 8 && (kind & kTableFlag)) {
     kind = static_cast<uint8_t>(kind & ~kTableFlag);
@@ -1325,7 +1344,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     kind = static_cast<uint8_t>(kind & ~kMixFlag);
     st.mix = true;
     const int base = kind & ~(kDefaultWeightsFlag | kTangentFlag);
-    if (base > static_cast<int>(Predictor::spread))
+    if (base > static_cast<int>(Predictor::spread) && base != static_cast<int>(Predictor::fan))
       return corrupt("predictor " + std::to_string(base) + " has no residual models to mix");
   }
   if (version >= 5 && (kind & kTangentFlag)) {
@@ -1338,7 +1357,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
   if (version >= 4 && (kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
     kind = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
     default_weights = true;
-    if (kind > static_cast<uint8_t>(Predictor::spread))
+    if (kind > static_cast<uint8_t>(Predictor::spread) && kind != static_cast<uint8_t>(Predictor::fan))
       return corrupt("predictor " + std::to_string(kind) + " has no weights to leave out");
   }
   if (kind > newest) return corrupt("unknown predictor " + std::to_string(kind));
@@ -1390,7 +1409,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     }
   }
   for (int k = 0; k < 3; ++k) c.alpha[k] = alpha[k];
-  c.spread_ctx = st.predictor == Predictor::spread;
+  c.spread_ctx = spread_contexts(st.predictor);
   if (st.mix) c.mix = std::make_unique<MixModels>();
   c.planes_from_top = st.top;
   if (st.predictor == Predictor::ancestors)
@@ -1405,9 +1424,8 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     if (st.predictor == Predictor::ancestors)
       ok = code_ancestors(g, st.ancestors, lambda, c, s, q);
     else
-      ok = st.predictor == Predictor::parallelograms || st.predictor == Predictor::spread
-               ? code_greedy(g, c, s, q)
-               : code_march_order(g, false, c, s, q);
+      ok = greedy_order(st.predictor) ? code_greedy(g, c, s, q)
+                                      : code_march_order(g, st.predictor == Predictor::fan, c, s, q);
     if (!ok || s.truncated()) return corrupt(s.truncated() ? s.truncation() : "coordinate outside the grid");
     if (stats) *stats = st;
     return Status::Ok();

@@ -36,7 +36,11 @@ enum class Predictor : uint8_t {
   gate = 2,           // march order; the single parallelogram across the gate (fast)
   spread = 3,         // as parallelograms; residual contexts from the parallelograms' spread
   raw = 4,            // version 4: no prediction, every coordinate as `bits` equiprobable bits (tiny meshes)
+  fan = 5,            // version 10: march order (as gate) predicted from every triangle around the new vertex,
+                      // residual contexts from the parallelograms' spread (as spread): levels 1-2
 };
+// The format version that introduced Predictor::fan.
+constexpr int kFanVersion = 10;
 // Version 4: the predictor byte of 1, 2 or 3 with this bit set says the
 // parallelogram weights are all 1.0 and not stored (6 bytes less).
 constexpr uint8_t kDefaultWeightsFlag = 0x80;

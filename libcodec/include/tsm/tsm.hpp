@@ -130,7 +130,7 @@ struct FileInfo {
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
-  // "gate", "ancestors" (with K) or "raw", followed by "+tangent" (tangent
+  // "gate", "fan" (format version 10), "ancestors" (with K) or "raw", followed by "+tangent" (tangent
   // step), "+mix" (residual mixing), "+top" (lattice planes from the top)
   // where used, and the lattice planes per axis (0 = unused).
   std::string geometry_predictor;
