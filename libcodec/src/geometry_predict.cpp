@@ -685,6 +685,101 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   return true;
 }
 
+// Level 1-2's decoder (predictor fan: every triangle around the vertex,
+// spread contexts, optionally the tangent step; no lattice, no mixing;
+// residuals from tables): SurfaceCoder::code with multi true, the fan walk
+// written out as one loop (the general walk calls a lambda per half-edge),
+// then the general Coder::vertex. Same arithmetic as the general walk,
+// which the encoder runs (the level-1 and level-2 round trips in the tests
+// compare the two).
+bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                       const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
+  const uint32_t* cv = g.corners().data();
+  const uint32_t* twin = g.twin.data();
+  const uint8_t* act = c.act.data();
+  const size_t H = g.corners().size();
+  auto known = [&](uint32_t h) {
+    const uint32_t v = cv[h];
+    return v != kNone && act[v] != kUnknown ? v : kNone;
+  };
+  auto at = [&](uint32_t v) { return &q[3 * size_t{v}]; };
+  constexpr int kPairs = 16;
+  for (uint32_t i = 0; i < nfirst; ++i) {
+    const uint32_t h0 = first[i], v = cv[h0];
+    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, pred[3];
+    int npara = 0, nnb = 0, actsum = 0, npair = 0;
+    uint32_t pu[kPairs], pw[kPairs];
+    uint32_t h = h0;
+    size_t guard = 0;
+    do {
+      const uint32_t hn = he_next(h), u = known(hn);
+      if (u != kNone) {
+        const uint32_t* U = at(u);
+        for (int a = 0; a < 3; ++a) nb[a] += U[a];
+        ++nnb;
+        actsum += act[u];
+        const uint32_t w = known(he_prev(h));
+        if (w != kNone) {
+          if (npair < kPairs) pu[npair] = u, pw[npair] = w;
+          ++npair;
+          const uint32_t o = known(he_prev(twin[hn]));
+          if (o != kNone) {
+            const uint32_t *W = at(w), *O = at(o);
+            for (int a = 0; a < 3; ++a) {
+              const int64_t x = int64_t{U[a]} + W[a] - O[a];
+              para[a] += x;
+              lo[a] = npara ? std::min(lo[a], x) : x;
+              hi[a] = npara ? std::max(hi[a], x) : x;
+            }
+            ++npara;
+          }
+        }
+      }
+      h = he_next(twin[h]);
+    } while (h != h0 && ++guard < H);
+    int cls;
+    if (npara) {
+      cls = 1 + std::min(npara, 3);
+      const int k = cls - 2;
+      const bool single = npara == 1 && nnb == 1;
+      for (int a = 0; a < 3; ++a) {
+        const int64_t P = single ? para[a] : div_round(para[a], npara), N = single ? nb[a] : div_round(nb[a], nnb);
+        pred[a] = N + floor_shift(c.alpha[k] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+      }
+    } else if (nnb) {
+      for (int a = 0; a < 3; ++a) pred[a] = div_round(nb[a], nnb);
+      cls = 1;
+    } else {
+      for (int a = 0; a < 3; ++a) pred[a] = last[a];
+      cls = 0;
+    }
+    int64_t spread[3];
+    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+    const int64_t* normal = nullptr;
+    NormalSum ns;
+    if (c.tangent && npara > 0) {
+      if (npair <= kPairs) {
+        for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
+      } else {  // a wide fan: walk it again
+        uint32_t hh = h0;
+        size_t gg = 0;
+        do {
+          const uint32_t u = known(he_next(hh)), w = known(he_prev(hh));
+          if (u != kNone && w != kNone) ns.add(at(u), at(w), pred);
+          hh = he_next(twin[hh]);
+        } while (hh != h0 && ++gg < H);
+      }
+      normal = ns.finish();
+    }
+    const int activity = nnb ? (actsum + nnb / 2) / nnb : last_act;
+    if (!c.vertex<false>(s, q, v, pred, cls, activity, npara >= 2 ? spread : nullptr, normal)) return false;
+    for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
+    last_act = act[v];
+    if ((i & 4095) == 0 && s.truncated()) return false;
+  }
+  return true;
+}
+
 // March order: vertices as the triangle tree first reaches them.
 template <class Sink>
 bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, std::vector<uint32_t>& q) {
@@ -708,11 +803,17 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
       seen[x] = 1;
     }
   }
-  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
     if (!multi && c.plain()) {
       if (!decode_gate_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
       return sc.isolated();
     }
+    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
+    if (multi && c.spread_ctx && !c.mix && no_lattice) {
+      if (!decode_fan_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+      return sc.isolated();
+    }
+  }
   auto walk = [&](auto plain) {
     for (uint32_t i = 0; i < nfirst; ++i) {
       if (!sc.template code<decltype(plain)::value>(first[i], multi)) return false;
