@@ -36,6 +36,18 @@ UNKNOWN = 255              # act[v] before v is decoded
 FLT_MAX = struct.unpack('<f', b'\xff\xff\x7f\x7f')[0]
 
 
+def f32_below(c):
+    """The binary32 value next below the binary32 value c (c finite, not -FLT_MAX)."""
+    bits = struct.unpack('<I', struct.pack('<f', c))[0]
+    if c > 0:
+        bits -= 1
+    elif c < 0:
+        bits += 1
+    else:
+        bits = 0x80000001            # below +-0: the negative denormal of least magnitude
+    return struct.unpack('<f', struct.pack('<I', bits))[0]
+
+
 class Corrupt(Exception):
     pass
 
@@ -2285,7 +2297,10 @@ def decode(data, trace=None):
         for a in range(3):
             x = float(h['origin'][a]) + float(q[v][a]) * step
             x = min(max(x, -FLT_MAX), FLT_MAX)
-            pt.append(f32(x))
+            c = f32(x)
+            while c - float(h['origin'][a]) > h['extent']:     # §5: not past origin + extent
+                c = f32_below(c)
+            pt.append(c)
         positions.append(pt)
     return h, faces, q, positions, info, attrs
 

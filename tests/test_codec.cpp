@@ -132,6 +132,37 @@ TEST(Codec, RoundTripDefaultOptionsAndAllLevels) {
   EXPECT_EQ(fi.level, tsm::kDefaultLevel);
 }
 
+// A mesh whose bounding box is nearly a cube: on an axis shorter than the
+// extent, the float nearest the last grid point could lie just past origin
+// + extent, so the decoded mesh had a larger extent and coding it again took
+// another grid (a jittered sphere at 12 bits drifted on every re-encoding).
+// The decoder keeps every coordinate within origin + extent (FORMAT.md §5).
+TEST(Codec, CanonicalWhenAShorterAxisNearlyReachesTheExtent) {
+  int checked = 0;
+  for (uint32_t seed = 1; seed <= 12; ++seed)
+    for (int q : {8, 12, 16}) {
+      const Mesh m = tsm_test::jittered(tsm_test::icosphere(3), 0.0002f, seed);
+      const std::string bytes = encode_ok(m, q, 0);
+      Mesh back;
+      ASSERT_TRUE(tsm::decode(bytes, back).ok());
+      // The decoded mesh has the extent it was coded with (the largest
+      // axis's ends decode exactly; no other axis may end beyond them).
+      auto extent = [](const Mesh& x) {
+        double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, e = 0;
+        for (size_t i = 0; i < x.positions.size(); ++i) {
+          lo[i % 3] = std::min(lo[i % 3], static_cast<double>(x.positions[i]));
+          hi[i % 3] = std::max(hi[i % 3], static_cast<double>(x.positions[i]));
+        }
+        for (int a = 0; a < 3; ++a) e = std::max(e, hi[a] - lo[a]);
+        return e;
+      };
+      EXPECT_EQ(extent(back), extent(m)) << "seed " << seed << " q " << q;
+      EXPECT_TRUE(encode_ok(back, q, 0) == bytes) << "seed " << seed << " q " << q;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 36);
+}
+
 TEST(Codec, RoundTripAwkwardCoordinates) {
   // Extents that are not exact in float, far from the origin, tiny and huge.
   std::vector<Named> cases;

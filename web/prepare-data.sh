@@ -20,7 +20,8 @@ mkdir -p "$OUT"
 MESHES="bunny:bun_zipper.ply dragon_res4:dragon_vrip_res4.ply dragon_res3:dragon_vrip_res3.ply
 dragon_res2:dragon_vrip_res2.ply dragon:dragon_vrip.ply cube_quads:edge/cube_quads.obj
 dragon_seg16k:dragon_vrip.ply:16384 bunny_seg4k:bun_zipper.ply:4096
-dragon_res4_l0:dragon_vrip_res4.ply::0 bunny_l0:bun_zipper.ply::0"
+dragon_res4_l0:dragon_vrip_res4.ply::0 bunny_l0:bun_zipper.ply::0 bunny_l2:bun_zipper.ply::2
+dragon_res3_l1:dragon_vrip_res3.ply::1"
 SEGMENTS=0
 "$TSM" encode --help 2>/dev/null | grep -q -- --segment-faces && SEGMENTS=1
 
@@ -49,7 +50,8 @@ for entry in $MESHES; do
     extra="$extra --segment-faces $segfaces"
   fi
   # A level (the fast ones: format version 9's table-coded run values and
-  # attribute residuals) for a variant of a mesh listed whole.
+  # attribute residuals, version 10's fan predictor at levels 1-2) for a
+  # variant of a mesh listed whole.
   [ -n "$level" ] && extra="$extra -l $level"
   if [ "${#want[@]}" -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
   [ -f "$src" ] || { echo "prepare-data: $src missing, skipped" >&2; continue; }

@@ -230,12 +230,21 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
   return Status::Ok();
 }
 
-double grid_value(const Header& h, double step, int axis, uint32_t q) {
+// A grid index as a coordinate (FORMAT.md §5).
+float grid_value(const Header& h, double step, int axis, uint32_t q) {
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
-  double x = static_cast<double>(h.origin[axis]) + static_cast<double>(q) * step;
+  const double o = static_cast<double>(h.origin[axis]);
+  double x = o + static_cast<double>(q) * step;
   // A grid point may lie up to half a step past the largest input
   // coordinate; near the float limit, clamp (the input was within range).
-  return x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
+  x = x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
+  float c = static_cast<float>(x);
+  // On an axis shorter than the extent, the float nearest a grid point may
+  // lie just past origin + extent; then the float below it, so that the
+  // decoded mesh has the extent it was coded with and coding it again
+  // takes the same grid (canonical re-encoding).
+  while (static_cast<double>(c) - o > h.extent) c = std::nextafter(c, -std::numeric_limits<float>::infinity());
+  return c;
 }
 
 // The parts of a file carry the same attributes (names, kinds, domains,
@@ -293,7 +302,7 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
   float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
   const uint32_t* q = part.q.data();
   for (size_t v = 0, nv = part.q.size() / 3; v < nv; ++v, q += 3, pos += 3)
-    for (int axis = 0; axis < 3; ++axis) pos[axis] = static_cast<float>(grid_value(h, step, axis, q[axis]));
+    for (int axis = 0; axis < 3; ++axis) pos[axis] = grid_value(h, step, axis, q[axis]);
   if (first) {  // the first part has no references: its faces as they are, no copy
     out.face_offsets = std::move(part.faces.face_offsets);
     out.indices = std::move(part.faces.indices);
