@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
                   "stdout (default: beside each input, NAME.tsm; stdout for stdin)");
   enc->add_option("-q,--quantization", ea.qbits, "Position quantization bits, 1..30")
       ->check(CLI::Range(1, 30))->capture_default_str();
-  enc->add_option("-l,--level", ea.level, "Level 0 (fastest decode) .. 9 (smallest); 0-2 decode about 2x / 1.3x faster than Draco, 3-6 "
-                 "are smaller than Draco's default, 7-9 smaller still and slower to decode")
+  enc->add_option("-l,--level", ea.level, "Level 0 (fastest decode) .. 9 (smallest): 0 decodes about 2x faster than Draco, 1-2 a little "
+                 "slower and smaller (2 below Draco's default size on scans), 3-6 smaller, 7-9 smallest and slowest")
       ->check(CLI::Range(0, 9))->capture_default_str();
   enc->add_option("--normal-bits", ea.attribute_bits.normal, "Float normals: octahedral bits per axis, 1..24")
       ->check(CLI::Range(1, 24))->capture_default_str();
