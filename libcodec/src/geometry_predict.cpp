@@ -290,11 +290,14 @@ struct Coder {
     if (j == L.size() || (j > 0 && p - L[j - 1] <= L[j] - p)) j = j == 0 ? 0 : j - 1;
     return j;
   }
+  // The table takes qmax + 1 entries per axis: only where the vertices
+  // look up more often than that (a mesh of a few vertices at 14 bits spent
+  // most of its decode building it); the binary search gives the same plane.
   void build_nearest() {
     for (int a = 0; a < 3; ++a) {
       const std::vector<uint32_t>& L = lattice.values[a];
       nearest[a].clear();
-      if (L.empty() || qmax >= (int64_t{1} << 18)) continue;
+      if (L.empty() || qmax >= (int64_t{1} << 18) || qmax + 1 > 16 * static_cast<int64_t>(act.size())) continue;
       nearest[a].resize(static_cast<size_t>(qmax) + 1);
       size_t j = 0;
       for (uint32_t p = 0; p <= qmax; ++p) {

@@ -76,10 +76,13 @@ async function main() {
   log(`modules ready: tsm ${result.tsmLoadMs.toFixed(1)} ms, draco ${result.dracoLoadMs.toFixed(1)} ms (fetch + compile)`);
 
   const rowsHtml = [];
+  // A level variant (name_lN) is timed against its whole mesh's Draco file.
+  const byName = Object.fromEntries(index.map((x) => [x.name, x]));
   for (const m of index) {
-    if (!m.drcBytes || m.ref.faceCount < 1000 || (only && !only.includes(m.name))) continue;
+    const base = byName[m.name.replace(/_l\d$/, '')] || m;
+    if (!base.drcBytes || m.ref.faceCount < 1000 || (only && !only.includes(m.name))) continue;
     const tb = await fetchBytes(`/data/${m.name}.tsm`);
-    const db = await fetchBytes(`/data/${m.name}.drc`);
+    const db = await fetchBytes(`/data/${base.name}.drc`);
     const a = tsm.decode(tb), b = dracoDecode(draco, db);
     for (let i = 0; i < 2; ++i) { tsm.decode(tb); dracoDecode(draco, db); }
     const ts = [], ds = [];
