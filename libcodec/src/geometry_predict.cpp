@@ -437,6 +437,31 @@ struct NormalSum {
   }
 };
 
+// The blend of FORMAT.md §8.5.4 from the sums a walk around a vertex found:
+// the parallelograms' average against the neighbours' with the class's
+// weight, else the neighbours' average, else the last vertex. Returns the
+// class; with parallelograms, d and n get P - N and N per axis (the
+// encoder's weight fit).
+__attribute__((always_inline)) inline int blend_prediction(const int32_t alpha[3], const int64_t para[3], int npara,
+                                                           const int64_t nb[3], int nnb, const int64_t last[3],
+                                                           int64_t pred[3], int64_t d[3], int64_t n[3]) {
+  if (npara) {
+    const int cls = 1 + std::min(npara, 3);
+    // One parallelogram and one neighbour (the gate predictor's usual
+    // case): the averages are the sums themselves (div_round(x, 1) == x).
+    const bool single = npara == 1 && nnb == 1;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t P = single ? para[a] : div_round(para[a], npara), N = single ? nb[a] : div_round(nb[a], nnb);
+      d[a] = P - N;
+      n[a] = N;
+      pred[a] = N + floor_shift(alpha[cls - 2] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+    }
+    return cls;
+  }
+  for (int a = 0; a < 3; ++a) pred[a] = nnb ? div_round(nb[a], nnb) : last[a];
+  return nnb ? 1 : 0;
+}
+
 // Prediction from the triangles around a vertex (march, greedy and gate
 // orders share it).
 template <class Sink>
@@ -532,26 +557,11 @@ struct SurfaceCoder {
       uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
       if (w != kNone && npara == 0) neighbour(w);
     }
-    int cls;
-    if (npara) {
-      cls = 1 + std::min(npara, 3);
-      const int k = cls - 2;
-      // One parallelogram and one neighbour (the gate predictor's usual
-      // case): the averages are the sums themselves (div_round(x, 1) == x).
-      const bool single = npara == 1 && nnb == 1;
-      for (int a = 0; a < 3; ++a) {
-        const int64_t P = single ? para[a] : div_round(para[a], npara), N = single ? nb[a] : div_round(nb[a], nnb);
-        if constexpr (Sink::kEncoder)
-          if (c.collect) c.samples[k].push_back({P - N, static_cast<int64_t>(at(v)[a]) - N});
-        pred[a] = N + floor_shift(c.alpha[k] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
-      }
-    } else if (nnb) {
-      for (int a = 0; a < 3; ++a) pred[a] = div_round(nb[a], nnb);
-      cls = 1;
-    } else {
-      for (int a = 0; a < 3; ++a) pred[a] = last[a];
-      cls = 0;
-    }
+    int64_t d[3], n[3];
+    const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
+    if constexpr (Sink::kEncoder)
+      if (c.collect && npara)
+        for (int a = 0; a < 3; ++a) c.samples[cls - 2].push_back({d[a], static_cast<int64_t>(at(v)[a]) - n[a]});
     int64_t spread[3];
     for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
@@ -740,22 +750,8 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
       }
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
-    int cls;
-    if (npara) {
-      cls = 1 + std::min(npara, 3);
-      const int k = cls - 2;
-      const bool single = npara == 1 && nnb == 1;
-      for (int a = 0; a < 3; ++a) {
-        const int64_t P = single ? para[a] : div_round(para[a], npara), N = single ? nb[a] : div_round(nb[a], nnb);
-        pred[a] = N + floor_shift(c.alpha[k] * (P - N) + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
-      }
-    } else if (nnb) {
-      for (int a = 0; a < 3; ++a) pred[a] = div_round(nb[a], nnb);
-      cls = 1;
-    } else {
-      for (int a = 0; a < 3; ++a) pred[a] = last[a];
-      cls = 0;
-    }
+    int64_t d[3], n[3];
+    const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
     int64_t spread[3];
     for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
