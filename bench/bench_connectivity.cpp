@@ -1,8 +1,13 @@
 // Connectivity alone (issue 3's figures). Usage:
-//   tsm_bench_connectivity [--runs N] MESH...
+//   tsm_bench_connectivity [--runs N] [--fresh-pages] MESH...
 //     linearity: encode_connectivity and decode_connectivity on each mesh,
 //     medians of several runs, triangles per second, and each mesh's rate
 //     relative to the fastest (default: the four dragon resolutions).
+//     The heap keeps freed memory between runs (glibc: arrays up to 32 MB
+//     from the heap, never trimmed), so every mesh is timed on memory the
+//     process already has; by default glibc maps arrays above its threshold
+//     afresh and unmaps them, so only the large meshes pay the kernel's page
+//     faults again on every run (--fresh-pages: that default).
 //   tsm_bench_connectivity --sizes [-q BITS] MESH...
 //     size: the connectivity bytes of a tsm file (`tsm info`'s figure) at the
 //     default level and at -l 9 beside Draco's connectivity alone, measured
@@ -13,6 +18,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <string>
 #include <vector>
 
@@ -76,7 +84,7 @@ int size_table(const std::vector<std::string>& files, int q) {
 
 int main(int argc, char** argv) {
   int runs = 5, q = 11;
-  bool sizes = false;
+  bool sizes = false, fresh_pages = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -90,10 +98,18 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--sizes") {
       sizes = true;
+    } else if (a == "--fresh-pages") {
+      fresh_pages = true;
     } else {
       files.push_back(a);
     }
   }
+#ifdef __GLIBC__
+  if (!fresh_pages) {
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  }
+#endif
   if (sizes) {
     if (files.empty())
       for (const char* n : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply",

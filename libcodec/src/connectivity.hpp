@@ -166,7 +166,9 @@ struct VertexForest {
 // geometric_ref: a root's reference edge goes to its neighbour with the
 // smallest position (CutHints::root_rule > 0; a tie sets *tie), else to
 // its neighbour of smallest id.
-VertexForest build_vertex_tree(const CutMesh& m, const std::vector<uint32_t>* qpos = nullptr, bool midpoint = false,
+// m is renumbered on the way (vertices in ring order, triangles after
+// them): the later stages walk it in memory order.
+VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos = nullptr, bool midpoint = false,
                                bool geometric_ref = false, bool* tie = nullptr);
 
 // Stage 3: bounding loop of one component (encoder side: with half-edges).
