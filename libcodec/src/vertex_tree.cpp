@@ -60,22 +60,30 @@ void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& rank, std::vector<uint
   permute(ref_he);
   permute(from_he);
   for (uint32_t& r : m.component_root) r = nid[r];
-  // Triangles: counting sort by the smallest new corner id.
-  std::vector<uint32_t> start(size_t{nv} + 1, 0), nt_of(nt);
-  auto key = [&](uint32_t t) { return std::min({nid[m.tri[3 * t]], nid[m.tri[3 * t + 1]], nid[m.tri[3 * t + 2]]}); };
-  for (uint32_t t = 0; t < nt; ++t) ++start[key(t) + 1];
+  // Triangles: counting sort by the smallest new corner id, then each new
+  // triangle gathered from its old place.
+  std::vector<uint32_t> start(size_t{nv} + 1, 0), nt_of(nt), old_of(nt);
+  for (uint32_t t = 0; t < nt; ++t) {
+    nt_of[t] = std::min({nid[m.tri[3 * t]], nid[m.tri[3 * t + 1]], nid[m.tri[3 * t + 2]]});
+    ++start[nt_of[t] + 1];
+  }
   for (uint32_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  for (uint32_t t = 0; t < nt; ++t) nt_of[t] = start[key(t)]++;
+  for (uint32_t t = 0; t < nt; ++t) {
+    nt_of[t] = start[nt_of[t]]++;
+    old_of[nt_of[t]] = t;
+  }
   auto nh = [&](uint32_t h) { return 3 * nt_of[h / 3] + h % 3; };
   std::vector<uint32_t> tri(m.tri.size()), twin(m.twin.size()), tri_source(nt);
   std::vector<uint8_t> diagonal(m.diagonal.size());
-  for (uint32_t h = 0; h < 3 * nt; ++h) {
-    const uint32_t g = nh(h);
-    tri[g] = nid[m.tri[h]];
-    twin[g] = nh(m.twin[h]);
-    diagonal[g] = m.diagonal[h];
+  for (uint32_t t = 0; t < nt; ++t) {
+    const uint32_t o = old_of[t];
+    for (uint32_t k = 0; k < 3; ++k) {
+      tri[3 * t + k] = nid[m.tri[3 * o + k]];
+      twin[3 * t + k] = nh(m.twin[3 * o + k]);
+      diagonal[3 * t + k] = m.diagonal[3 * o + k];
+    }
+    tri_source[t] = m.tri_source[o];
   }
-  for (uint32_t t = 0; t < nt; ++t) tri_source[nt_of[t]] = m.tri_source[t];
   m.tri.swap(tri);
   m.twin.swap(twin);
   m.diagonal.swap(diagonal);
@@ -202,12 +210,10 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     uint32_t rb;    // rank of the second endpoint
     uint32_t h;     // the edge (between parallel edges: parallel_less)
   };
-  std::vector<Edge> edges;
-  edges.reserve(nh / 2);
-  for (uint32_t h = 0; h < nh; ++h) {
-    uint32_t g = m.twin[h];
-    if (g < h) continue;
-    uint32_t a = m.tri[h], b = m.tri[g];
+  // The edge of half-edge h and its twin, keyed.
+  auto make_edge = [&](uint32_t h) -> Edge {
+    const uint32_t g = m.twin[h];
+    const uint32_t a = m.tri[h], b = m.tri[g];
     uint64_t cls, ring;
     uint32_t ra = std::min(rank[a], rank[b]), rb = std::max(rank[a], rank[b]);
     if (f.root_ref_he[a] == h || f.root_ref_he[b] == g) {
@@ -242,40 +248,68 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
         d += e * e;
       }
     }
-    edges.push_back({(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, d, rb, h});
-  }
+    return {(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, d, rb, std::min(h, g)};
+  };
   auto by_key = [&](const Edge& x, const Edge& y) {
     if ((x.key >> 60) != (y.key >> 60)) return x.key < y.key;
     if (x.dist != y.dist) return x.dist < y.dist;
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : parallel_less(x.h, y.h);
   };
-  // The layered tree sorts in linear time to the same order as by_key (dist
-  // is 0 there): the edges are in half-edge order; stably by the first
-  // rank, each vertex's few edges by (second rank, half-edge), then stably
-  // by class and ring. Ranks are below nv except at vertices no ring
-  // reaches, which a closed cut mesh does not have (then by_key).
+  // The layered tree lists its edges in linear time in an order the
+  // Kruskal phases below take as by_key's (dist is 0 there): walking the
+  // vertices by rank (their ids now), each edge at its lower-ranked end,
+  // each vertex's few edges sorted by (second rank, place in the walk); the
+  // reference edges (rank 0) first, then the same-ring edges, then the rest
+  // (phase 2 sorts those by class and ring). Within a component the rings
+  // follow the ranks, so this is by_key's order there; across components
+  // it is not, but no union joins two components. Ranks are below nv
+  // except at vertices no ring reaches, which a closed cut mesh does not
+  // have (then by_key over the edges in half-edge order).
   auto ring_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 32) & ((1u << 26) - 1)); };
   auto ra_of = [](const Edge& e) { return static_cast<uint32_t>(e.key); };
+  auto by_rb = [&](const Edge& x, const Edge& y) { return x.rb != y.rb ? x.rb < y.rb : parallel_less(x.h, y.h); };
+  auto sort_from = [&](std::vector<Edge>& v, size_t from) {
+    if (v.size() - from > 1) std::sort(v.begin() + static_cast<std::ptrdiff_t>(from), v.end(), by_rb);
+  };
+  std::vector<Edge> edges;
   bool linear = !midpoint;
-  uint32_t max_ring = 0;
-  for (const Edge& e : edges) {
-    if (ra_of(e) >= nv || e.rb >= nv) linear = false;
-    max_ring = std::max(max_ring, ring_of(e));
-  }
-  const size_t rings = size_t{max_ring} + 1;
-  std::vector<Edge> tmp;
   if (linear) {
-    counting_sort(edges, 0, nv, ra_of, tmp);
-    auto by_rb = [&](const Edge& x, const Edge& y) { return x.rb != y.rb ? x.rb < y.rb : parallel_less(x.h, y.h); };
-    for (size_t a = 0, b; a < edges.size(); a = b) {
-      for (b = a + 1; b < edges.size() && ra_of(edges[b]) == ra_of(edges[a]);) ++b;
-      const auto first = edges.begin() + static_cast<std::ptrdiff_t>(a);
-      if (b - a > 1) std::sort(first, first + static_cast<std::ptrdiff_t>(b - a), by_rb);
+    std::vector<Edge> refs, same_ring, rest;
+    rest.reserve(nh / 2);
+    for (uint32_t v = 0; v < nv && rank[v] != kNone; ++v) {
+      const uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v];
+      if (start == kNone) continue;
+      const size_t s0 = same_ring.size(), r0 = rest.size();
+      uint32_t g = start, guard = 0;
+      do {
+        const uint32_t w = m.tri[he_next(g)];
+        if (rank[w] > v) {  // kNone (a virtual vertex) too
+          const Edge e = make_edge(g < m.twin[g] ? g : m.twin[g]);
+          const uint64_t cls = e.key >> 60;
+          (cls == 0 ? refs : cls == 1 ? same_ring : rest).push_back(e);
+        }
+        g = he_next(m.twin[g]);
+      } while (g != start && ++guard < nh);
+      sort_from(same_ring, s0);
+      sort_from(rest, r0);
     }
-    counting_sort(edges, 0, 5 * rings, [&](const Edge& e) { return (e.key >> 60) * rings + ring_of(e); }, tmp);
-  } else {
+    sort_from(refs, 0);
+    edges.reserve(nh / 2);
+    for (const auto* part : {&refs, &same_ring, &rest}) edges.insert(edges.end(), part->begin(), part->end());
+    linear = edges.size() == nh / 2;
+    for (const Edge& e : edges)
+      if (ra_of(e) >= nv || e.rb >= nv) linear = false;
+  }
+  if (!linear) {
+    edges.clear();
+    for (uint32_t h = 0; h < nh; ++h)
+      if (h < m.twin[h]) edges.push_back(make_edge(h));
     std::sort(edges.begin(), edges.end(), by_key);
   }
+  uint32_t max_ring = 0;
+  for (const Edge& e : edges) max_ring = std::max(max_ring, ring_of(e));
+  const size_t rings = size_t{max_ring} + 1;
+  std::vector<Edge> tmp;
   UnionFind uf(nv);
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
