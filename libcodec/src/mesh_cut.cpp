@@ -169,29 +169,34 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
 
   // 2. Split vertices into one per fan: corners (= outgoing half-edges) that
   // are rotations of each other around their vertex form one fan.
-  UnionFind fans(nh);
-  for (uint32_t h = 0; h < nh; ++h)
-    if (m.twin[h] != kNone) fans.unite(h, he_next(m.twin[h]));
+  // Each fan is walked once, from its first corner in half-edge order
+  // (which so decides which fan keeps the vertex id), both ways round.
   m.source.resize(input_vertex_count);
   std::iota(m.source.begin(), m.source.end(), 0u);
   m.kind.assign(input_vertex_count, VertexKind::real);
-  std::vector<uint8_t> claimed(input_vertex_count, 0);
-  std::vector<uint32_t> fan_vertex(nh, kNone);
+  std::vector<uint8_t> claimed(input_vertex_count, 0), in_fan(nh, 0);
   for (uint32_t h = 0; h < nh; ++h) {
-    uint32_t r = fans.find(h);
-    if (fan_vertex[r] == kNone) {
-      uint32_t v = in.tri[h];
-      if (!claimed[v]) {
-        claimed[v] = 1;
-        fan_vertex[r] = v;
-      } else {
-        fan_vertex[r] = static_cast<uint32_t>(m.source.size());
-        m.source.push_back(v);
-        m.kind.push_back(VertexKind::duplicate);
-        ++m.duplicates;
-      }
+    if (in_fan[h]) continue;
+    const uint32_t v = in.tri[h];
+    uint32_t id = v;
+    if (!claimed[v]) {
+      claimed[v] = 1;
+    } else {
+      id = static_cast<uint32_t>(m.source.size());
+      m.source.push_back(v);
+      m.kind.push_back(VertexKind::duplicate);
+      ++m.duplicates;
     }
-    m.tri[h] = fan_vertex[r];
+    uint32_t g = h;
+    do {  // clockwise: g -> next(twin(g))
+      in_fan[g] = 1;
+      m.tri[g] = id;
+    } while (m.twin[g] != kNone && !in_fan[g = he_next(m.twin[g])]);
+    for (g = h; m.twin[he_prev(g)] != kNone && !in_fan[m.twin[he_prev(g)]];) {  // and back
+      g = m.twin[he_prev(g)];
+      in_fan[g] = 1;
+      m.tri[g] = id;
+    }
   }
 
   // 3. Close every hole with a virtual vertex. The boundary half-edge after
@@ -238,9 +243,10 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
   // triangle, by `isolated_key` when given (else by id).
   UnionFind comp(m.vertex_count);
   std::vector<uint8_t> on_triangle(m.vertex_count, 0);
-  for (uint32_t h = 0; h < m.tri.size(); ++h) {
-    comp.unite(m.tri[h], m.tri[he_next(h)]);
-    on_triangle[m.tri[h]] = 1;
+  for (uint32_t h = 0; h < m.tri.size(); h += 3) {  // two edges of a triangle join its three corners
+    comp.unite(m.tri[h], m.tri[h + 1]);
+    comp.unite(m.tri[h + 1], m.tri[h + 2]);
+    on_triangle[m.tri[h]] = on_triangle[m.tri[h + 1]] = on_triangle[m.tri[h + 2]] = 1;
   }
   m.vertex_component.assign(m.vertex_count, kNone);
   std::vector<uint32_t> isolated;
