@@ -28,7 +28,10 @@ void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std
   for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
   tmp.resize(v.size() - begin);
   for (size_t i = begin; i < v.size(); ++i) tmp[start[key(v[i])]++] = v[i];
-  std::copy(tmp.begin(), tmp.end(), v.begin() + static_cast<std::ptrdiff_t>(begin));
+  if (begin == 0)
+    v.swap(tmp);
+  else
+    std::copy(tmp.begin(), tmp.end(), v.begin() + static_cast<std::ptrdiff_t>(begin));
 }
 
 // Renumbers the cut mesh for the stages after the rings: vertices by ring
@@ -206,10 +209,12 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // Edges (each once), keyed by class and ring, Kruskal.
   struct Edge {
     uint64_t key;   // class (4 bits) | path-end preference (2) | ring (26 bits) | rank of the first endpoint (32)
-    double dist;    // midpoint variant: squared distance of the edge's midpoint from the root
     uint32_t rb;    // rank of the second endpoint
     uint32_t h;     // the edge (between parallel edges: parallel_less)
   };
+  // Midpoint variant: the squared distance of each edge's midpoint from the
+  // root, by the edge's smaller half-edge.
+  std::vector<double> mid_dist(midpoint ? nh : 0, 0.0);
   // The edge of half-edge h and its twin, keyed.
   auto make_edge = [&](uint32_t h) -> Edge {
     const uint32_t g = m.twin[h];
@@ -235,7 +240,6 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
       cls = 2;
       ring = std::min(dist[a], dist[b]);
     }
-    double d = 0;
     if (midpoint && (cls == 1 || cls == 2)) {
       cls = 1;
       ring = 0;
@@ -245,14 +249,14 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
       const uint32_t* pr = &(*qpos)[3 * static_cast<size_t>(m.source[root])];
       for (int k = 0; k < 3; ++k) {
         double e = static_cast<double>(pa[k]) + pb[k] - 2.0 * pr[k];
-        d += e * e;
+        mid_dist[std::min(h, g)] += e * e;
       }
     }
-    return {(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, d, rb, std::min(h, g)};
+    return {(cls << 60) | (std::min<uint64_t>(ring, (1u << 26) - 1) << 32) | ra, rb, std::min(h, g)};
   };
   auto by_key = [&](const Edge& x, const Edge& y) {
     if ((x.key >> 60) != (y.key >> 60)) return x.key < y.key;
-    if (x.dist != y.dist) return x.dist < y.dist;
+    if (midpoint && mid_dist[x.h] != mid_dist[y.h]) return mid_dist[x.h] < mid_dist[y.h];
     return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : parallel_less(x.h, y.h);
   };
   // The layered tree lists its edges in linear time in an order the
@@ -271,10 +275,12 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   auto sort_from = [&](std::vector<Edge>& v, size_t from) {
     if (v.size() - from > 1) std::sort(v.begin() + static_cast<std::ptrdiff_t>(from), v.end(), by_rb);
   };
-  std::vector<Edge> edges;
+  // low: the reference and same-ring edges (phase 1); edges: the rest.
+  std::vector<Edge> low, edges;
   bool linear = !midpoint;
   if (linear) {
-    std::vector<Edge> refs, same_ring, rest;
+    std::vector<Edge> refs, same_ring;
+    std::vector<Edge>& rest = edges;
     rest.reserve(nh / 2);
     for (uint32_t v = 0; v < nv && rank[v] != kNone; ++v) {
       const uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v];
@@ -294,17 +300,23 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
       sort_from(rest, r0);
     }
     sort_from(refs, 0);
-    edges.reserve(nh / 2);
-    for (const auto* part : {&refs, &same_ring, &rest}) edges.insert(edges.end(), part->begin(), part->end());
-    linear = edges.size() == nh / 2;
-    for (const Edge& e : edges)
-      if (ra_of(e) >= nv || e.rb >= nv) linear = false;
+    low.swap(refs);
+    low.insert(low.end(), same_ring.begin(), same_ring.end());
+    linear = low.size() + edges.size() == nh / 2;
+    for (const auto* part : {&low, &edges})
+      for (const Edge& e : *part)
+        if (ra_of(e) >= nv || e.rb >= nv) linear = false;
   }
   if (!linear) {
+    low.clear();
     edges.clear();
     for (uint32_t h = 0; h < nh; ++h)
       if (h < m.twin[h]) edges.push_back(make_edge(h));
     std::sort(edges.begin(), edges.end(), by_key);
+    size_t n = 0;
+    while (n < edges.size() && (edges[n].key >> 60) <= 1) ++n;
+    low.assign(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(n));
+    edges.erase(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(n));
   }
   uint32_t max_ring = 0;
   for (const Edge& e : edges) max_ring = std::max(max_ring, ring_of(e));
@@ -315,9 +327,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // paths (a vertex takes at most two same-ring tree edges).
   std::vector<uint8_t> ring_deg(nv, 0);
   std::vector<uint32_t> skipped;  // same-ring edges left out for the path rule
-  size_t i = 0;
-  for (; i < edges.size() && (edges[i].key >> 60) <= 1; ++i) {
-    const Edge& e = edges[i];
+  for (const Edge& e : low) {
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     const bool same_ring = (e.key >> 60) == 1 && !midpoint;
     if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) {
@@ -334,8 +344,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   }
   // Phase 2: the rest; ring-to-ring edges that join path ends first (a
   // path attached at its end continues a run instead of branching).
-  for (size_t j = i; j < edges.size(); ++j) {
-    Edge& e = edges[j];
+  for (Edge& e : edges) {
     if ((e.key >> 60) != 2) continue;
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     uint32_t inner = dist[a] < dist[b] ? a : b, outer = inner == a ? b : a;
@@ -347,10 +356,10 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // (class, ring, preference) is enough (class >= 2 here).
   auto ends_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 58) & 3); };
   if (linear) {
-    counting_sort(edges, i, 3 * rings * 4,
+    counting_sort(edges, 0, 3 * rings * 4,
                   [&](const Edge& e) { return (((e.key >> 60) - 2) * rings + ring_of(e)) * 4 + ends_of(e); }, tmp);
   } else {
-    std::sort(edges.begin() + static_cast<std::ptrdiff_t>(i), edges.end(), [&](const Edge& x, const Edge& y) {
+    std::sort(edges.begin(), edges.end(), [&](const Edge& x, const Edge& y) {
       uint64_t cx = x.key >> 60, cy = y.key >> 60;
       if (cx != cy) return cx < cy;
       if (ring_of(x) != ring_of(y)) return ring_of(x) < ring_of(y);
@@ -371,8 +380,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     for (uint32_t h : skipped)
       if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
   };
-  for (; i < edges.size(); ++i) {
-    const Edge& e = edges[i];
+  for (const Edge& e : edges) {
     if (!retried && (e.key >> 60) >= 3) retry_skipped();
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
