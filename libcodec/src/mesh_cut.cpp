@@ -130,8 +130,6 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
   const std::vector<uint32_t>* isolated_key = hints.anchor;
   CutMesh m;
   const uint32_t nh = static_cast<uint32_t>(in.tri.size());
-  m.tri = in.tri;
-  m.diagonal = in.tri_diagonal;
   m.twin.assign(nh, kNone);
 
   // 1. Pair half-edges: the uses of an edge in one direction with those in
@@ -166,6 +164,16 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
     if (j - i != 2 * pairs || j - i > 2) ++m.cut_edges;
     i = j;
   }
+
+  // Each half-edge left unpaired borders a hole, whose closing fan (step 3)
+  // adds a triangle for it: room for those before the arrays are filled.
+  const size_t open = static_cast<size_t>(std::count(m.twin.begin(), m.twin.end(), kNone));
+  m.tri.reserve(nh + 3 * open);
+  m.tri.assign(in.tri.begin(), in.tri.end());
+  m.diagonal.reserve(nh + 3 * open);
+  m.diagonal.assign(in.tri_diagonal.begin(), in.tri_diagonal.end());
+  if (open) m.twin.reserve(nh + 3 * open);
+  m.tri_source.reserve(nh / 3 + open);
 
   // 2. Split vertices into one per fan: corners (= outgoing half-edges) that
   // are rotations of each other around their vertex form one fan.

@@ -41,28 +41,35 @@ void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std
 // (the full dragon's connectivity encodes about 1.3x faster). No choice
 // changes: every later one depends on ranks, the walk and the root's
 // reference edge, and a half-edge id only breaks ties between parallel
-// edges. Per-vertex arrays of the caller (rank, dist, ref_he) move along.
-void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& rank, std::vector<uint32_t>& dist,
-                       std::vector<uint32_t>& ref_he, std::vector<uint32_t>& from_he) {
+// edges. by_rank lists the vertices the rings reach, in rank order; the
+// caller's per-vertex arrays (rank, dist, ref_he, from_he) move along.
+void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<uint32_t>& rank,
+                       std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he, std::vector<uint32_t>& from_he) {
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
-  std::vector<uint32_t> nid(nv);
-  uint32_t next = 0;
+  std::vector<uint32_t>& old_id = by_rank;  // new id -> old id
+  const uint32_t reached = static_cast<uint32_t>(old_id.size());
   for (uint32_t v = 0; v < nv; ++v)
-    if (rank[v] != kNone) next = std::max(next, rank[v] + 1);
-  for (uint32_t v = 0; v < nv; ++v) nid[v] = rank[v] != kNone ? rank[v] : next++;
-  auto permute = [&](auto& a) {
+    if (rank[v] == kNone) old_id.push_back(v);
+  std::vector<uint32_t> nid(nv);
+  for (uint32_t v = 0; v < nv; ++v) nid[old_id[v]] = v;
+  auto permute = [&](auto& a) {  // gathered in the new order
     std::remove_reference_t<decltype(a)> b(a.size());
-    for (uint32_t v = 0; v < nv; ++v) b[nid[v]] = a[v];
+    for (uint32_t v = 0; v < nv; ++v) b[v] = a[old_id[v]];
     a.swap(b);
   };
   permute(m.kind);
   permute(m.source);
   permute(m.vertex_component);
-  permute(rank);
   permute(dist);
-  permute(ref_he);
   permute(from_he);
-  for (uint32_t& r : m.component_root) r = nid[r];
+  for (uint32_t v = 0; v < nv; ++v) rank[v] = v < reached ? v : kNone;
+  // The reference half-edges are at the roots only.
+  std::vector<uint32_t> ref(nv, kNone);
+  for (uint32_t& r : m.component_root) {
+    ref[nid[r]] = ref_he[r];
+    r = nid[r];
+  }
+  ref_he.swap(ref);
   // Triangles: counting sort by the smallest new corner id, then each new
   // triangle gathered from its old place.
   std::vector<uint32_t> start(size_t{nv} + 1, 0), nt_of(nt), old_of(nt);
@@ -152,9 +159,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     f.root_ref_he[root] = out_he[root];
     dist[root] = 0;
     rank[root] = next_rank++;
-    queue.clear();
-    queue.push_back(root);
-    for (size_t qi = 0; qi < queue.size(); ++qi) {
+    queue.push_back(root);  // all components in one list: the vertices by rank
+    for (size_t qi = queue.size() - 1; qi < queue.size(); ++qi) {
       uint32_t v = queue[qi];
       uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : out_he[v];
       if (start == kNone) continue;  // isolated vertex
@@ -172,7 +178,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     }
   }
 
-  renumber_by_rings(m, rank, dist, f.root_ref_he, bfs_from);
+  renumber_by_rings(m, queue, rank, dist, f.root_ref_he, bfs_from);
   out_he.clear();
   // Between parallel edges (same two vertices, as where the faces of an
   // edge with more than two faces are paired): the one met last walking
