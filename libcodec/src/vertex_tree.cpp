@@ -46,8 +46,9 @@ void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std
 // reference edge, and a half-edge id only breaks ties between parallel
 // edges. by_rank lists the vertices the rings reach, in rank order; the
 // caller's per-vertex arrays (rank, dist, ref_he, from_he) move along.
-void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<uint32_t>& rank,
-                       std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he, std::vector<uint32_t>& from_he) {
+void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<uint32_t>& nt_of,
+                       std::vector<uint32_t>& old_of, std::vector<uint32_t>& rank, std::vector<uint32_t>& dist,
+                       std::vector<uint32_t>& ref_he, std::vector<uint32_t>& from_he) {
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
   std::vector<uint32_t>& old_id = by_rank;  // new id -> old id
   const uint32_t reached = static_cast<uint32_t>(old_id.size());
@@ -73,18 +74,13 @@ void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<u
     r = nid[r];
   }
   ref_he.swap(ref);
-  // Triangles: counting sort by the smallest new corner id, then each new
-  // triangle gathered from its old place.
-  std::vector<uint32_t> start(size_t{nv} + 1, 0), nt_of(nt), old_of(nt);
-  for (uint32_t t = 0; t < nt; ++t) {
-    nt_of[t] = std::min({nid[m.tri[3 * t]], nid[m.tri[3 * t + 1]], nid[m.tri[3 * t + 2]]});
-    ++start[nt_of[t] + 1];
-  }
-  for (uint32_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  for (uint32_t t = 0; t < nt; ++t) {
-    nt_of[t] = start[nt_of[t]]++;
-    old_of[nt_of[t]] = t;
-  }
+  // Triangles in the order the ring walk first met them (those it did not
+  // meet after them), each gathered from its old place.
+  for (uint32_t t = 0; t < nt; ++t)
+    if (nt_of[t] == kNone) {
+      nt_of[t] = static_cast<uint32_t>(old_of.size());
+      old_of.push_back(t);
+    }
   auto nh = [&](uint32_t h) { return 3 * nt_of[h / 3] + h % 3; };
   std::vector<uint32_t> tri(m.tri.size()), twin(m.twin.size()), tri_source(nt);
   std::vector<uint8_t> diagonal(m.diagonal.size());
@@ -154,8 +150,9 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // neighbours of a vertex are taken clockwise from the edge to its BFS parent.
   const uint32_t kFar = 0xFFFFFFFEu;
   std::vector<uint32_t> dist(nv, kFar), rank(nv, kNone), bfs_from(nv, kNone);
-  std::vector<uint32_t> queue;
+  std::vector<uint32_t> queue, tri_order(nh / 3, kNone), tri_by_order;
   queue.reserve(nv);
+  tri_by_order.reserve(nh / 3);
   uint32_t next_rank = 0;
   for (uint32_t c = 0; c < m.component_count(); ++c) {
     uint32_t root = m.component_root[c];
@@ -169,6 +166,10 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
       if (start == kNone) continue;  // isolated vertex
       uint32_t h = start;
       do {
+        if (tri_order[h / 3] == kNone) {  // triangles in the order the walk first meets them
+          tri_order[h / 3] = static_cast<uint32_t>(tri_by_order.size());
+          tri_by_order.push_back(h / 3);
+        }
         uint32_t w = m.tri[he_next(h)];
         if (dist[w] == kFar && !is_virtual(w)) {
           dist[w] = dist[v] + 1;
@@ -181,7 +182,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     }
   }
 
-  renumber_by_rings(m, queue, rank, dist, f.root_ref_he, bfs_from);
+  renumber_by_rings(m, queue, tri_order, tri_by_order, rank, dist, f.root_ref_he, bfs_from);
   out_he.clear();
   // Between parallel edges (same two vertices, as where the faces of an
   // edge with more than two faces are paired): the one met last walking
