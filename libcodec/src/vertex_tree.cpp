@@ -52,10 +52,13 @@ void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<u
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
   std::vector<uint32_t>& old_id = by_rank;  // new id -> old id
   const uint32_t reached = static_cast<uint32_t>(old_id.size());
+  std::vector<uint32_t> nid(nv, kNone);
+  for (uint32_t v = 0; v < reached; ++v) nid[old_id[v]] = v;
   for (uint32_t v = 0; v < nv; ++v)
-    if (rank[v] == kNone) old_id.push_back(v);
-  std::vector<uint32_t> nid(nv);
-  for (uint32_t v = 0; v < nv; ++v) nid[old_id[v]] = v;
+    if (nid[v] == kNone) {
+      nid[v] = static_cast<uint32_t>(old_id.size());
+      old_id.push_back(v);
+    }
   auto permute = [&](auto& a) {  // gathered in the new order
     std::remove_reference_t<decltype(a)> b(a.size());
     for (uint32_t v = 0; v < nv; ++v) b[v] = a[old_id[v]];
@@ -66,6 +69,7 @@ void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<u
   permute(m.vertex_component);
   permute(dist);
   permute(from_he);
+  rank.resize(nv);
   for (uint32_t v = 0; v < nv; ++v) rank[v] = v < reached ? v : kNone;
   // The reference half-edges are at the roots only.
   std::vector<uint32_t> ref(nv, kNone);
@@ -149,16 +153,17 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // Breadth-first rings and order from each root over real vertices; the
   // neighbours of a vertex are taken clockwise from the edge to its BFS parent.
   const uint32_t kFar = 0xFFFFFFFEu;
-  std::vector<uint32_t> dist(nv, kFar), rank(nv, kNone), bfs_from(nv, kNone);
+  // A virtual vertex is never reached (its dist is not kFar).
+  std::vector<uint32_t> dist(nv, kFar), rank, bfs_from(nv, kNone);
+  for (uint32_t v = 0; v < nv; ++v)
+    if (is_virtual(v)) dist[v] = kNone;
   std::vector<uint32_t> queue, tri_order(nh / 3, kNone), tri_by_order;
   queue.reserve(nv);
   tri_by_order.reserve(nh / 3);
-  uint32_t next_rank = 0;
   for (uint32_t c = 0; c < m.component_count(); ++c) {
     uint32_t root = m.component_root[c];
     f.root_ref_he[root] = out_he[root];
     dist[root] = 0;
-    rank[root] = next_rank++;
     queue.push_back(root);  // all components in one list: the vertices by rank
     for (size_t qi = queue.size() - 1; qi < queue.size(); ++qi) {
       uint32_t v = queue[qi];
@@ -171,9 +176,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
           tri_by_order.push_back(h / 3);
         }
         uint32_t w = m.tri[he_next(h)];
-        if (dist[w] == kFar && !is_virtual(w)) {
+        if (dist[w] == kFar) {
           dist[w] = dist[v] + 1;
-          rank[w] = next_rank++;
           bfs_from[w] = m.twin[h];  // w -> v
           queue.push_back(w);
         }
