@@ -331,10 +331,11 @@ TEST(Connectivity, MidpointKruskalTreeRoundTrips) {
   }
 }
 
-// The vertex tree renumbers the cut mesh (vertices by ring, triangles after
-// them) so that the later stages read memory in order; no choice may follow
-// the input's face order: a manifold mesh with its faces shuffled codes to
-// the same bytes (the walk, the ranks and the root decide everything).
+// The vertex tree renumbers the cut mesh (vertices by ring, triangles in the
+// order its ring walk meets them) so that the later stages read memory in
+// order; no choice may follow the input's face order: a manifold mesh with
+// its faces shuffled codes to the same bytes (the walk, the ranks and the
+// root decide everything).
 // (A non-manifold edge's faces are paired in input order, so those meshes
 // are not checked.)
 TEST(Connectivity, ManifoldBytesDoNotDependOnTheFaceOrder) {

@@ -21,19 +21,16 @@ namespace tsm {
 
 namespace {
 
-// Stable counting sort of v[begin, end) by key(x) in [0, buckets): linear,
-// where a comparison sort of a million edges is most of the tree's time.
+// Stable counting sort of v by key(x) in [0, buckets): linear, where a
+// comparison sort of a million edges is most of the tree's time.
 template <class T, class Key>
-void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std::vector<T>& tmp) {
+void counting_sort(std::vector<T>& v, size_t buckets, Key key) {
   std::vector<uint32_t> start(buckets + 1, 0);
-  for (size_t i = begin; i < v.size(); ++i) ++start[key(v[i]) + 1];
+  for (const T& x : v) ++start[key(x) + 1];
   for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-  tmp.resize(v.size() - begin);
-  for (size_t i = begin; i < v.size(); ++i) tmp[start[key(v[i])]++] = v[i];
-  if (begin == 0)
-    v.swap(tmp);
-  else
-    std::copy(tmp.begin(), tmp.end(), v.begin() + static_cast<std::ptrdiff_t>(begin));
+  std::vector<T> sorted(v.size());
+  for (const T& x : v) sorted[start[key(x)]++] = x;
+  v.swap(sorted);
 }
 
 // Renumbers the cut mesh for the stages after the rings: vertices by ring
@@ -45,12 +42,12 @@ void counting_sort(std::vector<T>& v, size_t begin, size_t buckets, Key key, std
 // faster by this alone, 1.6x with the edge listing it allows). No choice
 // changes: every later one depends on ranks, the walk and the root's
 // reference edge, and a half-edge id only breaks ties between parallel
-// edges. by_rank lists the vertices the rings reach, in rank order; rank
-// becomes the identity there; the caller's per-vertex arrays (dist, ref_he,
+// edges. by_rank lists the vertices the rings reach, in rank order (their
+// new ids are their ranks); the caller's per-vertex arrays (dist, ref_he,
 // from_he) move along.
 void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<uint32_t>& nt_of,
-                       std::vector<uint32_t>& old_of, std::vector<uint32_t>& rank, std::vector<uint32_t>& dist,
-                       std::vector<uint32_t>& ref_he, std::vector<uint32_t>& from_he) {
+                       std::vector<uint32_t>& old_of, std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he,
+                       std::vector<uint32_t>& from_he) {
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
   std::vector<uint32_t>& old_id = by_rank;  // new id -> old id
   const uint32_t reached = static_cast<uint32_t>(old_id.size());
@@ -71,8 +68,6 @@ void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<u
   permute(m.vertex_component);
   permute(dist);
   permute(from_he);
-  rank.resize(nv);
-  for (uint32_t v = 0; v < nv; ++v) rank[v] = v < reached ? v : kNone;
   // The reference half-edges are at the roots only.
   std::vector<uint32_t> ref(nv, kNone);
   for (uint32_t& r : m.component_root) {
@@ -156,7 +151,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // neighbours of a vertex are taken clockwise from the edge to its BFS parent.
   const uint32_t kFar = 0xFFFFFFFEu;
   // A virtual vertex is never reached (its dist is not kFar).
-  std::vector<uint32_t> dist(nv, kFar), rank, bfs_from(nv, kNone);
+  std::vector<uint32_t> dist(nv, kFar), bfs_from(nv, kNone);
   for (uint32_t v = 0; v < nv; ++v)
     if (is_virtual(v)) dist[v] = kNone;
   std::vector<uint32_t> queue, tri_order(nh / 3, kNone), tri_by_order;
@@ -188,8 +183,12 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     }
   }
 
-  renumber_by_rings(m, queue, tri_order, tri_by_order, rank, dist, f.root_ref_he, bfs_from);
-  out_he.clear();
+  // After the renumbering a vertex's rank is its id (kNone where no ring
+  // reached it), and its walk starts where its ring walk started.
+  const uint32_t reached = static_cast<uint32_t>(queue.size());
+  renumber_by_rings(m, queue, tri_order, tri_by_order, dist, f.root_ref_he, bfs_from);
+  auto rank = [reached](uint32_t v) { return v < reached ? v : kNone; };
+  auto walk_start = [&](uint32_t v) { return bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v]; };
   // Between parallel edges (same two vertices, as where the faces of an
   // edge with more than two faces are paired): the one met last walking
   // around the lower-ranked vertex from where its ring walk started, which
@@ -200,7 +199,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   std::vector<uint32_t> turn_at;
   std::vector<uint8_t> walked;
   auto turn = [&](uint32_t h) {
-    if (rank[m.tri[m.twin[h]]] < rank[m.tri[h]]) h = m.twin[h];
+    if (rank(m.tri[m.twin[h]]) < rank(m.tri[h])) h = m.twin[h];
     const uint32_t v = m.tri[h];
     if (walked.empty()) {
       turn_at.assign(nh, 0);
@@ -208,7 +207,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     }
     if (!walked[v]) {
       walked[v] = 1;
-      const uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v];
+      const uint32_t start = walk_start(v);
       if (start != kNone) {
         uint32_t g = start, k = 0;
         do turn_at[g] = k++;
@@ -236,7 +235,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     const uint32_t g = m.twin[h];
     const uint32_t a = m.tri[h], b = m.tri[g];
     uint64_t cls, ring;
-    uint32_t ra = std::min(rank[a], rank[b]), rb = std::max(rank[a], rank[b]);
+    uint32_t ra = std::min(rank(a), rank(b)), rb = std::max(rank(a), rank(b));
     if (f.root_ref_he[a] == h || f.root_ref_he[b] == g) {
       cls = 0;  // the root's reference edge comes first of all
       ring = 0;
@@ -247,7 +246,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     } else if (is_virtual(a) || is_virtual(b)) {
       cls = 3;
       ring = 0;
-      ra = rank[is_virtual(a) ? b : a];
+      ra = rank(is_virtual(a) ? b : a);
       rb = 0;
     } else if (dist[a] == dist[b]) {
       cls = 1;
@@ -298,14 +297,14 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     std::vector<Edge> refs, same_ring;
     std::vector<Edge>& rest = edges;
     rest.reserve(nh / 2);
-    for (uint32_t v = 0; v < nv && rank[v] != kNone; ++v) {
-      const uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v];
+    for (uint32_t v = 0; v < reached; ++v) {
+      const uint32_t start = walk_start(v);
       if (start == kNone) continue;
       const size_t s0 = same_ring.size(), r0 = rest.size();
       uint32_t g = start, guard = 0;
       do {
         const uint32_t w = m.tri[he_next(g)];
-        if (rank[w] > v) {  // kNone (a virtual vertex) too
+        if (rank(w) > v) {  // kNone (a virtual vertex) too
           const Edge e = make_edge(g < m.twin[g] ? g : m.twin[g]);
           const uint64_t cls = e.key >> 60;
           (cls == 0 ? refs : cls == 1 ? same_ring : rest).push_back(e);
@@ -337,7 +336,6 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   uint32_t max_ring = 0;
   for (const Edge& e : edges) max_ring = std::max(max_ring, ring_of(e));
   const size_t rings = size_t{max_ring} + 1;
-  std::vector<Edge> tmp;
   UnionFind uf(nv);
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
@@ -372,8 +370,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // (class, ring, preference) is enough (class >= 2 here).
   auto ends_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 58) & 3); };
   if (linear) {
-    counting_sort(edges, 0, 3 * rings * 4,
-                  [&](const Edge& e) { return (((e.key >> 60) - 2) * rings + ring_of(e)) * 4 + ends_of(e); }, tmp);
+    counting_sort(edges, 3 * rings * 4,
+                  [&](const Edge& e) { return (((e.key >> 60) - 2) * rings + ring_of(e)) * 4 + ends_of(e); });
   } else {
     std::sort(edges.begin(), edges.end(), [&](const Edge& x, const Edge& y) {
       uint64_t cx = x.key >> 60, cy = y.key >> 60;
