@@ -89,7 +89,7 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   out = ConnectivityEncoding();
   if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
     return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
-  const PreparedInput prep = prepare_input(mesh);
+  PreparedInput prep = prepare_input(mesh);
   CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), hints);
   const bool by_position = hints.root_rule > 0 && hints.qpos;
   out.root_tie = m.root_tie;

@@ -145,7 +145,8 @@ struct PositionExtreme {
   }
 };
 
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
+// Takes in.tri and in.tri_diagonal over (they are left empty).
+CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints = CutHints());
 
 // Stage 2: the vertex spanning forest, in pre-order.
 struct VertexForest {

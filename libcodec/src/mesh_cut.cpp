@@ -11,6 +11,7 @@
 //     fan (duplicates, stitched back by the decoder);
 //   - each hole is closed by a virtual vertex and a fan of virtual triangles.
 #include <algorithm>
+#include <memory>
 #include <numeric>
 
 #include "connectivity.hpp"
@@ -24,10 +25,11 @@ namespace {
 // (larger endpoint << 32 | half-edge), sorted, so the uses of one edge are
 // neighbours in half-edge order. Linear: a counting sort by the smaller
 // endpoint, then each vertex's few entries sorted; 8 bytes per half-edge
-// (the full dragon's 2.6 million half-edges are 21 MB to move, not 42).
+// (the full dragon's 2.6 million half-edges are 21 MB to move, not 42;
+// every entry is written by the scatter, none zeroed first).
 struct EdgeGroups {
   std::vector<uint32_t> start;
-  std::vector<uint64_t> e;
+  std::unique_ptr<uint64_t[]> e;
   // Calls f(first, last) for each edge's entries [first, last).
   template <class F>
   void each_edge(F f) const {
@@ -48,14 +50,14 @@ EdgeGroups sorted_edges(const std::vector<uint32_t>& tri) {
   g.start.assign(size_t{nv} + 1, 0);
   for (uint32_t h = 0; h < nh; ++h) ++g.start[std::min(tri[h], tri[he_next(h)]) + size_t{1}];
   for (uint32_t v = 0; v < nv; ++v) g.start[v + 1] += g.start[v];
-  g.e.resize(nh);
+  g.e.reset(new uint64_t[nh]);
   std::vector<uint32_t> fill(g.start.begin(), g.start.end() - 1);
   for (uint32_t h = 0; h < nh; ++h) {
     const uint32_t a = tri[h], b = tri[he_next(h)];
     g.e[fill[std::min(a, b)]++] = (uint64_t{std::max(a, b)} << 32) | h;
   }
   for (uint32_t v = 0; v < nv; ++v)
-    if (g.start[v + 1] - g.start[v] > 1) std::sort(g.e.begin() + g.start[v], g.e.begin() + g.start[v + 1]);
+    if (g.start[v + 1] - g.start[v] > 1) std::sort(g.e.get() + g.start[v], g.e.get() + g.start[v + 1]);
   return g;
 }
 
@@ -83,20 +85,35 @@ PreparedInput prepare_input(const Mesh& mesh) {
   auto emit = [&](const std::vector<uint32_t>& corners, uint32_t face, bool polygon) {
     size_t n = corners.size();
     for (size_t i = 1; i + 1 < n; ++i) {
-      out.tri.insert(out.tri.end(), {corners[0], corners[i], corners[i + 1]});
-      out.tri_diagonal.insert(out.tri_diagonal.end(),
-                              {static_cast<uint8_t>(i > 1), 0, static_cast<uint8_t>(i + 2 < n)});
+      for (size_t k : {size_t{0}, i, i + 1}) out.tri.push_back(corners[k]);
+      out.tri_diagonal.push_back(i > 1);
+      out.tri_diagonal.push_back(0);
+      out.tri_diagonal.push_back(i + 2 < n);
       poly_of_tri.push_back(polygon ? face : kNone);
     }
   };
-  std::vector<uint32_t> corners;
+  const size_t corners_in = mesh.corner_count(), faces_in = mesh.face_count();
+  if (corners_in > 2 * faces_in) {  // exact for triangles and polygons
+    const size_t tris = corners_in - 2 * faces_in;
+    // With room for the fans by which the cut closes a few holes (a
+    // triangle per boundary edge), so it need not move the arrays.
+    out.tri.reserve(3 * (tris + tris / 64 + 16));
+    out.tri_diagonal.reserve(3 * (tris + tris / 64 + 16));
+    poly_of_tri.reserve(tris);
+  }
+  std::vector<uint32_t> corners, sorted;
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     const uint32_t* c = mesh.face(f);
     uint32_t n = mesh.face_size(f);
     corners.assign(c, c + n);
-    std::vector<uint32_t> sorted = corners;
-    std::sort(sorted.begin(), sorted.end());
-    bool degenerate = n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+    bool degenerate;
+    if (n == 3) {
+      degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+    } else {
+      sorted.assign(c, c + n);
+      std::sort(sorted.begin(), sorted.end());
+      degenerate = n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+    }
     if (degenerate) {
       out.side_faces.push_back(f);
       continue;
@@ -135,10 +152,11 @@ PreparedInput prepare_input(const Mesh& mesh) {
   return kept;
 }
 
-CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints) {
+CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints& hints) {
   const std::vector<uint32_t>* isolated_key = hints.anchor;
   CutMesh m;
   const uint32_t nh = static_cast<uint32_t>(in.tri.size());
+  m.twin.reserve(in.tri.capacity());
   m.twin.assign(nh, kNone);
 
   // 1. Pair half-edges: the uses of an edge in one direction with those in
@@ -183,12 +201,16 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
 
   // Each half-edge left unpaired borders a hole, whose closing fan (step 3)
   // adds a triangle for it: room for those before the arrays are filled.
+  // Step 2 renames vertices in place: it reads a corner before its fan is
+  // renamed, and a fan's corners all held the same vertex before.
   const size_t open = static_cast<size_t>(std::count(m.twin.begin(), m.twin.end(), kNone));
-  m.tri.reserve(nh + 3 * open);
-  m.tri.assign(in.tri.begin(), in.tri.end());
-  m.diagonal.reserve(nh + 3 * open);
-  m.diagonal.assign(in.tri_diagonal.begin(), in.tri_diagonal.end());
-  if (open) m.twin.reserve(nh + 3 * open);
+  m.tri.swap(in.tri);
+  m.diagonal.swap(in.tri_diagonal);
+  if (open) {
+    m.tri.reserve(nh + 3 * open);
+    m.diagonal.reserve(nh + 3 * open);
+    m.twin.reserve(nh + 3 * open);
+  }
   m.tri_source.reserve(nh / 3 + open);
 
   // 2. Split vertices into one per fan: corners (= outgoing half-edges) that
@@ -201,7 +223,7 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
   std::vector<uint8_t> claimed(input_vertex_count, 0), in_fan(nh, 0);
   for (uint32_t h = 0; h < nh; ++h) {
     if (in_fan[h]) continue;
-    const uint32_t v = in.tri[h];
+    const uint32_t v = m.tri[h];  // not yet renamed (not in a fan)
     uint32_t id = v;
     if (!claimed[v]) {
       claimed[v] = 1;
@@ -227,9 +249,9 @@ CutMesh cut_mesh(const PreparedInput& in, uint32_t input_vertex_count, const Cut
   // h = a->b is found by rotating clockwise around b to the open side.
   m.tri_source.resize(nh / 3);
   std::iota(m.tri_source.begin(), m.tri_source.end(), 0u);
-  std::vector<uint8_t> done(nh, 0);
+  std::vector<uint8_t> done(open ? nh : 0, 0);
   std::vector<uint32_t> hole;
-  for (uint32_t h0 = 0; h0 < nh; ++h0) {
+  for (uint32_t h0 = 0; open && h0 < nh; ++h0) {
     if (m.twin[h0] != kNone || done[h0]) continue;
     hole.clear();
     for (uint32_t h = h0; !done[h];) {

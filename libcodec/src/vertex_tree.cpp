@@ -21,83 +21,101 @@ namespace tsm {
 
 namespace {
 
-// Stable counting sort of v by key(x) in [0, buckets): linear, where a
-// comparison sort of a million edges is most of the tree's time.
-template <class T, class Key>
-void counting_sort(std::vector<T>& v, size_t buckets, Key key) {
-  std::vector<uint32_t> start(buckets + 1, 0);
-  for (const T& x : v) ++start[key(x) + 1];
-  for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-  std::vector<T> sorted(v.size());
-  for (const T& x : v) sorted[start[key(x)]++] = x;
-  v.swap(sorted);
-}
+// What the breadth-first rings leave for the renumbering: the vertices in
+// rank order with what the walk knew of each when it reached it (so that
+// nothing is gathered back from a per-vertex array in id order), each
+// vertex's rank, and the triangles in the order the walk first met them.
+struct Rings {
+  std::vector<uint32_t> old_id;     // rank -> id
+  std::vector<uint32_t> dist;       // per rank: its ring
+  std::vector<uint32_t> from_he;    // per rank: the half-edge to its BFS parent, kNone at a root
+  std::vector<uint32_t> component;  // per rank
+  std::vector<uint32_t> rank;       // id -> rank; kFar not reached, kNone a virtual vertex
+  std::vector<uint32_t> tri_rank;   // triangle -> place in the walk, kNone where it did not meet it
+  std::vector<uint32_t> tri_by_rank;
+};
+constexpr uint32_t kFar = 0xFFFFFFFEu;
 
 // Renumbers the cut mesh for the stages after the rings: vertices by ring
 // rank (those no ring reaches after them, in id order), triangles in the
-// order the ring walk first met them (nt_of: old -> new, kNone where it did
-// not; old_of: new -> old, appended to here). The later stages walk the
-// mesh ring by ring, so they then read memory nearly in order instead of all
-// over a large mesh (the full dragon's connectivity encodes about 1.2x
-// faster by this alone, 1.6x with the edge listing it allows). No choice
-// changes: every later one depends on ranks, the walk and the root's
-// reference edge, and a half-edge id only breaks ties between parallel
-// edges. by_rank lists the vertices the rings reach, in rank order (their
-// new ids are their ranks); the caller's per-vertex arrays (dist, ref_he,
-// from_he) move along.
-void renumber_by_rings(CutMesh& m, std::vector<uint32_t>& by_rank, std::vector<uint32_t>& nt_of,
-                       std::vector<uint32_t>& old_of, std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he,
+// order the ring walk first met them (those it did not meet after them).
+// The later stages walk the mesh ring by ring, so they then read memory
+// nearly in order instead of all over a large mesh (the full dragon's
+// connectivity encodes about 1.2x faster by this alone, 1.6x with the edge
+// listing it allows). No choice changes: every later one depends on ranks,
+// the walk and the root's reference edge, and a half-edge id only breaks
+// ties between parallel edges. Returns the rings, from_he and ref_he (the
+// root's reference half-edges, by old id) in the new numbering.
+void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he,
                        std::vector<uint32_t>& from_he) {
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
-  std::vector<uint32_t>& old_id = by_rank;  // new id -> old id
-  const uint32_t reached = static_cast<uint32_t>(old_id.size());
-  std::vector<uint32_t> nid(nv, kNone);
-  for (uint32_t v = 0; v < reached; ++v) nid[old_id[v]] = v;
+  std::vector<uint32_t>& old_id = r.old_id;
+  std::vector<uint32_t>& nid = r.rank;
+  dist.swap(r.dist);
+  from_he.swap(r.from_he);
+  std::vector<uint32_t> component;
+  component.swap(r.component);
   for (uint32_t v = 0; v < nv; ++v)
-    if (nid[v] == kNone) {
+    if (nid[v] >= kFar) {
       nid[v] = static_cast<uint32_t>(old_id.size());
       old_id.push_back(v);
+      dist.push_back(m.kind[v] == VertexKind::virtual_ ? kNone : kFar);
+      from_he.push_back(kNone);
+      component.push_back(m.vertex_component[v]);
     }
-  auto permute = [&](auto& a) {  // gathered in the new order
-    std::remove_reference_t<decltype(a)> b(a.size());
-    for (uint32_t v = 0; v < nv; ++v) b[v] = a[old_id[v]];
-    a.swap(b);
-  };
-  permute(m.kind);
-  permute(m.source);
-  permute(m.vertex_component);
-  permute(dist);
-  permute(from_he);
+  m.vertex_component.swap(component);
+  std::vector<VertexKind> kind(nv);
+  std::vector<uint32_t> source(nv);
+  for (uint32_t v = 0; v < nv; ++v) {
+    kind[v] = m.kind[old_id[v]];
+    source[v] = m.source[old_id[v]];
+  }
+  m.kind.swap(kind);
+  m.source.swap(source);
   // The reference half-edges are at the roots only.
   std::vector<uint32_t> ref(nv, kNone);
-  for (uint32_t& r : m.component_root) {
-    ref[nid[r]] = ref_he[r];
-    r = nid[r];
+  for (uint32_t& root : m.component_root) {
+    ref[nid[root]] = ref_he[root];
+    root = nid[root];
   }
   ref_he.swap(ref);
-  // Triangles in the order the ring walk first met them (those it did not
-  // meet after them), each gathered from its old place.
+  // Triangles, each gathered from its old place.
+  std::vector<uint32_t>& nt_of = r.tri_rank;
+  std::vector<uint32_t>& old_of = r.tri_by_rank;
   for (uint32_t t = 0; t < nt; ++t)
     if (nt_of[t] == kNone) {
       nt_of[t] = static_cast<uint32_t>(old_of.size());
       old_of.push_back(t);
     }
   auto nh = [&](uint32_t h) { return 3 * nt_of[h / 3] + h % 3; };
-  std::vector<uint32_t> tri(m.tri.size()), twin(m.twin.size()), tri_source(nt);
-  std::vector<uint8_t> diagonal(m.diagonal.size());
+  std::vector<uint32_t> tri(m.tri.size()), twin(m.twin.size());
   for (uint32_t t = 0; t < nt; ++t) {
     const uint32_t o = old_of[t];
     for (uint32_t k = 0; k < 3; ++k) {
       tri[3 * t + k] = nid[m.tri[3 * o + k]];
       twin[3 * t + k] = nh(m.twin[3 * o + k]);
-      diagonal[3 * t + k] = m.diagonal[3 * o + k];
     }
-    tri_source[t] = m.tri_source[o];
   }
   m.tri.swap(tri);
   m.twin.swap(twin);
-  m.diagonal.swap(diagonal);
+  // The cut lists the input's triangles in order, then the holes' fans: no
+  // gather unless that is not so; no polygon diagonals, nothing to move.
+  uint32_t in_order = 0;
+  while (in_order < nt && m.tri_source[in_order] == in_order) ++in_order;
+  bool sources_in_order = true;
+  for (uint32_t t = in_order; t < nt; ++t) sources_in_order &= m.tri_source[t] == kNone;
+  std::vector<uint32_t> tri_source(nt);
+  for (uint32_t t = 0; t < nt; ++t) {
+    const uint32_t o = old_of[t];
+    tri_source[t] = sources_in_order ? (o < in_order ? o : kNone) : m.tri_source[o];
+  }
   m.tri_source.swap(tri_source);
+  if (std::any_of(m.diagonal.begin(), m.diagonal.end(), [](uint8_t d) { return d != 0; })) {
+    std::vector<uint8_t> diagonal(m.diagonal.size());
+    for (uint32_t t = 0; t < nt; ++t)
+      for (uint32_t k = 0; k < 3; ++k) diagonal[3 * t + k] = m.diagonal[3 * old_of[t] + k];
+    m.diagonal.swap(diagonal);
+  }
   for (auto* a : {&ref_he, &from_he})
     for (uint32_t& h : *a)
       if (h != kNone) h = nh(h);
@@ -149,35 +167,37 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
 
   // Breadth-first rings and order from each root over real vertices; the
   // neighbours of a vertex are taken clockwise from the edge to its BFS parent.
-  const uint32_t kFar = 0xFFFFFFFEu;
-  // A virtual vertex is never reached (its dist is not kFar).
-  std::vector<uint32_t> dist(nv, kFar), bfs_from(nv, kNone);
-  for (uint32_t v = 0; v < nv; ++v)
-    if (is_virtual(v)) dist[v] = kNone;
-  std::vector<uint32_t> queue, tri_order(nh / 3, kNone), tri_by_order;
-  queue.reserve(nv);
-  tri_by_order.reserve(nh / 3);
+  // A virtual vertex is never reached (its rank is kNone, not kFar).
+  Rings walk;
+  walk.rank.resize(nv);
+  for (uint32_t v = 0; v < nv; ++v) walk.rank[v] = is_virtual(v) ? kNone : kFar;
+  walk.tri_rank.assign(nh / 3, kNone);
+  for (auto* a : {&walk.old_id, &walk.dist, &walk.from_he, &walk.component}) a->reserve(nv);
+  walk.tri_by_rank.reserve(nh / 3);
+  std::vector<uint32_t>& queue = walk.old_id;  // all components in one list: the vertices by rank
+  auto reach = [&](uint32_t v, uint32_t d, uint32_t from, uint32_t c) {
+    walk.rank[v] = static_cast<uint32_t>(queue.size());
+    queue.push_back(v);
+    walk.dist.push_back(d);
+    walk.from_he.push_back(from);
+    walk.component.push_back(c);
+  };
   for (uint32_t c = 0; c < m.component_count(); ++c) {
     uint32_t root = m.component_root[c];
     f.root_ref_he[root] = out_he[root];
-    dist[root] = 0;
-    queue.push_back(root);  // all components in one list: the vertices by rank
+    reach(root, 0, kNone, c);
     for (size_t qi = queue.size() - 1; qi < queue.size(); ++qi) {
-      uint32_t v = queue[qi];
-      uint32_t start = bfs_from[v] != kNone ? bfs_from[v] : out_he[v];
+      const uint32_t start = walk.from_he[qi] != kNone ? walk.from_he[qi] : out_he[queue[qi]];
       if (start == kNone) continue;  // isolated vertex
+      const uint32_t d = walk.dist[qi] + 1;
       uint32_t h = start;
       do {
-        if (tri_order[h / 3] == kNone) {  // triangles in the order the walk first meets them
-          tri_order[h / 3] = static_cast<uint32_t>(tri_by_order.size());
-          tri_by_order.push_back(h / 3);
+        if (walk.tri_rank[h / 3] == kNone) {  // triangles in the order the walk first meets them
+          walk.tri_rank[h / 3] = static_cast<uint32_t>(walk.tri_by_rank.size());
+          walk.tri_by_rank.push_back(h / 3);
         }
-        uint32_t w = m.tri[he_next(h)];
-        if (dist[w] == kFar) {
-          dist[w] = dist[v] + 1;
-          bfs_from[w] = m.twin[h];  // w -> v
-          queue.push_back(w);
-        }
+        const uint32_t w = m.tri[he_next(h)];
+        if (walk.rank[w] == kFar) reach(w, d, m.twin[h], c);  // from w back to the vertex walked
         h = he_next(m.twin[h]);
       } while (h != start);
     }
@@ -186,7 +206,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // After the renumbering a vertex's rank is its id (kNone where no ring
   // reached it), and its walk starts where its ring walk started.
   const uint32_t reached = static_cast<uint32_t>(queue.size());
-  renumber_by_rings(m, queue, tri_order, tri_by_order, dist, f.root_ref_he, bfs_from);
+  std::vector<uint32_t> dist, bfs_from;
+  renumber_by_rings(m, walk, dist, f.root_ref_he, bfs_from);
   auto rank = [reached](uint32_t v) { return v < reached ? v : kNone; };
   auto walk_start = [&](uint32_t v) { return bfs_from[v] != kNone ? bfs_from[v] : f.root_ref_he[v]; };
   // Between parallel edges (same two vertices, as where the faces of an
@@ -279,7 +300,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // vertices by rank (their ids now), each edge at its lower-ranked end,
   // each vertex's few edges sorted by (second rank, place in the walk); the
   // reference edges (rank 0) first, then the same-ring edges, then the rest
-  // (phase 2 sorts those by class and ring). Within a component the rings
+  // by class (phase 2 orders the ring-to-ring ones by preference within
+  // each ring). Within a component the rings
   // follow the ranks, so this is by_key's order there; across components
   // it is not, but no union joins two components. Ranks are below nv
   // except at vertices no ring reaches, which a closed cut mesh does not
@@ -290,52 +312,52 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   auto sort_from = [&](std::vector<Edge>& v, size_t from) {
     if (v.size() - from > 1) std::sort(v.begin() + static_cast<std::ptrdiff_t>(from), v.end(), by_rb);
   };
-  // low: the reference and same-ring edges (phase 1); edges: the rest.
-  std::vector<Edge> low, edges;
+  // low: the reference and same-ring edges (phase 1); by class, the rest:
+  // ring-to-ring edges, edges to virtual vertices, polygon diagonals.
+  std::vector<Edge> low, edges, to_virtual, diagonals;
+  auto part_of = [&](uint64_t cls) -> std::vector<Edge>& {
+    return cls == 2 ? edges : cls == 3 ? to_virtual : diagonals;
+  };
   bool linear = !midpoint;
   if (linear) {
     std::vector<Edge> refs, same_ring;
-    std::vector<Edge>& rest = edges;
-    rest.reserve(nh / 2);
+    edges.reserve(nh / 2);
     for (uint32_t v = 0; v < reached; ++v) {
       const uint32_t start = walk_start(v);
       if (start == kNone) continue;
-      const size_t s0 = same_ring.size(), r0 = rest.size();
+      const size_t s0 = same_ring.size(), e0 = edges.size(), v0 = to_virtual.size(), d0 = diagonals.size();
       uint32_t g = start, guard = 0;
       do {
         const uint32_t w = m.tri[he_next(g)];
         if (rank(w) > v) {  // kNone (a virtual vertex) too
           const Edge e = make_edge(g < m.twin[g] ? g : m.twin[g]);
           const uint64_t cls = e.key >> 60;
-          (cls == 0 ? refs : cls == 1 ? same_ring : rest).push_back(e);
+          (cls == 0 ? refs : cls == 1 ? same_ring : part_of(cls)).push_back(e);
         }
         g = he_next(m.twin[g]);
       } while (g != start && ++guard < nh);
       sort_from(same_ring, s0);
-      sort_from(rest, r0);
+      sort_from(edges, e0);
+      sort_from(to_virtual, v0);
+      sort_from(diagonals, d0);
     }
     sort_from(refs, 0);
     low.swap(refs);
     low.insert(low.end(), same_ring.begin(), same_ring.end());
-    linear = low.size() + edges.size() == nh / 2;
-    for (const auto* part : {&low, &edges})
+    linear = low.size() + edges.size() + to_virtual.size() + diagonals.size() == nh / 2;
+    for (const auto* part : {&low, &edges, &to_virtual, &diagonals})
       for (const Edge& e : *part)
         if (ra_of(e) >= nv || e.rb >= nv) linear = false;
   }
   if (!linear) {
-    low.clear();
-    edges.clear();
+    std::vector<Edge> all;
     for (uint32_t h = 0; h < nh; ++h)
-      if (h < m.twin[h]) edges.push_back(make_edge(h));
-    std::sort(edges.begin(), edges.end(), by_key);
-    size_t n = 0;
-    while (n < edges.size() && (edges[n].key >> 60) <= 1) ++n;
-    low.assign(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(n));
-    edges.erase(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(n));
+      if (h < m.twin[h]) all.push_back(make_edge(h));
+    std::sort(all.begin(), all.end(), by_key);
+    low.clear();
+    for (auto* part : {&edges, &to_virtual, &diagonals}) part->clear();
+    for (const Edge& e : all) ((e.key >> 60) <= 1 ? low : part_of(e.key >> 60)).push_back(e);
   }
-  uint32_t max_ring = 0;
-  for (const Edge& e : edges) max_ring = std::max(max_ring, ring_of(e));
-  const size_t rings = size_t{max_ring} + 1;
   UnionFind uf(nv);
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
@@ -359,23 +381,30 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // Phase 2: the rest; ring-to-ring edges that join path ends first (a
   // path attached at its end continues a run instead of branching).
   for (Edge& e : edges) {
-    if ((e.key >> 60) != 2) continue;
     uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
     uint32_t inner = dist[a] < dist[b] ? a : b, outer = inner == a ? b : a;
     uint64_t ends = (ring_deg[outer] >= 2 ? 2u : 0u) + (ring_deg[inner] >= 2 ? 1u : 0u);
     e.key = (e.key & ~(uint64_t{3} << 58)) | (ends << 58);
   }
-  // Class, then ring, then path-end preference, then ranks: the edges are
-  // in that order but for the preference, so a stable counting sort by
-  // (class, ring, preference) is enough (class >= 2 here).
+  // Ring, then path-end preference, then ranks. Listed by the walk, the
+  // edges of each component are in that order but for the preference (an
+  // edge's ring is that of its lower-ranked end), so a stable partition by
+  // preference within each ring's run is the sort (where two components'
+  // runs meet, their edges interleave differently: no union joins two
+  // components).
   auto ends_of = [](const Edge& e) { return static_cast<uint32_t>((e.key >> 58) & 3); };
   if (linear) {
-    counting_sort(edges, 3 * rings * 4,
-                  [&](const Edge& e) { return (((e.key >> 60) - 2) * rings + ring_of(e)) * 4 + ends_of(e); });
+    std::vector<Edge> run;
+    for (size_t i = 0, j; i < edges.size(); i = j) {
+      for (j = i + 1; j < edges.size() && ring_of(edges[j]) == ring_of(edges[i]);) ++j;
+      run.assign(edges.begin() + static_cast<std::ptrdiff_t>(i), edges.begin() + static_cast<std::ptrdiff_t>(j));
+      size_t k = i;
+      for (uint32_t p = 0; p < 4; ++p)
+        for (const Edge& e : run)
+          if (ends_of(e) == p) edges[k++] = e;
+    }
   } else {
     std::sort(edges.begin(), edges.end(), [&](const Edge& x, const Edge& y) {
-      uint64_t cx = x.key >> 60, cy = y.key >> 60;
-      if (cx != cy) return cx < cy;
       if (ring_of(x) != ring_of(y)) return ring_of(x) < ring_of(y);
       if (ends_of(x) != ends_of(y)) return ends_of(x) < ends_of(y);
       return x.key != y.key ? x.key < y.key : x.rb != y.rb ? x.rb < y.rb : parallel_less(x.h, y.h);
@@ -388,18 +417,15 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // tree first: a virtual vertex then joins it by a single edge, as a leaf
   // (the decoder refuses a virtual vertex with children, FORMAT.md §8.7),
   // and a diagonal never joins it (it would be cut and split its polygon).
-  bool retried = false;
-  auto retry_skipped = [&] {
-    retried = true;
-    for (uint32_t h : skipped)
-      if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
+  auto take = [&](const std::vector<Edge>& part) {
+    for (const Edge& e : part)
+      if (uf.unite(m.tri[e.h], m.tri[m.twin[e.h]])) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
   };
-  for (const Edge& e : edges) {
-    if (!retried && (e.key >> 60) >= 3) retry_skipped();
-    uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
-    if (uf.unite(a, b)) f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
-  }
-  if (!retried) retry_skipped();
+  take(edges);
+  for (uint32_t h : skipped)
+    if (uf.unite(m.tri[h], m.tri[m.twin[h]])) f.tree_he[h] = f.tree_he[m.twin[h]] = 1;
+  take(to_virtual);
+  take(diagonals);
 
   // Pre-order, children clockwise from the parent edge (from the reference
   // half-edge at a root, which itself comes first).
