@@ -29,6 +29,7 @@ struct Rings {
   std::vector<uint32_t> old_id;     // rank -> id
   std::vector<uint32_t> dist;       // per rank: its ring
   std::vector<uint32_t> from_he;    // per rank: the half-edge to its BFS parent, kNone at a root
+  std::vector<uint32_t> reached_by; // per rank: from_he's twin by its place in the walk (3 x triangle rank + corner)
   std::vector<uint32_t> component;  // per rank
   std::vector<uint32_t> rank;       // id -> rank; kFar not reached, kNone a virtual vertex
   std::vector<uint32_t> tri_rank;   // triangle -> place in the walk, kNone where it did not meet it
@@ -51,6 +52,7 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
   std::vector<uint32_t>& old_id = r.old_id;
   std::vector<uint32_t>& nid = r.rank;
+  const uint32_t reached = static_cast<uint32_t>(old_id.size());
   dist.swap(r.dist);
   from_he.swap(r.from_he);
   std::vector<uint32_t> component;
@@ -116,9 +118,10 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
       for (uint32_t k = 0; k < 3; ++k) diagonal[3 * t + k] = m.diagonal[3 * old_of[t] + k];
     m.diagonal.swap(diagonal);
   }
-  for (auto* a : {&ref_he, &from_he})
-    for (uint32_t& h : *a)
-      if (h != kNone) h = nh(h);
+  for (uint32_t& h : ref_he)
+    if (h != kNone) h = nh(h);
+  for (uint32_t v = 0; v < reached; ++v)  // the new twins are near: no lookup in the old order
+    if (r.reached_by[v] != kNone) from_he[v] = m.twin[r.reached_by[v]];
 }
 
 }  // namespace
@@ -172,14 +175,15 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   walk.rank.resize(nv);
   for (uint32_t v = 0; v < nv; ++v) walk.rank[v] = is_virtual(v) ? kNone : kFar;
   walk.tri_rank.assign(nh / 3, kNone);
-  for (auto* a : {&walk.old_id, &walk.dist, &walk.from_he, &walk.component}) a->reserve(nv);
+  for (auto* a : {&walk.old_id, &walk.dist, &walk.from_he, &walk.reached_by, &walk.component}) a->reserve(nv);
   walk.tri_by_rank.reserve(nh / 3);
   std::vector<uint32_t>& queue = walk.old_id;  // all components in one list: the vertices by rank
-  auto reach = [&](uint32_t v, uint32_t d, uint32_t from, uint32_t c) {
+  auto reach = [&](uint32_t v, uint32_t d, uint32_t h, uint32_t c) {  // from h's start, or a root (h = kNone)
     walk.rank[v] = static_cast<uint32_t>(queue.size());
     queue.push_back(v);
     walk.dist.push_back(d);
-    walk.from_he.push_back(from);
+    walk.from_he.push_back(h == kNone ? kNone : m.twin[h]);
+    walk.reached_by.push_back(h == kNone ? kNone : 3 * walk.tri_rank[h / 3] + h % 3);
     walk.component.push_back(c);
   };
   for (uint32_t c = 0; c < m.component_count(); ++c) {
@@ -197,7 +201,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
           walk.tri_by_rank.push_back(h / 3);
         }
         const uint32_t w = m.tri[he_next(h)];
-        if (walk.rank[w] == kFar) reach(w, d, m.twin[h], c);  // from w back to the vertex walked
+        if (walk.rank[w] == kFar) reach(w, d, h, c);
         h = he_next(m.twin[h]);
       } while (h != start);
     }
@@ -312,16 +316,16 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   auto sort_from = [&](std::vector<Edge>& v, size_t from) {
     if (v.size() - from > 1) std::sort(v.begin() + static_cast<std::ptrdiff_t>(from), v.end(), by_rb);
   };
-  // low: the reference and same-ring edges (phase 1); by class, the rest:
-  // ring-to-ring edges, edges to virtual vertices, polygon diagonals.
-  std::vector<Edge> low, edges, to_virtual, diagonals;
+  // Phase 1's: the reference edges, then the same-ring edges; by class, the
+  // rest: ring-to-ring edges, edges to virtual vertices, polygon diagonals.
+  std::vector<Edge> refs, same_ring, edges, to_virtual, diagonals;
   auto part_of = [&](uint64_t cls) -> std::vector<Edge>& {
     return cls == 2 ? edges : cls == 3 ? to_virtual : diagonals;
   };
   bool linear = !midpoint;
   if (linear) {
-    std::vector<Edge> refs, same_ring;
     edges.reserve(nh / 2);
+    same_ring.reserve(nh / 4);
     for (uint32_t v = 0; v < reached; ++v) {
       const uint32_t start = walk_start(v);
       if (start == kNone) continue;
@@ -342,10 +346,8 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
       sort_from(diagonals, d0);
     }
     sort_from(refs, 0);
-    low.swap(refs);
-    low.insert(low.end(), same_ring.begin(), same_ring.end());
-    linear = low.size() + edges.size() + to_virtual.size() + diagonals.size() == nh / 2;
-    for (const auto* part : {&low, &edges, &to_virtual, &diagonals})
+    linear = refs.size() + same_ring.size() + edges.size() + to_virtual.size() + diagonals.size() == nh / 2;
+    for (const auto* part : {&refs, &same_ring, &edges, &to_virtual, &diagonals})
       for (const Edge& e : *part)
         if (ra_of(e) >= nv || e.rb >= nv) linear = false;
   }
@@ -354,30 +356,30 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
     for (uint32_t h = 0; h < nh; ++h)
       if (h < m.twin[h]) all.push_back(make_edge(h));
     std::sort(all.begin(), all.end(), by_key);
-    low.clear();
-    for (auto* part : {&edges, &to_virtual, &diagonals}) part->clear();
-    for (const Edge& e : all) ((e.key >> 60) <= 1 ? low : part_of(e.key >> 60)).push_back(e);
+    for (auto* part : {&refs, &same_ring, &edges, &to_virtual, &diagonals}) part->clear();
+    for (const Edge& e : all) ((e.key >> 60) <= 1 ? refs : part_of(e.key >> 60)).push_back(e);
   }
   UnionFind uf(nv);
   // Phase 1: the reference edges and same-ring edges, each ring a set of
   // paths (a vertex takes at most two same-ring tree edges).
   std::vector<uint8_t> ring_deg(nv, 0);
   std::vector<uint32_t> skipped;  // same-ring edges left out for the path rule
-  for (const Edge& e : low) {
-    uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
-    const bool same_ring = (e.key >> 60) == 1 && !midpoint;
-    if (same_ring && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) {
-      skipped.push_back(e.h);
-      continue;
-    }
-    if (uf.unite(a, b)) {
-      f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
-      if (same_ring) {
-        ++ring_deg[a];
-        ++ring_deg[b];
+  for (const auto* part : {&refs, &same_ring})
+    for (const Edge& e : *part) {
+      uint32_t a = m.tri[e.h], b = m.tri[m.twin[e.h]];
+      const bool path_rule = (e.key >> 60) == 1 && !midpoint;
+      if (path_rule && (ring_deg[a] >= 2 || ring_deg[b] >= 2)) {
+        skipped.push_back(e.h);
+        continue;
+      }
+      if (uf.unite(a, b)) {
+        f.tree_he[e.h] = f.tree_he[m.twin[e.h]] = 1;
+        if (path_rule) {
+          ++ring_deg[a];
+          ++ring_deg[b];
+        }
       }
     }
-  }
   // Phase 2: the rest; ring-to-ring edges that join path ends first (a
   // path attached at its end continues a run instead of branching).
   for (Edge& e : edges) {
