@@ -163,7 +163,7 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
   // the other, in order (two opposite uses: a manifold edge; more: sheets
   // meeting at an edge, kept as pairs so only unmatched uses are cut).
   const EdgeGroups edges = sorted_edges(in.tri);
-  std::vector<uint32_t> forward, backward;
+  std::vector<uint32_t> forward, backward, open_he;  // open_he: the uses left unpaired
   edges.each_edge([&](size_t i, size_t j) {
     if (j - i == 2) {  // the usual edge: two uses, paired when they are opposite
       const uint32_t x = edges.half_edge(i), y = edges.half_edge(i + 1);
@@ -172,6 +172,7 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
         m.twin[y] = x;
       } else {
         ++m.cut_edges;
+        open_he.insert(open_he.end(), {x, y});
       }
       return;
     }
@@ -196,6 +197,7 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
       m.twin[forward[k]] = backward[k];
       m.twin[backward[k]] = forward[k];
     }
+    for (const auto* side : {&forward, &backward}) open_he.insert(open_he.end(), side->begin() + pairs, side->end());
     if (j - i != 2 * pairs || j - i > 2) ++m.cut_edges;
   });
 
@@ -203,7 +205,8 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
   // adds a triangle for it: room for those before the arrays are filled.
   // Step 2 renames vertices in place: it reads a corner before its fan is
   // renamed, and a fan's corners all held the same vertex before.
-  const size_t open = static_cast<size_t>(std::count(m.twin.begin(), m.twin.end(), kNone));
+  std::sort(open_he.begin(), open_he.end());
+  const size_t open = open_he.size();
   m.tri.swap(in.tri);
   m.diagonal.swap(in.tri_diagonal);
   if (open) {
@@ -249,13 +252,20 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
   // h = a->b is found by rotating clockwise around b to the open side.
   m.tri_source.resize(nh / 3);
   std::iota(m.tri_source.begin(), m.tri_source.end(), 0u);
-  std::vector<uint8_t> done(open ? nh : 0, 0);
+  // Holes in the order of their first half-edge; done: per open half-edge.
+  std::vector<uint8_t> done_open(open, 0);
+  uint8_t not_open = 1;
+  auto done = [&](uint32_t h) -> uint8_t& {
+    const auto it = std::lower_bound(open_he.begin(), open_he.end(), h);
+    if (it == open_he.end() || *it != h) return not_open = 1;  // (a walk meets only open half-edges)
+    return done_open[static_cast<size_t>(it - open_he.begin())];
+  };
   std::vector<uint32_t> hole;
-  for (uint32_t h0 = 0; open && h0 < nh; ++h0) {
-    if (m.twin[h0] != kNone || done[h0]) continue;
+  for (uint32_t h0 : open_he) {
+    if (done(h0)) continue;
     hole.clear();
-    for (uint32_t h = h0; !done[h];) {
-      done[h] = 1;
+    for (uint32_t h = h0; !done(h);) {
+      done(h) = 1;
       hole.push_back(h);
       uint32_t g = he_next(h);
       while (m.twin[g] != kNone) g = he_next(m.twin[g]);
