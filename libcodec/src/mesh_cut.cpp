@@ -93,7 +93,7 @@ PreparedInput prepare_input(const Mesh& mesh) {
     }
   };
   const size_t corners_in = mesh.corner_count(), faces_in = mesh.face_count();
-  if (corners_in > 2 * faces_in) {  // exact for triangles and polygons
+  if (corners_in > 2 * faces_in) {  // exact unless some faces are degenerate
     const size_t tris = corners_in - 2 * faces_in;
     // With room for the fans by which the cut closes a few holes (a
     // triangle per boundary edge), so it need not move the arrays.
@@ -156,7 +156,7 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
   const std::vector<uint32_t>* isolated_key = hints.anchor;
   CutMesh m;
   const uint32_t nh = static_cast<uint32_t>(in.tri.size());
-  m.twin.reserve(in.tri.capacity());
+  m.twin.reserve(in.tri.capacity());  // the room prepare_input left for holes' fans
   m.twin.assign(nh, kNone);
 
   // 1. Pair half-edges: the uses of an edge in one direction with those in

@@ -8,12 +8,11 @@
 // diagonals last (so they are never cut). Rings are paths joined by single
 // edges: a spiral with few, long runs. After the rings the cut mesh is
 // renumbered in ring order (the later stages then read memory in order);
-// the edges are listed by walking it and ordered by a counting sort
-// (linear time). The tree is linearized in pre-order with the
-// children of a node in clockwise order starting from the edge to its parent.
+// the edges are listed by walking it, already by class and ring but for
+// the path-end preference, sorted within each ring (linear time). The tree
+// is linearized in pre-order with the children of a node in clockwise order
+// starting from the edge to its parent.
 #include <algorithm>
-#include <numeric>
-#include <type_traits>
 
 #include "connectivity.hpp"
 
@@ -29,7 +28,8 @@ struct Rings {
   std::vector<uint32_t> old_id;     // rank -> id
   std::vector<uint32_t> dist;       // per rank: its ring
   std::vector<uint32_t> from_he;    // per rank: the half-edge to its BFS parent, kNone at a root
-  std::vector<uint32_t> reached_by; // per rank: from_he's twin by its place in the walk (3 x triangle rank + corner)
+  std::vector<uint32_t> reached_by; // per rank: the parent's half-edge to it (from_he's twin), numbered as
+                                    // after the renumbering (3 x triangle rank + corner), kNone at a root
   std::vector<uint32_t> component;  // per rank
   std::vector<uint32_t> rank;       // id -> rank; kFar not reached, kNone a virtual vertex
   std::vector<uint32_t> tri_rank;   // triangle -> place in the walk, kNone where it did not meet it
@@ -45,8 +45,9 @@ constexpr uint32_t kFar = 0xFFFFFFFEu;
 // connectivity encodes about 1.2x faster by this alone, 1.6x with the edge
 // listing it allows). No choice changes: every later one depends on ranks,
 // the walk and the root's reference edge, and a half-edge id only breaks
-// ties between parallel edges. Returns the rings, from_he and ref_he (the
-// root's reference half-edges, by old id) in the new numbering.
+// ties between parallel edges. Leaves dist and from_he per new id, and
+// ref_he (the roots' reference half-edges, given by old id) in the new
+// numbering.
 void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::vector<uint32_t>& ref_he,
                        std::vector<uint32_t>& from_he) {
   const uint32_t nv = m.vertex_count, nt = m.triangle_count();
