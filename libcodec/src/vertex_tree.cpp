@@ -55,7 +55,6 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
   std::vector<uint32_t>& nid = r.rank;
   const uint32_t reached = static_cast<uint32_t>(old_id.size());
   dist.swap(r.dist);
-  from_he.swap(r.from_he);
   std::vector<uint32_t> component;
   component.swap(r.component);
   for (uint32_t v = 0; v < nv; ++v)
@@ -63,7 +62,6 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
       nid[v] = static_cast<uint32_t>(old_id.size());
       old_id.push_back(v);
       dist.push_back(m.kind[v] == VertexKind::virtual_ ? kNone : kFar);
-      from_he.push_back(kNone);
       component.push_back(m.vertex_component[v]);
     }
   m.vertex_component.swap(component);
@@ -101,18 +99,10 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
   }
   m.tri.swap(tri);
   m.twin.swap(twin);
-  // The cut lists the input's triangles in order, then the holes' fans: no
-  // gather unless that is not so; no polygon diagonals, nothing to move.
-  uint32_t in_order = 0;
-  while (in_order < nt && m.tri_source[in_order] == in_order) ++in_order;
-  bool sources_in_order = true;
-  for (uint32_t t = in_order; t < nt; ++t) sources_in_order &= m.tri_source[t] == kNone;
   std::vector<uint32_t> tri_source(nt);
-  for (uint32_t t = 0; t < nt; ++t) {
-    const uint32_t o = old_of[t];
-    tri_source[t] = sources_in_order ? (o < in_order ? o : kNone) : m.tri_source[o];
-  }
+  for (uint32_t t = 0; t < nt; ++t) tri_source[t] = m.tri_source[old_of[t]];
   m.tri_source.swap(tri_source);
+  // No polygon diagonals: nothing to move.
   if (std::any_of(m.diagonal.begin(), m.diagonal.end(), [](uint8_t d) { return d != 0; })) {
     std::vector<uint8_t> diagonal(m.diagonal.size());
     for (uint32_t t = 0; t < nt; ++t)
@@ -121,7 +111,10 @@ void renumber_by_rings(CutMesh& m, Rings& r, std::vector<uint32_t>& dist, std::v
   }
   for (uint32_t& h : ref_he)
     if (h != kNone) h = nh(h);
-  for (uint32_t v = 0; v < reached; ++v)  // the new twins are near: no lookup in the old order
+  // A reached vertex's parent edge through the new twins (near in the new
+  // order; no lookup in the old one).
+  from_he.assign(nv, kNone);
+  for (uint32_t v = 0; v < reached; ++v)
     if (r.reached_by[v] != kNone) from_he[v] = m.twin[r.reached_by[v]];
 }
 
