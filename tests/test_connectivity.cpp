@@ -183,6 +183,36 @@ TEST(Connectivity, BowtieNeedsAStitch) {
   EXPECT_GE(stats_of(bowtie()).stitches, 1u);
 }
 
+// A double-sided sheet: every face also given reversed, on the same
+// vertices (as some exporters write thin geometry). Each edge then has four
+// uses; a face must not be paired with its own reverse (every face would
+// close on itself: one component and three stitches per face), but with its
+// neighbours, so the mesh codes as two sheets: a closed surface as two
+// components with the second one's vertices stitched, an open one as one
+// component joined along its border.
+TEST(Connectivity, DoubleSidedSheetsStayWhole) {
+  auto double_sided = [](Mesh m) {
+    const size_t nf = m.face_count();
+    for (size_t f = 0; f < nf; ++f) m.add_triangle(m.face(f)[0], m.face(f)[2], m.face(f)[1]);
+    return m;
+  };
+  const Mesh sphere = icosphere(2), grid = grid_with_holes(8, 2);
+  for (const auto& [single, name] : {std::pair<const Mesh&, const char*>{sphere, "sphere"}, {grid, "grid"}}) {
+    const Mesh both = double_sided(single);
+    expect_round_trip(both, std::string("double-sided ") + name);
+    // As the codec codes them (pairing by the third corners' positions).
+    FileInfo one, two;
+    for (auto [mesh, info] : {std::pair<const Mesh*, FileInfo*>{&single, &one}, {&both, &two}}) {
+      std::string bytes;
+      ASSERT_TRUE(encode(*mesh, EncodeOptions(), bytes).ok()) << name;
+      ASSERT_TRUE(inspect(bytes, *info).ok()) << name;
+    }
+    EXPECT_LE(two.components, 2 * one.components) << name;
+    EXPECT_LE(two.stitches, single.vertex_count()) << name;
+    EXPECT_LT(two.connectivity_bytes, 3 * one.connectivity_bytes + single.vertex_count()) << name;
+  }
+}
+
 TEST(Connectivity, DuplicateAndDegenerateFaces) {
   Mesh m = icosphere(1);
   m.add_triangle(0, 1, 2);

@@ -182,9 +182,9 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
       const uint32_t h = edges.half_edge(k);
       (in.tri[h] < in.tri[he_next(h)] ? forward : backward).push_back(h);
     }
+    auto third = [&](uint32_t h) { return &(*hints.qpos)[3 * static_cast<size_t>(in.tri[he_prev(h)])]; };
     if (hints.qpos && j - i > 2) {
       // By the third corner's quantized position (then half-edge order).
-      auto third = [&](uint32_t h) { return &(*hints.qpos)[3 * static_cast<size_t>(in.tri[he_prev(h)])]; };
       auto less = [&](uint32_t x, uint32_t y) {
         const uint32_t *a = third(x), *b = third(y);
         return std::lexicographical_compare(a, a + 3, b, b + 3);
@@ -193,6 +193,21 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
       std::stable_sort(backward.begin(), backward.end(), less);
     }
     const size_t pairs = std::min(forward.size(), backward.size());
+    if (hints.qpos && forward.size() == 2 && backward.size() == 2) {
+      // A double-sided sheet (its faces given both ways round on the same
+      // vertices): each edge has two uses each way, and pairing a face
+      // with its own reverse (their third corners coincide, so the sorted
+      // order lines them up) would close every face on itself, the sheet
+      // falling apart into two-triangle pieces stitched together. So the
+      // pairs cross when that makes fewer such pairs. The choice follows
+      // positions alone (in particular not ids or the face order, which a
+      // decoded mesh does not keep): both sides' third corners are apart.
+      auto same_third = [&](uint32_t x, uint32_t y) { return std::equal(third(x), third(x) + 3, third(y)); };
+      const int straight = same_third(forward[0], backward[0]) + same_third(forward[1], backward[1]);
+      const int crossed = same_third(forward[0], backward[1]) + same_third(forward[1], backward[0]);
+      if (crossed < straight && !same_third(forward[0], forward[1]) && !same_third(backward[0], backward[1]))
+        std::swap(backward[0], backward[1]);
+    }
     for (size_t k = 0; k < pairs; ++k) {
       m.twin[forward[k]] = backward[k];
       m.twin[backward[k]] = forward[k];
