@@ -3,6 +3,7 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <algorithm>
+#include <tuple>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -509,14 +510,28 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 // stitched back: there the decoded order lets the cut find another copy of
 // a split vertex first. So a part with stitches is coded as its decoded
 // self would be: decode the streams, code that mesh, and repeat until
-// decoding gives back the faces coded, corner for corner (every stitched
-// mesh we have reaches it after at most one round, the dragons included).
+// decoding gives back the faces coded, corner for corner (the corpus's
+// stitched meshes reach it after at most one round, the dragons included).
 // At that point output vertex v may simply be the coded mesh's vertex v,
 // whatever order the coder chose: the decoded faces name the same ids at
 // the same corners. That matters for a symmetric mesh (the Moebius strip),
 // whose coder order is a symmetry of its faces (its mirror image): taken as
 // it is, it would permute the positions on every re-encoding.
-constexpr int kCanonicalRounds = 4;
+// Some tangles of non-manifold faces (random soups; faces also given
+// reversed) never settle: the rounds come back to a mesh coded before and
+// go round a cycle. Every member of the cycle leads round the same cycle,
+// so the member whose streams are smallest (then first in byte order) is
+// coded: a decoded mesh, itself on the cycle, finds the same one.
+constexpr int kCanonicalRounds = 16;
+
+bool same_faces(const Mesh& a, const Mesh& b) { return a.indices == b.indices && a.face_offsets == b.face_offsets; }
+
+bool streams_before(const ConnectivityStreams& a, const ConnectivityStreams& b) {
+  const size_t na = a.vertex_tree.size() + a.triangle_tree.size() + a.topology.size();
+  const size_t nb = b.vertex_tree.size() + b.triangle_tree.size() + b.topology.size();
+  if (na != nb) return na < nb;
+  return std::tie(a.vertex_tree, a.triangle_tree, a.topology) < std::tie(b.vertex_tree, b.triangle_tree, b.topology);
+}
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                               const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
@@ -528,12 +543,29 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   Mesh coded;                  // that mesh (faces only), once it is not `mesh`
   std::vector<uint32_t> q;
   std::vector<uint8_t> ref;
+  // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
+  // streams and its base.
+  std::vector<Mesh> coded_in;
+  std::vector<ConnectivityStreams> streams_of;
+  std::vector<std::vector<uint32_t>> base_of;
+  // Codes round r's mesh again (its ids -> input ids: `base`).
+  auto code = [&](const Mesh& faces) -> Status {
+    q.resize(3 * n);
+    for (size_t v = 0; v < n; ++v)
+      for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
+    if (!is_ref.empty()) {
+      ref.resize(n);
+      for (size_t v = 0; v < n; ++v) ref[v] = is_ref[base[v]];
+    }
+    ce = ConnectivityEncoding();
+    return part_connectivity(faces, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view);
+  };
   for (int round = 0; round < kCanonicalRounds; ++round) {
     Mesh decoded;
     GeometryLayout scratch;
     TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
     const Mesh& now = round == 0 ? mesh : coded;
-    if (decoded.indices == now.indices && decoded.face_offsets == now.face_offsets) {
+    if (same_faces(decoded, now)) {
       // Output vertex v as `now`'s vertex v, when every vertex is on a face
       // (a vertex on none is placed by its anchor, which the order found).
       std::vector<uint8_t> on_face(n, 0);
@@ -544,20 +576,36 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       }
       break;
     }
+    if (round > 0) coded_in.push_back(std::move(coded));
+    streams_of.push_back(ce.streams);
+    base_of.push_back(base);
+    // Back at a mesh coded in round i: the cycle is rounds i..round.
+    size_t i = 0;
+    while (i <= static_cast<size_t>(round) && !same_faces(decoded, i == 0 ? mesh : coded_in[i - 1])) ++i;
+    if (i <= static_cast<size_t>(round)) {
+      size_t best = i;
+      for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
+        if (streams_before(streams_of[k], streams_of[best])) best = k;
+      if (best != static_cast<size_t>(round)) {
+        base = base_of[best];
+        if (best == 0) {
+          base.clear();
+          ce = ConnectivityEncoding();
+          TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, tree, ce, view));
+        } else {
+          TSM_RETURN_IF_ERROR(code(coded_in[best - 1]));
+        }
+      } else {
+        base = base_of[best];
+      }
+      break;
+    }
     std::vector<uint32_t> next(n);
     for (size_t v = 0; v < n; ++v) next[v] = base.empty() ? ce.vertex_order[v] : base[ce.vertex_order[v]];
     base = std::move(next);
     coded = std::move(decoded);
     coded.positions.assign(3 * n, 0.0f);  // the coder reads the grid indices, not these
-    q.resize(3 * n);
-    for (size_t v = 0; v < n; ++v)
-      for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
-    if (!is_ref.empty()) {
-      ref.resize(n);
-      for (size_t v = 0; v < n; ++v) ref[v] = is_ref[base[v]];
-    }
-    ce = ConnectivityEncoding();
-    TSM_RETURN_IF_ERROR(part_connectivity(coded, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view));
+    TSM_RETURN_IF_ERROR(code(coded));
   }
   if (!base.empty())
     for (uint32_t& x : ce.vertex_order) x = base[x];  // back to the part's input ids
