@@ -3,11 +3,11 @@
 // §6) and code them in decoded vertex order, and lay the streams out as
 // container sections.
 #include <algorithm>
-#include <tuple>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 #include <unordered_map>
 #ifndef TSM_NO_THREADS
 #include <thread>
@@ -586,17 +586,14 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       size_t best = i;
       for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
         if (streams_before(streams_of[k], streams_of[best])) best = k;
-      if (best != static_cast<size_t>(round)) {
+      if (best != static_cast<size_t>(round)) {  // (else `ce` is it)
         base = base_of[best];
-        if (best == 0) {
-          base.clear();
+        if (best == 0) {  // the input itself (base empty)
           ce = ConnectivityEncoding();
           TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, tree, ce, view));
         } else {
           TSM_RETURN_IF_ERROR(code(coded_in[best - 1]));
         }
-      } else {
-        base = base_of[best];
       }
       break;
     }
