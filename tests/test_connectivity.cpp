@@ -370,6 +370,54 @@ TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
   EXPECT_EQ(checked, 400);
 }
 
+// Vertices on no face with several sharing their nearest surface vertex (the
+// anchor that orders them), coloured, at level 3 and up where small meshes
+// try every vertex tree: under the trees not chosen, a decoded mesh ordered
+// them by its own ids, coded otherwise, and another tree could win (found by
+// fuzz_roundtrip's canonical check). They are ordered by position now.
+TEST(Connectivity, VerticesOnNoFaceReencodeCanonicallyUnderTheRootSearch) {
+  std::mt19937 rng(99);
+  int checked = 0;
+  for (int iter = 0; iter < 24; ++iter) {
+    // A flat grid, and vertices on no face halfway between its vertices:
+    // equally near to two or four, so their anchor is the one of lowest
+    // output id, which differs from tree to tree.
+    Mesh m;
+    const int n = 4 + iter % 3;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) m.add_vertex(static_cast<float>(2 * x), static_cast<float>(2 * y), 0.0f);
+    for (int y = 0; y + 1 < n; ++y)
+      for (int x = 0; x + 1 < n; ++x) {
+        const uint32_t a = static_cast<uint32_t>(y * n + x), b = a + 1, c = a + static_cast<uint32_t>(n), d = c + 1;
+        m.add_triangle(a, b, d);
+        m.add_triangle(a, d, c);
+      }
+    for (int i = 0; i < 60; ++i)
+      m.add_vertex(static_cast<float>(rng() % (2 * n - 1)), static_cast<float>(rng() % (2 * n - 1)),
+                   static_cast<float>(rng() % 3));
+    Attribute color;
+    color.name = "color";
+    color.kind = AttributeKind::color;
+    color.type = AttributeType::u8;
+    color.components = 3;
+    for (size_t k = 0; k < 3 * m.vertex_count(); ++k) color.values.push_back(static_cast<float>(rng() % 256));
+    m.attributes.push_back(color);
+    for (int level : {3, 6, 9}) {
+      EncodeOptions eo;
+      eo.level = level;
+      eo.quantization_bits = 10 + iter % 11;
+      std::string bytes, again;
+      Mesh back;
+      ASSERT_TRUE(encode(m, eo, bytes).ok());
+      ASSERT_TRUE(decode(bytes, back).ok());
+      ASSERT_TRUE(encode(back, eo, again).ok());
+      EXPECT_TRUE(again == bytes) << "iteration " << iter << " level " << level << " q " << eo.quantization_bits;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 72);
+}
+
 TEST(Connectivity, CorpusRoundTrips) {
   TSM_REQUIRE_CORPUS();
   for (const auto& entry : std::filesystem::directory_iterator(corpus_dir() + "/edge")) {

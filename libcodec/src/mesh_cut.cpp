@@ -334,9 +334,16 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
     m.vertex_component[v] = m.vertex_component[r];
   }
   if (hints.root_rule > 0 && hints.qpos) root_by_position(m, on_triangle, *hints.qpos, hints.root_rule);
+  // Those of one anchor by position (then id): the order then follows ids
+  // only among vertices of one grid cell, so a decoded mesh (other ids)
+  // orders them alike under every vertex tree the encoder tries.
   if (isolated_key)
-    std::stable_sort(isolated.begin(), isolated.end(),
-                     [&](uint32_t a, uint32_t b) { return (*isolated_key)[a] < (*isolated_key)[b]; });
+    std::stable_sort(isolated.begin(), isolated.end(), [&](uint32_t a, uint32_t b) {
+      const uint32_t ka = (*isolated_key)[a], kb = (*isolated_key)[b];
+      if (ka != kb || !hints.qpos) return ka < kb;
+      const uint32_t *pa = &(*hints.qpos)[3 * size_t{m.source[a]}], *pb = &(*hints.qpos)[3 * size_t{m.source[b]}];
+      return std::lexicographical_compare(pa, pa + 3, pb, pb + 3);
+    });
   for (uint32_t v : isolated) {
     m.vertex_component[v] = static_cast<uint32_t>(m.component_root.size());
     m.component_root.push_back(v);
