@@ -4,9 +4,11 @@
 //   - polygons are fan-triangulated, their diagonals flagged (restored by
 //     one bit per marching edge, as MPEG-4's polygon-edge flags);
 //   - degenerate faces (fewer than 3 or repeated corners) go to a side list;
-//   - an edge is kept only when exactly two faces use it in opposite
-//     directions; all others (boundaries, non-manifold edges, edges whose
-//     faces disagree in orientation) are cut;
+//   - the uses of an edge are paired one each way: two faces in opposite
+//     directions are the usual manifold edge; more are sheets meeting at
+//     the edge, paired by their third corners' positions (a face not with
+//     its own reverse where another pairing avoids it); uses left over
+//     (boundaries, faces that disagree in orientation) are cut;
 //   - a vertex whose faces form several fans is split into one vertex per
 //     fan (duplicates, stitched back by the decoder);
 //   - each hole is closed by a virtual vertex and a fan of virtual triangles.
