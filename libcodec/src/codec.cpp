@@ -535,21 +535,15 @@ bool streams_before(const ConnectivityStreams& a, const ConnectivityStreams& b) 
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                               const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
-  TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, tree, ce, view));
-  if (tree.root_rule != 0) return Status::Ok();  // only tried on parts without stitches (encode_part)
-  if (ce.stats.stitches == 0) return Status::Ok();
   const size_t n = mesh.vertex_count();
   std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids (empty: the same)
   Mesh coded;                  // that mesh (faces only), once it is not `mesh`
   std::vector<uint32_t> q;
   std::vector<uint8_t> ref;
-  // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
-  // streams and its base.
-  std::vector<Mesh> coded_in;
-  std::vector<ConnectivityStreams> streams_of;
-  std::vector<std::vector<uint32_t>> base_of;
-  // Codes round r's mesh again (its ids -> input ids: `base`).
+  // Codes a mesh whose ids are the part's input ids through `base`.
   auto code = [&](const Mesh& faces) -> Status {
+    ce = ConnectivityEncoding();
+    if (base.empty()) return part_connectivity(faces, qin, is_ref, options, tree, ce, view);
     q.resize(3 * n);
     for (size_t v = 0; v < n; ++v)
       for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
@@ -557,9 +551,17 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       ref.resize(n);
       for (size_t v = 0; v < n; ++v) ref[v] = is_ref[base[v]];
     }
-    ce = ConnectivityEncoding();
     return part_connectivity(faces, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view);
   };
+  TSM_RETURN_IF_ERROR(code(mesh));
+  if (tree.root_rule != 0) return Status::Ok();  // only tried on parts without stitches (encode_part)
+  if (ce.stats.stitches == 0) return Status::Ok();
+  // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
+  // streams and its base.
+  std::vector<Mesh> coded_in;
+  std::vector<ConnectivityStreams> streams_of;
+  std::vector<std::vector<uint32_t>> base_of;
+  auto coded_by = [&](size_t r) -> const Mesh& { return r == 0 ? mesh : coded_in[r - 1]; };
   for (int round = 0; round < kCanonicalRounds; ++round) {
     Mesh decoded;
     GeometryLayout scratch;
@@ -581,19 +583,14 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     base_of.push_back(base);
     // Back at a mesh coded in round i: the cycle is rounds i..round.
     size_t i = 0;
-    while (i <= static_cast<size_t>(round) && !same_faces(decoded, i == 0 ? mesh : coded_in[i - 1])) ++i;
+    while (i <= static_cast<size_t>(round) && !same_faces(decoded, coded_by(i))) ++i;
     if (i <= static_cast<size_t>(round)) {
       size_t best = i;
       for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
         if (streams_before(streams_of[k], streams_of[best])) best = k;
       if (best != static_cast<size_t>(round)) {  // (else `ce` is it)
         base = base_of[best];
-        if (best == 0) {  // the input itself (base empty)
-          ce = ConnectivityEncoding();
-          TSM_RETURN_IF_ERROR(part_connectivity(mesh, qin, is_ref, options, tree, ce, view));
-        } else {
-          TSM_RETURN_IF_ERROR(code(coded_in[best - 1]));
-        }
+        TSM_RETURN_IF_ERROR(code(coded_by(best)));
       }
       break;
     }
