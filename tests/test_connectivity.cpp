@@ -47,6 +47,17 @@ ConnectivityStats stats_of(const Mesh& m) {
   return ce.stats;
 }
 
+// The property tests' undamaged meshes, drawn from rng: a small soup, a grid
+// with holes, a sphere or a surface of genus 0-2 (`kind` 0-3).
+Mesh random_base_mesh(std::mt19937& rng, int& kind) {
+  kind = static_cast<int>(rng() % 4);
+  if (kind == 0)
+    return random_soup(3 + static_cast<int>(rng() % 12), static_cast<int>(rng() % 20), static_cast<uint32_t>(rng()));
+  if (kind == 1) return grid_with_holes(3 + static_cast<int>(rng() % 5), static_cast<int>(rng() % 3));
+  if (kind == 2) return icosphere(static_cast<int>(rng() % 2));
+  return genus_surface(static_cast<int>(rng() % 3), 1);
+}
+
 }  // namespace
 
 TEST(Connectivity, Spheres) {
@@ -284,17 +295,8 @@ TEST(Connectivity, RandomSoups) {
 TEST(Connectivity, PropertyThousandsOfRandomMeshes) {
   std::mt19937 rng(12345);
   for (int iter = 0; iter < 2000; ++iter) {
-    Mesh m;
-    int kind = static_cast<int>(rng() % 4);
-    if (kind == 0) {
-      m = random_soup(3 + static_cast<int>(rng() % 12), static_cast<int>(rng() % 20), static_cast<uint32_t>(rng()));
-    } else if (kind == 1) {
-      m = grid_with_holes(3 + static_cast<int>(rng() % 5), static_cast<int>(rng() % 3));
-    } else if (kind == 2) {
-      m = icosphere(static_cast<int>(rng() % 2));
-    } else {
-      m = genus_surface(static_cast<int>(rng() % 3), 1);
-    }
+    int kind;
+    const Mesh m = random_base_mesh(rng, kind);
     // Random damage: drop, flip, duplicate faces; add polygons and strays.
     Mesh d;
     d.positions = m.positions;
@@ -330,17 +332,8 @@ TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
   std::mt19937 rng(777);
   int checked = 0;
   for (int iter = 0; iter < 400; ++iter) {
-    Mesh m;
-    const int kind = static_cast<int>(rng() % 4);
-    if (kind == 0) {
-      m = random_soup(3 + static_cast<int>(rng() % 12), static_cast<int>(rng() % 20), static_cast<uint32_t>(rng()));
-    } else if (kind == 1) {
-      m = grid_with_holes(3 + static_cast<int>(rng() % 5), static_cast<int>(rng() % 3));
-    } else if (kind == 2) {
-      m = icosphere(static_cast<int>(rng() % 2));
-    } else {
-      m = genus_surface(static_cast<int>(rng() % 3), 1);
-    }
+    int kind;
+    const Mesh m = random_base_mesh(rng, kind);
     std::vector<std::vector<uint32_t>> faces;
     for (size_t f = 0; f < m.face_count(); ++f) {
       std::vector<uint32_t> c(m.face(f), m.face(f) + m.face_size(f));
