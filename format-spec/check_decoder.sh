@@ -98,6 +98,8 @@ for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
 for q in 11 16; do check box_q$q "$work/box.obj" $q 6; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50
+for l in 0 6; do check double_sided_l$l "$work/double_sided.obj" 12 $l; done  # version 11: stitch targets by candidates
+check double_sided_segments "$work/double_sided.obj" 12 6 300
 for l in 1 2; do check mixed_l$l "$work/mixed.obj" 16 $l; done  # levels 1-2 where the gate still wins (its planes)
 dragon=$corpus/dragon_vrip_res4.ply
 for l in 0 1 2 6 9; do corpus_case check dragon_l$l "$dragon" 11 $l; done

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 to 9), written from
+"""An independent decoder for .tsm files (format versions 3 to 11), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -134,7 +134,7 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6, 7, 8, 9, 10):
+    if version not in (3, 4, 5, 6, 7, 8, 9, 10, 11):
         raise Unsupported('version %d' % version)                   # step 3
     if flags != 0:
         reject('flags')                                             # step 4
@@ -654,6 +654,73 @@ def triangle_walk(L, root, march, branch, loop, n, read_bit):
 
 # ---------------------------------------------------------------- §8.3 connectivity
 
+def stitch_targets_by_candidates(nstitch, P, tri, twin, virtual, stitch_to, run_value,
+                                 o_position, o_distance, o_rank, do, overrun):
+    """§8.3.2 (version 11): every stitch position, then each target by its
+    rank among the candidates (or, rank 0, as a distance)."""
+    stitched = [0] * P
+    at_list = []
+    at = 0
+    for i in range(nstitch):
+        d = run_value(o_position, do, 6)
+        if overrun() or at + d >= P or (i > 0 and d == 0):
+            reject('stitch position')
+        at += d
+        stitched[at] = 1
+        at_list.append(at)
+    first_he = [NONE] * P                  # the last half-edge in decode order leaving p
+    for h, x in enumerate(tri):
+        if x < P:
+            first_he[x] = h
+
+    def ring(p):                           # at most 16 heads of half-edges leaving p
+        out = []
+        h0 = h = first_he[p]
+        for _ in range(16):
+            if h >= len(tri):
+                break
+            t = h - h % 3
+            out.append(tri[t + (h % 3 + 1) % 3])
+            h = twin[t + (h % 3 + 2) % 3]
+            if h == h0:
+                break
+        return out
+
+    def vertex(n, d):                      # the vertex position n stands for, seen from stitch d
+        if n >= P or virtual[n]:
+            return NONE
+        if not stitched[n]:
+            return n
+        return stitch_to[n] if n < d else NONE
+
+    for d in at_list:
+        known = [r for r in (vertex(n, d) for n in ring(d)) if r != NONE]
+        near = set(known)
+        votes = {}
+        for r in known:
+            for x in ring(r):
+                c = vertex(x, d)
+                if c != NONE and c < d and c not in near:
+                    votes[c] = votes.get(c, 0) + 1
+        ranked = sorted(votes, key=lambda c: (-votes[c], -c))
+        ctx = 1 if ranked and votes[ranked[0]] >= 3 else 0
+        rank = o_rank[ctx].decode(do)
+        if overrun() or rank == INVALID:
+            reject('stitch target rank')
+        if rank == 0:
+            dist = run_value(o_distance, do, 7)
+            if dist >= d:
+                reject('stitch target')
+            t = d - dist - 1
+        else:
+            if rank > len(ranked):
+                reject('stitch target rank')
+            t = ranked[rank - 1]
+        if virtual[t] or stitched[t]:
+            reject('stitch to a vertex without position')
+        stitch_to[d] = t
+
+
 def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, version=4):
     tables = rbits = None
     if version >= 9:                                        # §8.3.1: the mode byte
@@ -684,6 +751,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, vers
     t_bit = probs(8 * 8 * 3 * 9)   # bit[va][vb][prev][vr][vl] at ((8 va + vb) 3 + prev) 9 + 3 vr + vl
     t_diag = probs(2)
     o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
+    o_rank = [UIntModel(), UIntModel()]                      # §8.3.2 (version 11)
     o_has_poly = probs(1)
 
     def overrun():
@@ -840,15 +908,19 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, vers
         reject('stitch count')
     stitch_to = [NONE] * P
     at = 0
-    for i in range(nstitch):
-        d = run_value(o_position, do, 6)
-        dist = run_value(o_distance, do, 7)
-        if overrun() or at + d >= P or (i > 0 and d == 0):
-            reject('stitch position')
-        at += d
-        if dist >= at:
-            reject('stitch target')
-        stitch_to[at] = at - dist - 1
+    if version < 11:
+        for i in range(nstitch):
+            d = run_value(o_position, do, 6)
+            dist = run_value(o_distance, do, 7)
+            if overrun() or at + d >= P or (i > 0 and d == 0):
+                reject('stitch position')
+            at += d
+            if dist >= at:
+                reject('stitch target')
+            stitch_to[at] = at - dist - 1
+    elif nstitch > 0:
+        stitch_targets_by_candidates(nstitch, P, tri, twin, virtual, stitch_to, run_value,
+                                     o_position, o_distance, o_rank, do, overrun)
     # §8.7 numbering
     ids = [NONE] * P
     nxt = 0

@@ -113,6 +113,13 @@ def sphere_rings(v, n_, m_):
     return ring
 
 
+def double_sided(V, F):
+    """Every face also given reversed on the same vertices (as exporters
+    write thin geometry): one stitch per vertex, coded by candidates
+    (version 11, §8.3.2)."""
+    return V, [list(f) for f in F] + [list(f[::-1]) for f in F]
+
+
 def mixed(n_=30, m_=60):
     V, F = [], []
 
@@ -662,6 +669,7 @@ def main():
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
     write_obj(os.path.join(out, 'fan.obj'), *fan())
     write_obj(os.path.join(out, 'box.obj'), *box())
+    write_obj(os.path.join(out, 'double_sided.obj'), *double_sided(*mixed(16, 30)))
     unused_vt(os.path.join(out, 'unused_vt.obj'))
     attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))

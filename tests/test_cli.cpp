@@ -244,7 +244,7 @@ TEST_F(Cli, BadArgumentsExitTwo) {
         "encode " + q("in.ply") + " --no-such-flag", "encode", "decode", "info",
         "encode " + q("in.ply") + " " + q("extra.ply"), "bench " + q("in.ply") + " --runs 0",
         "bench " + q("in.ply") + " -q 40", "decode " + q("in.ply") + " --max-vertices x",
-        "encode " + q("in.ply") + " --format-version 3", "encode " + q("in.ply") + " --format-version 11"}) {
+        "encode " + q("in.ply") + " --format-version 3", "encode " + q("in.ply") + " --format-version 12"}) {
     Result r = tsm(args);
     EXPECT_EQ(r.code, 2) << "tsm " << args << "\n" << r.out << r.err;
     EXPECT_FALSE(r.err.empty() && r.out.empty()) << "tsm " << args << ": says nothing";

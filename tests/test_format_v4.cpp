@@ -176,8 +176,8 @@ TEST(FormatV4, VersionRulesForSectionsAndPredictors) {
   with_unknown.push_back({tsm::kSectionMesh, "anything"});
   EXPECT_EQ(decode_ok(rebuild(v4, 3, with_unknown)).indices, decode_ok(v4).indices);
   EXPECT_EQ(decode_code(rebuild(v4, 3, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
-  // Version 11 is not read.
-  EXPECT_EQ(decode_code(rebuild(v4, 11, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
+  // Version 12 is not read.
+  EXPECT_EQ(decode_code(rebuild(v4, 12, {{tsm::kSectionMesh, mesh}})), tsm::ErrorCode::unsupported);
   // A mesh section whose stream lengths run past its end.
   EXPECT_EQ(decode_code(rebuild(v4, 4, {{tsm::kSectionMesh, std::string("\x05\x00\x00\x00\x01", 5)}})),
             tsm::ErrorCode::corrupt_data);
@@ -489,8 +489,13 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
       const bool irregular = name.rfind("irregular", 0) == 0;
       // Level 2 says version 10 where its fan predictor wins (FormatV10
       // below): asked for version 9 here, the file it wrote before.
+      // Level 0 with stitches says version 11 (its stitch targets by
+      // candidates, FormatV11 below), where they make the file smaller.
       const std::string v9 = encode_as(m, 12, level, level == 0 ? 0 : 9);
-      EXPECT_EQ(version_of(v9), 9u);
+      tsm::FileInfo fi;
+      ASSERT_TRUE(tsm::inspect(v9, fi).ok());
+      const bool v11 = version_of(v9) == 11;
+      EXPECT_TRUE(version_of(v9) == 9 || (v11 && level == 0 && fi.stitches > 0)) << version_of(v9);
       EXPECT_EQ(topology_of(v9).substr(0, 1), std::string(1, irregular ? '\x01' : '\0'));
       EXPECT_EQ(run_table_parts(v9), irregular ? 1u : 0u);
       expect_round_trip(m, v9, 12, name);
@@ -501,6 +506,8 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
       // Tables cost a few percent of the file at most; mode 0 one byte.
       if (irregular)
         EXPECT_LT(v9.size(), v8.size() * 104 / 100) << v8.size() << " -> " << v9.size();
+      else if (v11)
+        EXPECT_LE(v9.size(), v8.size()) << v8.size() << " -> " << v9.size();
       else
         EXPECT_EQ(v9.size(), v8.size() + 1);
     }
@@ -531,7 +538,7 @@ TEST(FormatV9, RunTablesAtTheFastLevels) {
   const Mesh grid = tsm_test::irregular_grid(60, 4);
   for (uint32_t faces : {4000u, 300u}) {
     const std::string seg = encode_as(grid, 14, 0, 0, faces);
-    EXPECT_EQ(version_of(seg), 9u);
+    EXPECT_EQ(version_of(seg), 11u);  // 9, but its bowtie vertices' stitches pay by candidates (version 11)
     if (faces > 1000) {
       EXPECT_GE(run_table_parts(seg), 1u);
     }
@@ -621,7 +628,7 @@ TEST(FormatV9, AttributeTablesAtTheFastLevels) {
   for (int level : {0, 2}) {
     SCOPED_TRACE("level " + std::to_string(level));
     const std::string v9 = encode_as(m, 12, level, 0), v8 = encode_as(m, 12, level, 8);
-    EXPECT_EQ(version_of(v9), 9u);
+    EXPECT_EQ(version_of(v9), 11u);  // 9, but the grid's bowtie vertices' stitches pay by candidates
     EXPECT_EQ(table_coded_attributes(v9), 3u);  // noise, rgb, label
     EXPECT_EQ(table_coded_attributes(v8), 0u);
     expect_round_trip(m, v9, 12, "attribute tables");
@@ -742,4 +749,43 @@ TEST(FormatV10, FanPredictorAtLevels1And2) {
   EXPECT_EQ(version_of(seg), 10u);
   expect_round_trip(smooth, seg, 12, "fan in segments");
   EXPECT_TRUE(encode_as(decode_ok(seg), 12, 1, 0, 3000) == seg);
+}
+
+// Version 11 (FORMAT.md §8.3.2): stitch targets by their rank among
+// candidates (neighbours of the stitched vertex's known neighbours), written
+// where that makes the file smaller; the mesh decoded is the same.
+TEST(FormatV11, StitchTargetsByCandidates) {
+  auto double_sided = [](Mesh m) {
+    const size_t nf = m.face_count();
+    for (size_t f = 0; f < nf; ++f) m.add_triangle(m.face(f)[0], m.face(f)[2], m.face(f)[1]);
+    return m;
+  };
+  const Mesh sphere = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
+  const std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"double-sided sphere", double_sided(sphere)},
+      {"double-sided grid with holes", double_sided(tsm_test::grid_with_holes(30, 5))},
+      {"books", tsm_test::copies(tsm_test::book(6), 50)},
+  };
+  for (const auto& [name, m] : meshes)
+    for (int level : {0, 6})
+      for (uint32_t segment_faces : {0u, 2000u}) {
+        SCOPED_TRACE(name + ", level " + std::to_string(level) + ", segments of " + std::to_string(segment_faces));
+        const std::string v11 = encode_as(m, 12, level, 0, segment_faces);
+        const std::string v10 = encode_as(m, 12, level, 10, segment_faces);
+        tsm::FileInfo a, b;
+        ASSERT_TRUE(tsm::inspect(v11, a).ok() && tsm::inspect(v10, b).ok());
+        EXPECT_EQ(version_of(v11), 11u);
+        EXPECT_GT(a.stitches, 0u);
+        EXPECT_EQ(a.stitches, b.stitches);
+        EXPECT_LT(a.connectivity_bytes, b.connectivity_bytes);
+        if (name.rfind("double", 0) == 0) {  // nearly every stitch's target is the first candidate
+          EXPECT_LT(10 * a.connectivity_bytes, 7 * b.connectivity_bytes) << b.connectivity_bytes << " -> " << a.connectivity_bytes;
+        }
+        expect_round_trip(m, v11, 12, name);
+        const Mesh x = decode_ok(v11), y = decode_ok(v10);
+        EXPECT_TRUE(x.indices == y.indices && x.positions == y.positions);
+        EXPECT_TRUE(encode_as(x, 12, level, 0, segment_faces) == v11);
+      }
+  // Without stitches nothing changes: the version-8 layout.
+  EXPECT_LE(version_of(encode_as(sphere, 12, 6, 0)), 8u);
 }

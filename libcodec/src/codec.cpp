@@ -123,6 +123,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   cs.triangle_tree.assign(s.triangle_tree);
   cs.topology.assign(s.topology);
   cs.mode_byte = s.version >= 9;
+  cs.stitch_candidates = s.version >= kCandidateVersion;
   GeometryLayout layout;
   const PartCounts& c = out.counts;
   TSM_RETURN_IF_ERROR(
@@ -356,6 +357,7 @@ bool attribute_tables(const PartOptions& options) { return options.mode_byte && 
 
 uint16_t needed_version(const ConnectivityStreams& streams, const std::string& geometry) {
   const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
+  if (streams.stitch_candidates) return kCandidateVersion;
   if ((kind & 7) == static_cast<uint8_t>(Predictor::fan)) return kFanVersion;
   if (streams.mode_byte) return 9;
   return kind & kTableFlag ? 8 : kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
@@ -371,6 +373,7 @@ int geometry_version(const PartOptions& options) {
 // Encoder: one part (the whole mesh or a segment) coded.
 struct EncodedPart {
   ConnectivityStreams streams;
+  std::string candidate_topology;  // ConnectivityEncoding::candidate_topology
   std::string geometry;
   std::string attributes;
   std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
@@ -655,6 +658,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
+  out.candidate_topology = std::move(ce.candidate_topology);
   if (!headers.empty() && is_ref.empty())  // a whole mesh: its attributes now
     TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, attribute_tables(options), out));
   return Status::Ok();
@@ -729,6 +733,7 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
       best = size;
       // What encode_part_from fills (the caller's other fields stay).
       out.streams = std::move(alt.streams);
+      out.candidate_topology = std::move(alt.candidate_topology);
       out.geometry = std::move(alt.geometry);
       out.attributes = std::move(alt.attributes);
       out.order = std::move(alt.order);
@@ -854,6 +859,32 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
   return out;
 }
 
+// Version 11 (FORMAT.md §8.3.2): stitch targets by their rank among
+// candidates instead of as distances. Every part of a file has the mode
+// byte or none, so the parts take their version-11 topology streams (and
+// those without stitches the mode byte) only when that makes the file
+// smaller, and only where version 11 may be written. Decided on the coded
+// streams, which a decoded mesh codes alike: canonical.
+void take_candidate_stitches(const EncodeOptions& options, std::vector<EncodedPart*> parts) {
+  if (written_version(options) < kCandidateVersion) return;
+  int64_t gain = 0;
+  for (const EncodedPart* p : parts) {
+    if (!p->candidate_topology.empty())
+      gain += static_cast<int64_t>(p->streams.topology.size()) - static_cast<int64_t>(p->candidate_topology.size());
+    else if (!p->streams.mode_byte)
+      gain -= 1;
+  }
+  if (gain <= 0) return;
+  for (EncodedPart* p : parts) {
+    if (!p->candidate_topology.empty())
+      p->streams.topology = std::move(p->candidate_topology);
+    else if (!p->streams.mode_byte)
+      p->streams.topology.insert(0, 1, '\0');
+    p->streams.mode_byte = true;
+    p->streams.stitch_candidates = true;
+  }
+}
+
 // The segmented file's parts: each segment's mesh with its own vertex ids
 // (the vertices its faces use, the last one also the vertices on no face,
 // numbered by canonical_part_order), coded in parallel; then the
@@ -906,6 +937,11 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
     parts[k].part = std::move(part);
   });
+  {
+    std::vector<EncodedPart*> all;
+    for (EncodedPart& p : parts) all.push_back(&p);
+    take_candidate_stitches(options, all);
+  }
   // Per corner attribute, per value of the mesh: its id in the file's value
   // list once a segment has added it.
   std::vector<std::vector<uint32_t>> value_id(mesh.attributes.size());
@@ -1030,6 +1066,7 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   if (segments.size() == 1) {
     EncodedPart p;
     TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, po, p));
+    take_candidate_stitches(options, {&p});
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
     needed = needed_version(p.streams, p.geometry);

@@ -43,7 +43,110 @@ struct TriangleTreeModels {
 
 struct TopologyModels {
   UIntModel count, corner, partner, position, distance, face_size, index;
+  // Version 11: a stitch target's candidate rank + 1 (0: its distance
+  // follows), by StitchCandidates::context.
+  UIntModel rank[2];
   Prob has_polygons;
+};
+
+// Version 11 (FORMAT.md §8.3.2): the candidates for a stitch's target. A
+// stitched position d is a copy of a vertex T; each of d's neighbours in
+// the cut surface whose vertex is known (a position not stitched, or one
+// stitched before d: its target) is a neighbour of T in the mesh, so T is
+// usually a neighbour, in the cut surface, of those vertices: the
+// candidates (positions before d; the neighbours' vertices themselves
+// excluded), ranked by how many of them propose each (votes), ties by
+// position, the later first. Encoder and decoder run it on the same cut
+// surface (triangle corners as pre-order positions and twins, in decode
+// order); at most kRing neighbours per position keep hostile files linear.
+class StitchCandidates {
+ public:
+  static constexpr uint32_t kRing = 16;
+  StitchCandidates(const std::vector<uint32_t>& corner, const std::vector<uint32_t>& twin,
+                   const std::vector<uint8_t>& is_virtual, const std::vector<uint8_t>& stitched,
+                   const std::vector<uint32_t>& target)
+      : corner_(corner), twin_(twin), virtual_(is_virtual), stitched_(stitched), target_(target) {
+    const size_t P = is_virtual.size();
+    first_he_.assign(P, kNone);
+    for (size_t h = 0; h < corner.size(); ++h)
+      if (corner[h] < P) first_he_[corner[h]] = static_cast<uint32_t>(h);  // the last one in decode order
+    stamp_.assign(P, kNone);
+    near_.assign(P, kNone);
+    votes_.assign(P, 0);
+  }
+  // Gathers the candidates for the stitch at position d, each as a key
+  // (votes << 32 | position: distinct, the larger the better).
+  void gather(uint32_t d) {
+    keys_.clear();
+    ring(d, [&](uint32_t n) {
+      const uint32_t r = vertex(n, d);
+      if (r != kNone) near_[r] = d;
+    });
+    ring(d, [&](uint32_t n) {
+      const uint32_t r = vertex(n, d);
+      if (r == kNone) return;
+      ring(r, [&](uint32_t x) {
+        const uint32_t c = vertex(x, d);
+        if (c == kNone || c >= d || near_[c] == d) return;
+        if (stamp_[c] != d) {
+          stamp_[c] = d;
+          votes_[c] = 0;
+          keys_.push_back(c);
+        }
+        ++votes_[c];
+      });
+    });
+    for (uint64_t& k : keys_) k |= uint64_t{votes_[k]} << 32;
+  }
+  // The rank's model: 1 when the best candidate has 3 votes or more.
+  int context() const {
+    uint64_t best = 0;
+    for (uint64_t k : keys_) best = std::max(best, k);
+    return (best >> 32) >= 3 ? 1 : 0;
+  }
+  // Encoder: the rank + 1 of position c among the candidates, 0 if not one.
+  uint32_t rank_of(uint32_t c) const {
+    const auto it = std::find_if(keys_.begin(), keys_.end(), [c](uint64_t k) { return static_cast<uint32_t>(k) == c; });
+    if (it == keys_.end()) return 0;
+    const uint64_t key = *it;
+    return 1 + static_cast<uint32_t>(std::count_if(keys_.begin(), keys_.end(), [key](uint64_t k) { return k > key; }));
+  }
+  // Decoder: the candidate of rank + 1 `r`, kNone if there is none.
+  uint32_t at_rank(uint32_t r) {
+    if (r == 0 || r > keys_.size()) return kNone;
+    std::nth_element(keys_.begin(), keys_.begin() + (r - 1), keys_.end(), std::greater<uint64_t>());
+    return static_cast<uint32_t>(keys_[r - 1]);
+  }
+
+ private:
+  // The vertex position n stands for as seen from stitch d: itself, or the
+  // target of a stitch before d; kNone when not known or virtual.
+  uint32_t vertex(uint32_t n, uint32_t d) const {
+    if (n >= virtual_.size() || virtual_[n]) return kNone;
+    if (!stitched_[n]) return n;
+    return n < d ? target_[n] : kNone;
+  }
+  // Calls f with the heads of the half-edges leaving p, turning from the
+  // last one in decode order (next edge out: the twin of the previous
+  // half-edge of its triangle), at most kRing, until back at the first.
+  template <class F>
+  void ring(uint32_t p, F f) const {
+    const uint32_t h0 = p < first_he_.size() ? first_he_[p] : kNone;
+    uint32_t h = h0;
+    for (uint32_t i = 0; i < kRing && h < corner_.size(); ++i) {
+      const uint32_t t = h - h % 3;
+      f(corner_[t + (h % 3 + 1) % 3]);
+      h = twin_[t + (h % 3 + 2) % 3];
+      if (h == h0) break;
+    }
+  }
+  const std::vector<uint32_t>& corner_;
+  const std::vector<uint32_t>& twin_;
+  const std::vector<uint8_t>& virtual_;
+  const std::vector<uint8_t>& stitched_;
+  const std::vector<uint32_t>& target_;
+  std::vector<uint32_t> first_he_, stamp_, near_, votes_;
+  std::vector<uint64_t> keys_;
 };
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
@@ -262,27 +365,61 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     }
   }
 
-  om.count.encode(eo, static_cast<uint32_t>(virtual_pos.size()));
-  uint32_t prev = 0;
-  for (uint32_t p : virtual_pos) {
-    runs.put(eo, om.position, kRunPositionCtx, p - prev);
-    prev = p;
-  }
-  om.count.encode(eo, static_cast<uint32_t>(stitches.size()));
-  prev = 0;
-  for (auto [dup, orig] : stitches) {
-    runs.put(eo, om.position, kRunPositionCtx, dup - prev);
-    runs.put(eo, om.distance, kRunDistanceCtx, dup - orig - 1);
-    prev = dup;
-  }
-  // Side faces, corners as output vertex ids.
+  // The rest of the topology stream: virtual vertices, stitches, side
+  // faces. With stitches it is coded twice from here: as versions up to 10
+  // code it (targets as distances) and as version 11 does (targets by
+  // candidates, FORMAT.md §8.3.2), from copies of the coder and models.
   std::vector<uint32_t> input_to_out(mesh.vertex_count());
   for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
-  om.count.encode(eo, static_cast<uint32_t>(prep.side_faces.size()));
-  for (uint32_t face : prep.side_faces) {
-    om.face_size.encode(eo, mesh.face_size(face));
-    for (uint32_t i = 0; i < mesh.face_size(face); ++i) om.index.encode(eo, input_to_out[mesh.face(face)[i]]);
+  auto code_tail = [&](RangeEncoder& e, TopologyModels& o, RunEncoder& r, bool candidates) {
+    o.count.encode(e, static_cast<uint32_t>(virtual_pos.size()));
+    uint32_t prev = 0;
+    for (uint32_t p : virtual_pos) {
+      r.put(e, o.position, kRunPositionCtx, p - prev);
+      prev = p;
+    }
+    o.count.encode(e, static_cast<uint32_t>(stitches.size()));
+    prev = 0;
+    for (auto [dup, orig] : stitches) {
+      r.put(e, o.position, kRunPositionCtx, dup - prev);
+      if (!candidates) r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
+      prev = dup;
+    }
+    if (candidates) {
+      std::vector<uint32_t> cpos(g.corner.size()), target(P, kNone);
+      for (size_t k = 0; k < dec_tri.size(); ++k)
+        for (uint32_t c = 0; c < 3; ++c)
+          cpos[3 * k + c] = pos_of[m.tri[3 * dec_tri[k] + (rot[dec_tri[k]] + c) % 3]];
+      std::vector<uint8_t> is_virtual(P, 0), stitched(P, 0);
+      for (uint32_t p : virtual_pos) is_virtual[p] = 1;
+      for (auto [dup, orig] : stitches) stitched[dup] = 1;
+      StitchCandidates sc(cpos, g.twin, is_virtual, stitched, target);
+      for (auto [dup, orig] : stitches) {
+        sc.gather(dup);
+        const uint32_t rank = sc.rank_of(orig);
+        o.rank[sc.context()].encode(e, rank);
+        if (rank == 0) {
+          r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
+        }
+        target[dup] = orig;
+      }
+    }
+    // Side faces, corners as output vertex ids.
+    o.count.encode(e, static_cast<uint32_t>(prep.side_faces.size()));
+    for (uint32_t face : prep.side_faces) {
+      o.face_size.encode(e, mesh.face_size(face));
+      for (uint32_t i = 0; i < mesh.face_size(face); ++i) o.index.encode(e, input_to_out[mesh.face(face)[i]]);
+    }
+  };
+  RangeEncoder eo2;
+  TopologyModels om2;
+  RunEncoder runs2;
+  if (!stitches.empty()) {
+    eo2 = eo;
+    om2 = om;
+    runs2 = runs;
   }
+  code_tail(eo, om, runs, false);
   st.components = C;
   st.virtual_vertices = virtual_pos.size();
   st.stitches = stitches.size();
@@ -308,6 +445,10 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     }
     out.streams.mode_byte = true;
     out.streams.topology = block + out.streams.topology;
+  }
+  if (!stitches.empty()) {  // version 11: the mode byte always (adaptive without tables)
+    code_tail(eo2, om2, runs2, true);
+    out.candidate_topology = (runs2.tables ? runs2.block() : std::string(1, '\0')) + eo2.finish();
   }
   st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
   return Status::Ok();
@@ -521,13 +662,42 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (nstitch > P) return corrupt("more stitches than vertices");
   std::vector<uint32_t> stitch_to(P, kNone);
   at = 0;
-  for (uint32_t i = 0; i < nstitch; ++i) {
-    const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-    const uint32_t dist = run_value(om.distance, dop, kRunDistanceCtx);
-    if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
-    at += d;
-    if (dist >= at) return corrupt("stitch target out of range");
-    stitch_to[at] = at - dist - 1;
+  if (!in.stitch_candidates) {
+    for (uint32_t i = 0; i < nstitch; ++i) {
+      const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
+      const uint32_t dist = run_value(om.distance, dop, kRunDistanceCtx);
+      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
+      at += d;
+      if (dist >= at) return corrupt("stitch target out of range");
+      stitch_to[at] = at - dist - 1;
+    }
+  } else if (nstitch > 0) {  // version 11 (§8.3.2): every position, then every target
+    std::vector<uint8_t> stitched(P, 0);
+    std::vector<uint32_t> at_list(nstitch);
+    for (uint32_t i = 0; i < nstitch; ++i) {
+      const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
+      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
+      at += d;
+      stitched[at] = 1;
+      at_list[i] = at;
+    }
+    StitchCandidates sc(corner, twin, is_virtual, stitched, stitch_to);
+    for (uint32_t d : at_list) {
+      sc.gather(d);
+      const uint32_t rank = om.rank[sc.context()].decode(dop);
+      if (overrun() || rank == 0xFFFFFFFFu) return corrupt("stitch target rank out of range");
+      uint32_t t;
+      if (rank == 0) {
+        const uint32_t dist = run_value(om.distance, dop, kRunDistanceCtx);
+        if (dist >= d) return corrupt("stitch target out of range");
+        t = d - dist - 1;
+      } else {
+        t = sc.at_rank(rank);
+        if (t == kNone) return corrupt("stitch target rank out of range");
+      }
+      if (is_virtual[t] || stitched[t]) return corrupt("stitch to a vertex that carries no position");
+      stitch_to[d] = t;
+    }
   }
   uint32_t next_id = 0;
   for (uint32_t p = 0; p < P; ++p) {

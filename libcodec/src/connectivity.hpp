@@ -288,6 +288,10 @@ struct ConnectivityStreams {
   // Version 9 and later: the topology stream starts with the run coding's
   // mode byte (0 adaptive, 1 tables; FORMAT.md §8.3.1).
   bool mode_byte = false;
+  // Version 11 and later (implies mode_byte): the topology stream lists all
+  // stitch positions first, then each target by its rank among candidates
+  // (FORMAT.md §8.3.2).
+  bool stitch_candidates = false;
 };
 
 struct ConnectivityEncoding {
@@ -297,6 +301,10 @@ struct ConnectivityEncoding {
   // The cut surface as the decoder will rebuild it, for the geometry coder.
   GeometryLayout layout;
   ConnectivityStats stats;
+  // With stitches: the topology stream as version 11 codes it (with the mode
+  // byte, stitch targets by candidates; the rest of the streams unchanged),
+  // for the file to take when it pays (codec.cpp). Empty without stitches.
+  std::string candidate_topology;
   bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
 };
 

@@ -11,8 +11,9 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 10;       // what the encoder writes
-constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 9
+constexpr uint16_t kFormatVersion = 11;       // what the encoder writes
+constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 11
+constexpr uint16_t kCandidateVersion = 11;    // stitch targets by candidates (FORMAT.md §8.3.2)
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder
