@@ -788,4 +788,37 @@ TEST(FormatV11, StitchTargetsByCandidates) {
       }
   // Without stitches nothing changes: the version-8 layout.
   EXPECT_LE(version_of(encode_as(sphere, 12, 6, 0)), 8u);
+  // Asked for version 11: the file says 11, so its stitches are coded by
+  // candidates even where distances would be smaller (a random soup).
+  const Mesh soup = tsm_test::random_soup(40, 60, 3);
+  const std::string s11 = encode_as(soup, 12, 6, 11), s10 = encode_as(soup, 12, 6, 10);
+  EXPECT_EQ(version_of(s11), 11u);
+  expect_round_trip(soup, s11, 12, "soup as version 11");
+  EXPECT_TRUE(decode_ok(s11).indices == decode_ok(s10).indices);
+}
+
+// Every version the encoder may be asked for writes a file that says that
+// version, decodes to the quantized mesh and re-encodes to its own bytes,
+// on meshes with stitches, holes and handles.
+TEST(FormatV11, EveryAskedForVersionRoundTrips) {
+  Mesh double_sided = tsm_test::icosphere(2);
+  for (size_t f = 0, n = double_sided.face_count(); f < n; ++f)
+    double_sided.add_triangle(double_sided.face(f)[0], double_sided.face(f)[2], double_sided.face(f)[1]);
+  const std::vector<std::pair<std::string, Mesh>> meshes = {
+      {"soup", tsm_test::random_soup(40, 60, 3)},
+      {"books", tsm_test::copies(tsm_test::book(6), 10)},
+      {"double-sided sphere", double_sided},
+      {"irregular grid", tsm_test::irregular_grid(20, 3)},
+      {"grid with holes", tsm_test::grid_with_holes(12, 3)},
+      {"genus 2", tsm_test::genus_surface(2)},
+  };
+  for (const auto& [name, m] : meshes)
+    for (int version = 4; version <= tsm::kFormatVersion; ++version)
+      for (int level : {0, 2, 6}) {
+        SCOPED_TRACE(name + ", version " + std::to_string(version) + ", level " + std::to_string(level));
+        const std::string bytes = encode_as(m, 12, level, version);
+        EXPECT_EQ(version_of(bytes), static_cast<uint32_t>(version));
+        expect_round_trip(m, bytes, 12, name);
+        EXPECT_TRUE(encode_as(decode_ok(bytes), 12, level, version) == bytes);
+      }
 }

@@ -863,8 +863,9 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // candidates instead of as distances. Every part of a file has the mode
 // byte or none, so the parts take their version-11 topology streams (and
 // those without stitches the mode byte) only when that makes the file
-// smaller, and only where version 11 may be written. Decided on the coded
-// streams, which a decoded mesh codes alike: canonical.
+// smaller, and only where version 11 may be written; always when version
+// 11 is asked for (the file says 11, so its stitches must be read so).
+// Decided on the coded streams, which a decoded mesh codes alike: canonical.
 void take_candidate_stitches(const EncodeOptions& options, std::vector<EncodedPart*> parts) {
   if (written_version(options) < kCandidateVersion) return;
   int64_t gain = 0;
@@ -874,7 +875,7 @@ void take_candidate_stitches(const EncodeOptions& options, std::vector<EncodedPa
     else if (!p->streams.mode_byte)
       gain -= 1;
   }
-  if (gain <= 0) return;
+  if (gain <= 0 && options.format_version < kCandidateVersion) return;
   for (EncodedPart* p : parts) {
     if (!p->candidate_topology.empty())
       p->streams.topology = std::move(p->candidate_topology);
