@@ -35,11 +35,14 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (9; the file says the oldest
-  // version that reads it: 5 unless it uses residual mixing, 6, lattice
-  // planes coded from the top, 7, residuals through tables, 8, or the
+  // The format version to write: 0 = the newest (11; the file says the
+  // oldest version that reads it: 5 unless it uses residual mixing, 6,
+  // lattice planes coded from the top, 7, residuals through tables, 8, the
   // connectivity's run values through tables, which levels 0-2 use on
-  // meshes of 256 faces or more, 9); 8 writes files that decoders of
+  // meshes of 256 faces or more, 9, the fan predictor of levels 1-2, 10,
+  // or stitch targets by candidates, where a non-manifold mesh's stitches
+  // cost less so, 11); 10 writes files that decoders of version 10 read
+  // (stitch targets as distances); 9 without the fan predictor; 8 writes files that decoders of
   // version 8 read (levels 0-2 then code run values adaptively); 7 files
   // that decoders of version 7 read (levels 0-2 then code residuals
   // adaptively too: slower to decode); 6 or 5 write files that decoders of that
