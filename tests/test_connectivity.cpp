@@ -324,6 +324,28 @@ TEST(Connectivity, PropertyThousandsOfRandomMeshes) {
   }
 }
 
+// A tangle whose canonical rounds settle only after 20 (grids with faces
+// reversed, dropped, welded and added between random vertices: 325 faces on
+// 16 vertices, found by a review's random meshes). With the rounds capped at
+// 16 the encoder kept round 15's coding, and the decoded mesh, further along
+// the same sequence, re-encoded to other bytes. Small parts now get up to
+// 256 rounds (codec.cpp, canonical_rounds).
+TEST(Connectivity, TangleSettlingAfterManyRoundsReencodesCanonically) {
+  Mesh m;
+  ASSERT_TRUE(read_mesh(std::string(TSM_REGRESSIONS_DIR) + "/canonical-after-20-rounds.obj", m).ok());
+  ASSERT_EQ(m.face_count(), 325u);
+  for (int level : {0, 6}) {
+    EncodeOptions o;
+    o.level = level;
+    std::string a, b;
+    Mesh d;
+    ASSERT_TRUE(encode(m, o, a).ok());
+    ASSERT_TRUE(decode(a, d).ok());
+    ASSERT_TRUE(encode(d, o, b).ok());
+    EXPECT_TRUE(a == b) << "level " << level << ": " << a.size() << " vs " << b.size() << " bytes";
+  }
+}
+
 // Canonical re-encoding of damaged meshes: faces dropped, flipped, given
 // twice, given also reversed, in shuffled order. Such tangles can send the
 // encoder's canonical rounds round a cycle (one in six of these did before
