@@ -373,7 +373,7 @@ int geometry_version(const PartOptions& options) {
 // Encoder: one part (the whole mesh or a segment) coded.
 struct EncodedPart {
   ConnectivityStreams streams;
-  std::string candidate_topology;  // ConnectivityEncoding::candidate_topology
+  std::shared_ptr<const CandidateTail> candidate_tail;  // ConnectivityEncoding::candidate_tail
   std::string geometry;
   std::string attributes;
   std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
@@ -665,7 +665,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
-  out.candidate_topology = std::move(ce.candidate_topology);
+  out.candidate_tail = std::move(ce.candidate_tail);
   if (!headers.empty() && is_ref.empty())  // a whole mesh: its attributes now
     TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, attribute_tables(options), out));
   return Status::Ok();
@@ -740,7 +740,7 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
       best = size;
       // What encode_part_from fills (the caller's other fields stay).
       out.streams = std::move(alt.streams);
-      out.candidate_topology = std::move(alt.candidate_topology);
+      out.candidate_tail = std::move(alt.candidate_tail);
       out.geometry = std::move(alt.geometry);
       out.attributes = std::move(alt.attributes);
       out.order = std::move(alt.order);
@@ -875,17 +875,21 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // Decided on the coded streams, which a decoded mesh codes alike: canonical.
 void take_candidate_stitches(const EncodeOptions& options, std::vector<EncodedPart*> parts) {
   if (written_version(options) < kCandidateVersion) return;
+  std::vector<std::string> topology(parts.size());
   int64_t gain = 0;
-  for (const EncodedPart* p : parts) {
-    if (!p->candidate_topology.empty())
-      gain += static_cast<int64_t>(p->streams.topology.size()) - static_cast<int64_t>(p->candidate_topology.size());
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const EncodedPart* p = parts[k];
+    topology[k] = candidate_topology(p->candidate_tail.get());
+    if (!topology[k].empty())
+      gain += static_cast<int64_t>(p->streams.topology.size()) - static_cast<int64_t>(topology[k].size());
     else if (!p->streams.mode_byte)
       gain -= 1;
   }
   if (gain <= 0 && options.format_version < kCandidateVersion) return;
-  for (EncodedPart* p : parts) {
-    if (!p->candidate_topology.empty())
-      p->streams.topology = std::move(p->candidate_topology);
+  for (size_t k = 0; k < parts.size(); ++k) {
+    EncodedPart* p = parts[k];
+    if (!topology[k].empty())
+      p->streams.topology = std::move(topology[k]);
     else if (!p->streams.mode_byte)
       p->streams.topology.insert(0, 1, '\0');
     p->streams.mode_byte = true;

@@ -13,6 +13,7 @@
 // stored at the start of the topology stream: one lookup per value.
 // The decoder reverses it and reassembles the exact input faces.
 #include <algorithm>
+#include <memory>
 
 #include "byte_io.hpp"
 #include "connectivity.hpp"
@@ -186,7 +187,73 @@ struct RunEncoder {
   }
 };
 
+// The topology stream from the virtual vertices on: the lists it codes.
+struct TopologyTail {
+  std::vector<uint32_t> virtual_pos;                     // ascending
+  std::vector<std::pair<uint32_t, uint32_t>> stitches;  // (position, target), ascending positions
+  uint32_t side_faces = 0;
+  std::vector<uint32_t> side;  // per side face: its size, then its corners (output ids)
+};
+
+// Codes the tail: stitch targets as distances (versions up to 10), or with
+// `sc` by their rank among the candidates (version 11, §8.3.2; positions
+// all first).
+void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const TopologyTail& t,
+               StitchCandidates* sc = nullptr, std::vector<uint32_t>* target = nullptr) {
+  o.count.encode(e, static_cast<uint32_t>(t.virtual_pos.size()));
+  uint32_t prev = 0;
+  for (uint32_t p : t.virtual_pos) {
+    r.put(e, o.position, kRunPositionCtx, p - prev);
+    prev = p;
+  }
+  o.count.encode(e, static_cast<uint32_t>(t.stitches.size()));
+  prev = 0;
+  for (auto [dup, orig] : t.stitches) {
+    r.put(e, o.position, kRunPositionCtx, dup - prev);
+    if (!sc) r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
+    prev = dup;
+  }
+  if (sc)
+    for (auto [dup, orig] : t.stitches) {
+      sc->gather(dup);
+      const uint32_t rank = sc->rank_of(orig);
+      o.rank[sc->context()].encode(e, rank);
+      if (rank == 0) r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
+      (*target)[dup] = orig;
+    }
+  o.count.encode(e, t.side_faces);
+  for (size_t i = 0; i < t.side.size(); i += 1 + size_t{t.side[i]}) {
+    o.face_size.encode(e, t.side[i]);
+    for (uint32_t j = 1; j <= t.side[i]; ++j) o.index.encode(e, t.side[i + j]);
+  }
+}
+
 }  // namespace
+
+// What version 11's topology stream of a coding needs beyond the lists:
+// the coder, models and run values where the tail starts, and the cut
+// surface in decode order (corners as pre-order positions, twins).
+struct CandidateTail {
+  RangeEncoder coder;
+  TopologyModels models;
+  RunEncoder runs;
+  TopologyTail tail;
+  std::vector<uint32_t> corner, twin;
+  uint32_t positions = 0;
+};
+
+std::string candidate_topology(const CandidateTail* tail) {
+  if (!tail) return std::string();
+  CandidateTail c = *tail;  // its coder and models go on from where they are
+  std::vector<uint8_t> is_virtual(c.positions, 0), stitched(c.positions, 0);
+  for (uint32_t p : c.tail.virtual_pos) is_virtual[p] = 1;
+  for (auto [dup, orig] : c.tail.stitches) stitched[dup] = 1;
+  std::vector<uint32_t> target(c.positions, kNone);
+  StitchCandidates sc(c.corner, c.twin, is_virtual, stitched, target);
+  code_tail(c.coder, c.models, c.runs, c.tail, &sc, &target);
+  // The mode byte always (adaptive without tables).
+  return (c.runs.tables ? c.runs.block() : std::string(1, '\0')) + c.coder.finish();
+}
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
   out = ConnectivityEncoding();
@@ -324,8 +391,9 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   // carries it; later ones are stitched to it; virtual vertices carry nothing.
   const uint32_t P = static_cast<uint32_t>(f.order.size());
   std::vector<uint32_t> first_pos(mesh.vertex_count(), kNone), out_id(P, kNone);
-  std::vector<uint32_t> virtual_pos;
-  std::vector<std::pair<uint32_t, uint32_t>> stitches;
+  TopologyTail tail;  // the topology stream's lists from the virtual vertices on
+  std::vector<uint32_t>& virtual_pos = tail.virtual_pos;
+  std::vector<std::pair<uint32_t, uint32_t>>& stitches = tail.stitches;
   for (uint32_t p = 0; p < P; ++p) {
     uint32_t v = f.order[p];
     if (m.kind[v] == VertexKind::virtual_) {
@@ -356,73 +424,51 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   if (dec_tri.size() != m.triangle_count()) return Status(ErrorCode::internal, "triangle trees lost triangles");
   g.corner.resize(3 * dec_tri.size());
   g.twin.resize(3 * dec_tri.size());
+  // With stitches also the corners as pre-order positions (version 11's cut
+  // surface, candidate_topology).
+  std::vector<uint32_t> cut_corner(stitches.empty() ? 0 : g.corner.size());
   for (size_t k = 0; k < dec_tri.size(); ++k) {
     const uint32_t t = dec_tri[k];
     for (uint32_t e = 0; e < 3; ++e) {
-      g.corner[3 * k + e] = out_id[pos_of[m.tri[3 * t + (rot[t] + e) % 3]]];
+      const uint32_t p = pos_of[m.tri[3 * t + (rot[t] + e) % 3]];
+      g.corner[3 * k + e] = out_id[p];
+      if (!cut_corner.empty()) cut_corner[3 * k + e] = p;
       const uint32_t h = m.twin[3 * t + (rot[t] + e) % 3], t2 = h / 3;
       g.twin[3 * k + e] = 3 * dec_of[t2] + (h % 3 + 3 - rot[t2]) % 3;
     }
   }
 
   // The rest of the topology stream: virtual vertices, stitches, side
-  // faces. With stitches it is coded twice from here: as versions up to 10
-  // code it (targets as distances) and as version 11 does (targets by
-  // candidates, FORMAT.md §8.3.2), from copies of the coder and models.
-  std::vector<uint32_t> input_to_out(mesh.vertex_count());
-  for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
-  auto code_tail = [&](RangeEncoder& e, TopologyModels& o, RunEncoder& r, bool candidates) {
-    o.count.encode(e, static_cast<uint32_t>(virtual_pos.size()));
-    uint32_t prev = 0;
-    for (uint32_t p : virtual_pos) {
-      r.put(e, o.position, kRunPositionCtx, p - prev);
-      prev = p;
-    }
-    o.count.encode(e, static_cast<uint32_t>(stitches.size()));
-    prev = 0;
-    for (auto [dup, orig] : stitches) {
-      r.put(e, o.position, kRunPositionCtx, dup - prev);
-      if (!candidates) r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
-      prev = dup;
-    }
-    if (candidates) {
-      std::vector<uint32_t> cpos(g.corner.size()), target(P, kNone);
-      for (size_t k = 0; k < dec_tri.size(); ++k)
-        for (uint32_t c = 0; c < 3; ++c)
-          cpos[3 * k + c] = pos_of[m.tri[3 * dec_tri[k] + (rot[dec_tri[k]] + c) % 3]];
-      std::vector<uint8_t> is_virtual(P, 0), stitched(P, 0);
-      for (uint32_t p : virtual_pos) is_virtual[p] = 1;
-      for (auto [dup, orig] : stitches) stitched[dup] = 1;
-      StitchCandidates sc(cpos, g.twin, is_virtual, stitched, target);
-      for (auto [dup, orig] : stitches) {
-        sc.gather(dup);
-        const uint32_t rank = sc.rank_of(orig);
-        o.rank[sc.context()].encode(e, rank);
-        if (rank == 0) {
-          r.put(e, o.distance, kRunDistanceCtx, dup - orig - 1);
-        }
-        target[dup] = orig;
-      }
-    }
-    // Side faces, corners as output vertex ids.
-    o.count.encode(e, static_cast<uint32_t>(prep.side_faces.size()));
+  // faces (corners as output vertex ids). With stitches, what version 11
+  // codes from here on instead (targets by candidates) is kept for
+  // candidate_topology, which codes it for the one coding a file keeps.
+  {
+    std::vector<uint32_t> input_to_out(mesh.vertex_count());
+    for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
+    tail.side_faces = static_cast<uint32_t>(prep.side_faces.size());
     for (uint32_t face : prep.side_faces) {
-      o.face_size.encode(e, mesh.face_size(face));
-      for (uint32_t i = 0; i < mesh.face_size(face); ++i) o.index.encode(e, input_to_out[mesh.face(face)[i]]);
+      tail.side.push_back(mesh.face_size(face));
+      for (uint32_t i = 0; i < mesh.face_size(face); ++i) tail.side.push_back(input_to_out[mesh.face(face)[i]]);
     }
-  };
-  RangeEncoder eo2;
-  TopologyModels om2;
-  RunEncoder runs2;
-  if (!stitches.empty()) {
-    eo2 = eo;
-    om2 = om;
-    runs2 = runs;
   }
-  code_tail(eo, om, runs, false);
+  std::shared_ptr<CandidateTail> c;
+  if (!stitches.empty()) {
+    c = std::make_shared<CandidateTail>();
+    c->coder = eo;
+    c->models = om;
+    c->runs = runs;
+  }
+  code_tail(eo, om, runs, tail);
   st.components = C;
   st.virtual_vertices = virtual_pos.size();
   st.stitches = stitches.size();
+  if (c) {
+    c->corner = std::move(cut_corner);
+    c->twin = g.twin;
+    c->positions = P;
+    c->tail = std::move(tail);
+    out.candidate_tail = std::move(c);
+  }
   st.side_faces = prep.side_faces.size();
   st.polygons = prep.polygon_count;
   out.streams.vertex_tree = ev.finish();
@@ -445,10 +491,6 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     }
     out.streams.mode_byte = true;
     out.streams.topology = block + out.streams.topology;
-  }
-  if (!stitches.empty()) {  // version 11: the mode byte always (adaptive without tables)
-    code_tail(eo2, om2, runs2, true);
-    out.candidate_topology = (runs2.tables ? runs2.block() : std::string(1, '\0')) + eo2.finish();
   }
   st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
   return Status::Ok();

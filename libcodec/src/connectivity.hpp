@@ -11,6 +11,7 @@
 // outside, so around a vertex, cw_next(h) = next(twin(h)).
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -294,6 +295,8 @@ struct ConnectivityStreams {
   bool stitch_candidates = false;
 };
 
+struct CandidateTail;  // connectivity.cpp
+
 struct ConnectivityEncoding {
   ConnectivityStreams streams;
   // Output vertex id (vertex-tree pre-order) -> input vertex id.
@@ -301,14 +304,18 @@ struct ConnectivityEncoding {
   // The cut surface as the decoder will rebuild it, for the geometry coder.
   GeometryLayout layout;
   ConnectivityStats stats;
-  // With stitches: the topology stream as version 11 codes it (with the mode
-  // byte, stitch targets by candidates; the rest of the streams unchanged),
-  // for the file to take when it pays (codec.cpp). Empty without stitches.
-  std::string candidate_topology;
+  // With stitches: what the topology stream as version 11 codes it needs
+  // (candidate_topology), null without stitches.
+  std::shared_ptr<const CandidateTail> candidate_tail;
   bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
 };
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints = CutHints());
+// The topology stream of a coding (its candidate_tail) as version 11 codes
+// it: the mode byte, stitch targets by candidates (FORMAT.md §8.3.2), the
+// other streams unchanged; for the file to take when it pays (codec.cpp).
+// Empty for null (no stitches).
+std::string candidate_topology(const CandidateTail* tail);
 // Fills out.face_offsets / out.indices (positions are the geometry stage's
 // job) and the layout the geometry decoder walks. The counts come from the
 // header and are checked against what the streams say.
