@@ -129,9 +129,7 @@ std::vector<Named> meshes() {
   out.push_back({"flipped", tsm_test::flipped_face_sphere(1)});
   out.push_back({"soup", tsm_test::random_soup(40, 60, 3)});
   out.push_back({"copies", tsm_test::copies(tsm_test::cube_quads(), 3)});
-  tsm::Mesh both = tsm_test::icosphere(1);  // every face also reversed: stitch targets by candidates (version 11)
-  for (size_t f = 0, n = both.face_count(); f < n; ++f) both.add_triangle(both.face(f)[0], both.face(f)[2], both.face(f)[1]);
-  out.push_back({"double_sided", both});
+  out.push_back({"double_sided", tsm_test::double_sided(tsm_test::icosphere(1))});  // stitch targets by candidates (version 11)
   out.push_back({"points", point_set(30)});
   tsm::Mesh one;
   one.add_vertex(1.5f, -2.0f, 3.25f);

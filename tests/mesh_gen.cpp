@@ -280,6 +280,11 @@ Mesh jittered(Mesh m, float amplitude, uint32_t seed) {
   return m;
 }
 
+Mesh double_sided(Mesh m) {
+  for (size_t f = 0, n = m.face_count(); f < n; ++f) m.add_triangle(m.face(f)[0], m.face(f)[2], m.face(f)[1]);
+  return m;
+}
+
 Mesh copies(const Mesh& src, int count) {
   Mesh m;
   for (int c = 0; c < count; ++c) {

@@ -36,6 +36,9 @@ tsm::Mesh cube_quads();
 tsm::Mesh ngon(int n);
 // Disjoint copies of `m`, each shifted along x.
 tsm::Mesh copies(const tsm::Mesh& m, int count);
+// `m` (triangles) with every face also given reversed on the same vertices,
+// after all of them: double-sided, as exporters write thin geometry.
+tsm::Mesh double_sided(tsm::Mesh m);
 // `m` with every coordinate moved by a uniform random offset in
 // [-amplitude, amplitude] (std::mt19937 seeded with `seed`): a noisy surface.
 tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);

@@ -202,11 +202,6 @@ TEST(Connectivity, BowtieNeedsAStitch) {
 // components with the second one's vertices stitched, an open one as one
 // component joined along its border.
 TEST(Connectivity, DoubleSidedSheetsStayWhole) {
-  auto double_sided = [](Mesh m) {
-    const size_t nf = m.face_count();
-    for (size_t f = 0; f < nf; ++f) m.add_triangle(m.face(f)[0], m.face(f)[2], m.face(f)[1]);
-    return m;
-  };
   const Mesh sphere = icosphere(2), grid = grid_with_holes(8, 2);
   for (const auto& [single, name] : {std::pair<const Mesh&, const char*>{sphere, "sphere"}, {grid, "grid"}}) {
     const Mesh both = double_sided(single);

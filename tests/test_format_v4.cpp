@@ -755,15 +755,10 @@ TEST(FormatV10, FanPredictorAtLevels1And2) {
 // candidates (neighbours of the stitched vertex's known neighbours), written
 // where that makes the file smaller; the mesh decoded is the same.
 TEST(FormatV11, StitchTargetsByCandidates) {
-  auto double_sided = [](Mesh m) {
-    const size_t nf = m.face_count();
-    for (size_t f = 0; f < nf; ++f) m.add_triangle(m.face(f)[0], m.face(f)[2], m.face(f)[1]);
-    return m;
-  };
   const Mesh sphere = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
   const std::vector<std::pair<std::string, Mesh>> meshes = {
-      {"double-sided sphere", double_sided(sphere)},
-      {"double-sided grid with holes", double_sided(tsm_test::grid_with_holes(30, 5))},
+      {"double-sided sphere", tsm_test::double_sided(sphere)},
+      {"double-sided grid with holes", tsm_test::double_sided(tsm_test::grid_with_holes(30, 5))},
       {"books", tsm_test::copies(tsm_test::book(6), 50)},
   };
   for (const auto& [name, m] : meshes)
@@ -801,13 +796,10 @@ TEST(FormatV11, StitchTargetsByCandidates) {
 // version, decodes to the quantized mesh and re-encodes to its own bytes,
 // on meshes with stitches, holes and handles.
 TEST(FormatV11, EveryAskedForVersionRoundTrips) {
-  Mesh double_sided = tsm_test::icosphere(2);
-  for (size_t f = 0, n = double_sided.face_count(); f < n; ++f)
-    double_sided.add_triangle(double_sided.face(f)[0], double_sided.face(f)[2], double_sided.face(f)[1]);
   const std::vector<std::pair<std::string, Mesh>> meshes = {
       {"soup", tsm_test::random_soup(40, 60, 3)},
       {"books", tsm_test::copies(tsm_test::book(6), 10)},
-      {"double-sided sphere", double_sided},
+      {"double-sided sphere", tsm_test::double_sided(tsm_test::icosphere(2))},
       {"irregular grid", tsm_test::irregular_grid(20, 3)},
       {"grid with holes", tsm_test::grid_with_holes(12, 3)},
       {"genus 2", tsm_test::genus_surface(2)},
