@@ -1,8 +1,9 @@
 // Connectivity alone (issue 3's figures). Usage:
 //   tsm_bench_connectivity [--runs N] [--fresh-pages] MESH...
 //     linearity: encode_connectivity and decode_connectivity on each mesh,
-//     medians of several runs, triangles per second, and each mesh's rate
-//     relative to the fastest (default: the four dragon resolutions).
+//     medians of several runs (interleaved: run r of every mesh, then run
+//     r + 1), triangles per second, and each mesh's rate relative to the
+//     fastest (default: the four dragon resolutions).
 //     The heap keeps freed memory between runs (glibc: arrays up to 32 MB
 //     from the heap, never trimmed), so every mesh is timed on memory the
 //     process already has; by default glibc maps arrays above its threshold
@@ -125,27 +126,33 @@ int main(int argc, char** argv) {
     size_t faces;
     double enc, dec;
   };
-  std::vector<Row> rows;
-  for (const std::string& f : files) {
-    tsm::Mesh m;
-    if (!load(f, m)) return 3;
-    std::vector<double> enc, dec;
-    tsm::ConnectivityEncoding ce;
-    for (int r = 0; r < runs; ++r) {
+  // Runs interleaved (run r of every mesh before run r + 1 of any): a busy
+  // stretch of a shared machine then slows every mesh a little instead of
+  // all runs of one mesh, which the relative columns would read as
+  // non-linearity.
+  std::vector<tsm::Mesh> meshes(files.size());
+  for (size_t i = 0; i < files.size(); ++i)
+    if (!load(files[i], meshes[i])) return 3;
+  std::vector<std::vector<double>> enc(files.size()), dec(files.size());
+  for (int r = 0; r < runs; ++r)
+    for (size_t i = 0; i < files.size(); ++i) {
+      const tsm::Mesh& m = meshes[i];
       double t0 = now_ms();
-      ce = tsm::ConnectivityEncoding();
+      tsm::ConnectivityEncoding ce;
       tsm::Status s = tsm::encode_connectivity(m, ce);
-      enc.push_back(now_ms() - t0);
+      enc[i].push_back(now_ms() - t0);
       if (!s.ok()) return 5;
       tsm::Mesh back;
       tsm::GeometryLayout layout;
       t0 = now_ms();
       s = tsm::decode_connectivity(ce.streams, m.vertex_count(), m.face_count(), m.corner_count(), back, layout);
-      dec.push_back(now_ms() - t0);
+      dec[i].push_back(now_ms() - t0);
       if (!s.ok()) return 5;
     }
-    rows.push_back({f.substr(f.find_last_of('/') + 1), m.face_count(), median(enc), median(dec)});
-  }
+  std::vector<Row> rows;
+  for (size_t i = 0; i < files.size(); ++i)
+    rows.push_back({files[i].substr(files[i].find_last_of('/') + 1), meshes[i].face_count(), median(enc[i]),
+                    median(dec[i])});
   double best_enc = 0, best_dec = 0;
   for (const Row& r : rows) {
     best_enc = std::max(best_enc, static_cast<double>(r.faces) / r.enc);
