@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 namespace fs = std::filesystem;
 

@@ -16,6 +16,7 @@
 
 #include "bench_timing.hpp"
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 using tsm::bench::median;
 using tsm::bench::now_ms;

@@ -12,6 +12,8 @@
 #include "cli_util.hpp"
 #include "bench_timing.hpp"
 #include "tsm/tsm.hpp"
+#include "tsm/compare.hpp"
+#include "tsm/io.hpp"
 
 namespace tsm::cli {
 

@@ -18,6 +18,7 @@
 
 #include "batch.hpp"
 #include "cli_util.hpp"
+#include "tsm/io.hpp"
 
 namespace tsm::cli {
 

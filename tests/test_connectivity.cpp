@@ -11,6 +11,7 @@
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 using namespace tsm;
 using namespace tsm_test;

@@ -40,6 +40,7 @@
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 // --- Counting allocator -----------------------------------------------------
 

@@ -15,6 +15,7 @@
 #include "test_util.hpp"
 #include "tsm/compare.hpp"
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 namespace {
 

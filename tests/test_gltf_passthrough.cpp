@@ -1,4 +1,4 @@
-// glTF pass-through (libcodec/src/io_gltf.cpp, Mesh::metadata "gltf"): a
+// glTF pass-through (libio/src/io_gltf.cpp, Mesh::metadata "gltf"): a
 // document with several meshes and primitives, materials, a node tree with
 // transforms and an instanced mesh, textures, samplers, images (bytes in a
 // buffer view, a data URI, an external URI), a camera, an animation, a skin,

@@ -1,4 +1,4 @@
-// Tests for the glTF 2.0 reader and writer (libcodec/src/io_gltf.cpp).
+// Tests for the glTF 2.0 reader and writer (libio/src/io_gltf.cpp).
 // Generated data only: meshes made here, .gltf JSON written here.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Tests for the PLY reader and writer (libcodec/src/io_ply.cpp).
+// Tests for the PLY reader and writer (libio/src/io_ply.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>

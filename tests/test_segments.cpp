@@ -12,6 +12,7 @@
 #include "test_util.hpp"
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
+#include "tsm/io.hpp"
 
 using namespace tsm;
 using namespace tsm_test;

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "tsm/compare.hpp"
+#include "tsm/quantization.hpp"
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 

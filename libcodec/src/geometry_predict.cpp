@@ -43,7 +43,7 @@
 #include "connectivity.hpp"
 #include "range_coder.hpp"
 #include "table_coder.hpp"
-#include "tsm/compare.hpp"
+#include "tsm/quantization.hpp"
 
 namespace tsm {
 

@@ -1,6 +1,6 @@
 // tsm: Topological Surgery mesh compression, C++ API.
 //
-//   tsm::Mesh mesh;  tsm::read_mesh("bunny.ply", mesh);
+//   tsm::Mesh mesh;  tsm::read_mesh("bunny.ply", mesh);   // tsm/io.hpp (tsm_io)
 //   std::string bytes;
 //   tsm::encode(mesh, tsm::EncodeOptions{}, bytes);
 //   tsm::Mesh back;  tsm::decode(bytes, back);
@@ -13,8 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "tsm/compare.hpp"
-#include "tsm/io.hpp"
+#include "tsm/quantization.hpp"
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
 
