@@ -270,7 +270,7 @@ TEST(Segments, CApiStreams) {
 }
 
 TEST(Segments, CorpusDragonInSegments) {
-  if (!have_corpus()) GTEST_SKIP() << "corpus not found";
+  TSM_REQUIRE_CORPUS();
   Mesh m;
   ASSERT_TRUE(read_mesh(corpus_file("dragon_vrip_res3.ply"), m).ok());
   const std::string bytes = encode_ok(m, 4000, 11, 2);
@@ -288,7 +288,7 @@ TEST(Segments, CorpusDragonInSegments) {
 // chunks and whole give the same mesh, and the first segment's triangles
 // come out before the last bytes went in.
 TEST(Segments, CorpusMeshesStreamedByteByByteInChunksAndWhole) {
-  if (!have_corpus()) GTEST_SKIP() << "corpus not found";
+  TSM_REQUIRE_CORPUS();
   for (const char* name : {"bun_zipper.ply", "dragon_vrip_res4.ply"}) {
     Mesh m;
     ASSERT_TRUE(read_mesh(corpus_file(name), m).ok()) << name;

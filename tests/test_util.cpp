@@ -1,9 +1,24 @@
 #include "test_util.hpp"
 
 #include <atomic>
+#include <cctype>
+#include <cstdlib>
 #include <random>
 
 namespace tsm_test {
+
+bool running_in_ci() {
+  const char* ci = std::getenv("CI");
+  if (ci == nullptr) return false;
+  std::string v(ci);
+  for (char& c : v) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return !v.empty() && v != "0" && v != "false";
+}
+
+std::string corpus_missing_message() {
+  return "corpus not found at " + corpus_dir() +
+         " (clone the project beside ../shared, or set TSM_CORPUS to the corpus folder)";
+}
 
 TempDir::TempDir() {
   static std::atomic<unsigned> counter{0};

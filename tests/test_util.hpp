@@ -23,6 +23,10 @@ inline std::string corpus_dir() {
 }
 inline bool have_corpus() { return std::filesystem::is_directory(corpus_dir()); }
 inline std::string corpus_file(const std::string& rel) { return corpus_dir() + "/" + rel; }
+// The CI variable is set to a value other than "", "0" or "false" (any case).
+bool running_in_ci();
+// "corpus not found at DIR (...how to provide it)".
+std::string corpus_missing_message();
 
 // The bits of a float and back, for bit-exact comparisons.
 inline uint32_t bits(float x) {
@@ -101,10 +105,16 @@ inline std::vector<uint32_t> random_permutation(size_t n, uint32_t seed) {
 
 }  // namespace tsm_test
 
-// Skips the current test with a message when ../shared/corpus is absent.
+// Every test that reads ../shared/corpus starts with this. When the corpus is
+// absent the test is skipped with a message, except in CI (the CI variable set
+// to anything but "", "0" or "false"), where it fails: a CI run that skipped
+// the corpus tests would pass without having checked the real meshes.
 #define TSM_REQUIRE_CORPUS()                                                          \
   do {                                                                                \
-    if (!tsm_test::have_corpus())                                                     \
-      GTEST_SKIP() << "corpus not found at " << tsm_test::corpus_dir()                \
-                   << " (clone the project beside ../shared, or set TSM_CORPUS)";     \
+    if (!tsm_test::have_corpus()) {                                                   \
+      if (tsm_test::running_in_ci())                                                  \
+        GTEST_FAIL() << tsm_test::corpus_missing_message()                            \
+                     << "; CI is set, so a missing corpus is a failure, not a skip";  \
+      GTEST_SKIP() << tsm_test::corpus_missing_message();                             \
+    }                                                                                 \
   } while (0)

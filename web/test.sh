@@ -10,14 +10,21 @@
 #   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md)
 #
 # When emscripten or Chromium (or Node/npm) cannot be had, it prints
-# "web test SKIPPED: <reason>" and exits 0. Any other failure exits non-zero.
+# "web test SKIPPED: <reason>" and exits 0, except in CI (the CI variable set
+# to anything but "", "0" or "false"): there it prints "web test FAILED: cannot
+# run in CI: <reason>" and exits 1, so a CI run cannot pass without the
+# browser test. Any other failure exits non-zero.
 set -uo pipefail
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 ROOT="$(cd "$HERE/.." && pwd)"
 BENCH=0
 for a in "$@"; do case "$a" in --bench) BENCH=1 ;; *) echo "usage: web/test.sh [--bench]" >&2; exit 2 ;; esac; done
 
-skip() { echo "web test SKIPPED: $*"; exit 0; }
+in_ci() { case "$(printf '%s' "${CI:-}" | tr '[:upper:]' '[:lower:]')" in ""|0|false) return 1 ;; *) return 0 ;; esac; }
+skip() {
+  if in_ci; then echo "web test FAILED: cannot run in CI: $*" >&2; exit 1; fi
+  echo "web test SKIPPED: $*"; exit 0
+}
 fail() { echo "web test FAILED: $*" >&2; exit 1; }
 mkdir -p "$ROOT/build/web"
 LOG="$ROOT/build/web/install.log"
