@@ -281,7 +281,6 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   eo.quantization_bits = a.qbits;
   eo.level = a.level;
   eo.segment_faces = a.segment_faces;
-  eo.format_version = a.format_version;
   eo.attribute_bits = a.attribute_bits;
   // One file: its segments use the -j threads; several: the files do.
   eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;

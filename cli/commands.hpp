@@ -22,7 +22,6 @@ struct EncodeArgs : BatchArgs {
   int qbits = kDefaultQuantizationBits;
   int level = kDefaultLevel;
   uint32_t segment_faces = 0;       // 0 = the library's default
-  int format_version = 0;           // 0 = the newest
   AttributeQuantization attribute_bits;
   bool force = false, allow_nonfinite = false;
 };

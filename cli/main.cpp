@@ -74,16 +74,6 @@ int main(int argc, char** argv) {
                   "Code meshes with more faces as segments of at most this many (streaming, parallel decoding); "
                   "0 = default (262144)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  enc->add_option("--format-version", ea.format_version,
-                  "Write this format version: 11 (the newest; by default each file says the oldest version that "
-                  "reads it), 10 for decoders of version 10 (non-manifold meshes without version 11's stitch targets "
-                  "by candidates: 1% larger on the low-resolution dragons, twice as large on double-sided meshes), 9 for decoders of version 9 (levels 1-2 without version 10's fan predictor: "
-                  "3-6% larger), 8 for decoders of version 8 (levels 0-2 without version 9's table-coded connectivity "
-                  "run values: slower to decode, 0.2-1% smaller), 7 for decoders of version 7 (levels 0-2 without "
-                  "version 8's table-coded residuals either: slower to decode, 1-2% smaller), 6 for decoders of version 6 (no lattice planes from the top: a few bytes more on "
-                  "boxes), 5 for decoders of version 5 (no residual mixing either, which only levels 7-9 use), "
-                  "or 4 for decoders of version 4 (no tangent step either; usually slightly larger)")
-      ->check(CLI::Range(4, 11));
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));

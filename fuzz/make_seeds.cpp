@@ -129,7 +129,7 @@ std::vector<Named> meshes() {
   out.push_back({"flipped", tsm_test::flipped_face_sphere(1)});
   out.push_back({"soup", tsm_test::random_soup(40, 60, 3)});
   out.push_back({"copies", tsm_test::copies(tsm_test::cube_quads(), 3)});
-  out.push_back({"double_sided", tsm_test::double_sided(tsm_test::icosphere(1))});  // stitch targets by candidates (version 11)
+  out.push_back({"double_sided", tsm_test::double_sided(tsm_test::icosphere(1))});  // stitch targets by candidates
   out.push_back({"points", point_set(30)});
   tsm::Mesh one;
   one.add_vertex(1.5f, -2.0f, 3.25f);
@@ -460,16 +460,16 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 0);
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 9);
   encode_seed(decode_dir, "grid_holes", tsm_test::grid_with_holes(10, 2), 30, 9);
-  // a noisy sphere at level 9: residual mixing (format version 6)
+  // a noisy sphere at level 9: residual mixing
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(3), 0.004f, 5), 14, 9);
-  // ... and at level 0: table-coded residuals (format version 8), at 30 bits too
+  // ... and at level 0: table-coded residuals, at 30 bits too
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(3), 0.004f, 5), 14, 0);
   encode_seed(decode_dir, "noisy_sphere", tsm_test::jittered(tsm_test::icosphere(2), 0.004f, 5), 30, 0);
-  // table-coded connectivity run values (format version 9, mode 1): an
+  // table-coded connectivity run values (mode 1): an
   // irregular grid with holes and fins (the noisy sphere above has mode 0)
   encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(20, 3), 11, 0);
   encode_seed(decode_dir, "irregular_grid", tsm_test::irregular_grid(24, 3), 11, 0, 400);
-  // the fan predictor (format version 10): levels 1 and 2 (with the tangent
+  // the fan predictor: levels 1 and 2 (with the tangent
   // step), whole and in segments
   const tsm::Mesh fan_sphere = tsm_test::jittered(tsm_test::icosphere(4), 0.003f, 5);
   encode_seed(decode_dir, "fan_sphere", fan_sphere, 12, 1);
@@ -485,7 +485,7 @@ int main(int argc, char** argv) {
   encode_seed(decode_dir, "uv_vertex", with_attributes(false), 12, 6);
   encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6);
   encode_seed(decode_dir, "uv_corner", with_attributes(true), 12, 6, 60);
-  // table-coded attribute residuals (format version 9): noisy values on an
+  // table-coded attribute residuals: noisy values on an
   // irregular grid at level 0, whole and in segments
   encode_seed(decode_dir, "noisy_attributes", noisy_attributes(), 12, 0);
   encode_seed(decode_dir, "noisy_attributes", noisy_attributes(), 12, 0, 300);

@@ -45,7 +45,7 @@ tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);
 
 // n x n vertices, each quad split along a random diagonal, every 7th quad
 // left out (holes) and a fin of three faces on every 11th quad's lower edge
-// (stitches): irregular runs, as on a scan (format version 9's run tables).
+// (stitches): irregular runs, as on a scan (the fast levels' run tables).
 tsm::Mesh irregular_grid(int n, uint32_t seed);
 
 }  // namespace tsm_test

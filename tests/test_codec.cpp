@@ -270,7 +270,7 @@ TEST(Codec, InspectReportsHeader) {
   tsm::FileInfo fi;
   tsm::Status s = tsm::inspect(bytes, fi);
   ASSERT_TRUE(s.ok()) << s.to_string();
-  EXPECT_EQ(fi.format_version, 5u);
+  EXPECT_EQ(fi.format_version, 12u);
   EXPECT_EQ(fi.vertex_count, m.vertex_count());
   EXPECT_EQ(fi.face_count, m.face_count());
   EXPECT_EQ(fi.corner_count, m.corner_count());
@@ -554,7 +554,7 @@ TEST(Codec, ForgingHelpersRebuildTheEncodersBytes) {
   std::string bytes = encode_ok(m, 9, 4);
   Parsed h = parse(bytes);
   ASSERT_TRUE(h.extent_bytes == 4 || h.extent_bytes == 8) << h.extent_bytes;
-  EXPECT_EQ(h.version, 5);
+  EXPECT_EQ(h.version, 12);
   EXPECT_EQ(h.vertices, m.vertex_count());
   EXPECT_EQ(h.faces, m.face_count());
   EXPECT_EQ(h.corners, m.corner_count());
@@ -606,10 +606,18 @@ TEST(Codec, ForgedHeaderFieldsRefused) {
   const Parsed good = parse(encode_ok(m, 9, 4));
   Mesh back;
   ASSERT_TRUE(tsm::decode(build(good), back).ok());
-  {
+  // Any other version than 12 (one format until 1.0): unsupported, with a
+  // message that says which version is read.
+  for (int version : {0, 1, 3, 11, 13, 0xFFFF}) {
     Parsed h = good;
-    h.version = 1;  // the version before segments
-    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::unsupported);
+    h.version = static_cast<uint16_t>(version);
+    const tsm::Status s = tsm::decode(build(h), back);
+    EXPECT_EQ(s.code(), ErrorCode::unsupported) << version;
+    EXPECT_NE(s.message().find("format version " + std::to_string(version) + ": this decoder reads only format version 12"),
+              std::string::npos)
+        << s.to_string();
+    tsm::StreamDecoder sd;
+    EXPECT_EQ(sd.feed(build(h)).code(), ErrorCode::unsupported) << version;
   }
   {
     Parsed h = good;
@@ -739,7 +747,7 @@ std::string spec_example_bytes() {
 // checked it).
 TEST(Codec, FormatSpecWorkedExampleIsCurrent) {
   const std::string example = spec_example_bytes();
-  ASSERT_EQ(example.size(), 73u) << "could not read the example from " << TSM_FORMAT_SPEC;
+  ASSERT_EQ(example.size(), 74u) << "could not read the example from " << TSM_FORMAT_SPEC;
   tsm::Mesh m;
   m.add_vertex(0, 0, 0);
   m.add_vertex(2, 0, 0);

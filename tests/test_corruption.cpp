@@ -124,8 +124,8 @@ using tsm_test::random_bytes;
 // budget), so how far a file may expand is bounded, but the bound is large:
 // the most compressible genuine files measured (flat grids at q = 1) decode
 // to ~23 KB of decoder memory per input byte for a million vertices (29 KB
-// in GenuineFilesDecodeUnderTheCeiling with format version 3's coder, which
-// prints its largest ratio), slowly more as they grow, and a forged header around the genuine connectivity
+// measured in GenuineFilesDecodeUnderTheCeiling, which prints its largest
+// ratio), slowly more as they grow, and a forged header around the genuine connectivity
 // streams of such a grid (ForgedCountsAroundGenuineStreams, there at a
 // smaller size) reaches ~31 KB per byte. A zstd section
 // may expand 1024 times (FORMAT.md §4.1). 64 KiB per input byte plus a fixed

@@ -1,4 +1,4 @@
-// The static prefix codes of format version 8 (table_coder.hpp, FORMAT.md
+// The static prefix codes (table_coder.hpp, FORMAT.md
 // §8.5.11): symbols, code lengths, canonical codes and the table block.
 #include <gtest/gtest.h>
 

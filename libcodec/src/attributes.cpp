@@ -33,7 +33,7 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 
 constexpr int kMaxAttributes = 64;
 
-// Version 9 (FORMAT.md §8.12.1): an attribute's residuals through static
+// FORMAT.md §8.12.1: an attribute's residuals through static
 // prefix codes, one per residual model res[cls][c][z], at context
 // 24 i + 8 cls + 2 c + z of attribute i (bit 3 of its predictor byte).
 constexpr uint8_t kAttributeTableFlag = 0x08;
@@ -176,7 +176,7 @@ struct TableResiduals {
 
 struct Enc {
   RangeEncoder e;
-  TableResiduals* tables = nullptr;  // version 9: this attribute's residuals through tables
+  TableResiduals* tables = nullptr;  // this attribute's residuals through tables
   int32_t sint(SIntModelT<4>& m, int64_t v) {
     m.encode(e, static_cast<int32_t>(v));
     return static_cast<int32_t>(v);
@@ -197,7 +197,7 @@ struct Enc {
 
 struct Dec {
   RangeDecoder d;
-  // Version 9: the attribute tables and their bit stream; `base` is the
+  // The attribute tables and their bit stream; `base` is the
   // current attribute's first context, -1 when its residuals are range coded.
   const TableSet* tables = nullptr;
   BitReader bits;
@@ -968,14 +968,14 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
-    if (in.version >= 9 && (p & kAttributeTableFlag)) {
+    if (p & kAttributeTableFlag) {
       tabled[i] = 1;
       p = static_cast<uint8_t>(p & ~kAttributeTableFlag);
     }
     if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
-  // Version 9 (§8.12.1): with a table-coded attribute, the bit stream's
+  // §8.12.1: with a table-coded attribute, the bit stream's
   // length, the tables of every attribute's contexts, the bit stream.
   Dec dec;
   TableSet tables;

@@ -57,7 +57,7 @@ struct AttributeInput {
   // Out (optional): per attribute, the part input values that this part adds
   // to the file's value list, in the order the decoder appends them.
   std::vector<std::vector<uint32_t>>* own_values = nullptr;
-  // Version 9, the fast levels: residuals through static prefix codes where
+  // The fast levels: residuals through static prefix codes where
   // they cost at most 9/8 of the adaptive models (FORMAT.md §8.12.1).
   bool tables = false;
 };
@@ -75,7 +75,6 @@ struct AttributePart {
   const std::vector<uint32_t>* global = nullptr;   // per part vertex: kNone own, else a reference
   const std::vector<uint32_t>* q = nullptr;        // own vertices' grid indices
   bool segmented = false;                          // a segment's payload (may name earlier values)
-  int version = 9;                                 // the file's format version (9: table-coded residuals)
   uint32_t* table_coded = nullptr;                 // out (optional): attributes with table-coded residuals
 };
 // `alias` (optional) gets per attribute, per value of the part's value list,

@@ -27,12 +27,6 @@ const char* version_string() { return TSM_VERSION; }
 
 namespace {
 
-// The format version a file is written in (EncodeOptions::format_version,
-// 0 = the newest; validated by encode()).
-uint16_t written_version(const EncodeOptions& options) {
-  return static_cast<uint16_t>(options.format_version ? options.format_version : kFormatVersion);
-}
-
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
 
 double grid_step(const Header& h) {
@@ -45,8 +39,8 @@ const Section* find_section(const std::vector<Section>& sections, uint16_t id) {
   return nullptr;
 }
 
-// One part of a file: the whole mesh (section 10, or in version 3 sections
-// 3-6) or one segment (§4.5).
+// One part of a file: the whole mesh (the mesh section, §4.7) or one
+// segment (§4.5).
 struct PartCounts {
   uint64_t vertex_count = 0, face_count = 0, corner_count = 0, reference_count = 0;
 };
@@ -54,7 +48,6 @@ struct PartStreams {
   std::string_view vertex_tree, triangle_tree, topology, references, geometry;
   bool segmented = false;  // has a references stream
   std::string_view attributes;  // empty: none
-  uint16_t version = kFormatVersion;  // the file's format version (what the geometry header may hold)
 };
 
 // A modelled binary decision costs at least 0.0028146 bits (range_coder.hpp:
@@ -112,7 +105,7 @@ struct DecodedPart {
   std::vector<std::vector<uint32_t>> alias;  // per attribute, per corner value: an earlier segment's value, or kNone
   ConnectivityStats cstats;
   GeometryStats gstats;
-  uint32_t table_coded_attributes = 0;  // version 9: attributes whose residuals are table-coded
+  uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
   Status status;
 };
 
@@ -122,27 +115,24 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   cs.vertex_tree.assign(s.vertex_tree);
   cs.triangle_tree.assign(s.triangle_tree);
   cs.topology.assign(s.topology);
-  cs.mode_byte = s.version >= 9;
-  cs.stitch_candidates = s.version >= kCandidateVersion;
   GeometryLayout layout;
   const PartCounts& c = out.counts;
   TSM_RETURN_IF_ERROR(
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
   if (!s.segmented) {
     if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
-    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats, s.version));
+    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
   } else {
     TSM_RETURN_IF_ERROR(
         decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
     TSM_RETURN_IF_ERROR(
-        decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats, s.version));
+        decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats));
   }
   AttributePart ap;
   ap.faces = &out.faces;
   ap.global = &out.global;
   ap.q = &out.q;
   ap.segmented = s.segmented;
-  ap.version = s.version;
   ap.table_coded = &out.table_coded_attributes;
   return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
 }
@@ -172,10 +162,10 @@ void parallel_for(size_t n, int threads, F&& f) {
 }
 
 // A segment section as a part: its streams (views into the section) and counts.
-Status read_part(const Section& sec, uint16_t version, PartStreams& s, PartCounts& c) {
+Status read_part(const Section& sec, PartStreams& s, PartCounts& c) {
   SegmentPayload p;
   TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes, version};
+  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
   c = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
   return Status::Ok();
 }
@@ -185,27 +175,15 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
                      std::vector<DecodedPart>& parts) {
   if (h.segment_count == 1) {
     PartStreams s;
-    s.version = h.version;
-    if (h.version >= 4) {
-      const Section* sec = find_section(sections, kSectionMesh);
-      if (!sec) return corrupt("the mesh section is missing");
-      MeshPayload p;
-      TSM_RETURN_IF_ERROR(read_mesh_payload(sec->data, p));
-      s.vertex_tree = p.vertex_tree;
-      s.triangle_tree = p.triangle_tree;
-      s.topology = p.topology;
-      s.geometry = p.geometry;
-      s.attributes = p.attributes;
-    } else {
-      std::string_view* slot[4] = {&s.vertex_tree, &s.triangle_tree, &s.topology, &s.geometry};
-      const uint16_t ids[4] = {kSectionVertexTree, kSectionTriangleTree, kSectionTopology, kSectionGeometry};
-      for (int k = 0; k < 4; ++k) {
-        const Section* sec = find_section(sections, ids[k]);
-        if (!sec) return corrupt(k < 3 ? "a connectivity section is missing" : "the geometry section is missing");
-        *slot[k] = sec->data;
-      }
-      if (const Section* a = find_section(sections, kSectionAttributes)) s.attributes = a->data;
-    }
+    const Section* sec = find_section(sections, kSectionMesh);
+    if (!sec) return corrupt("the mesh section is missing");
+    MeshPayload p;
+    TSM_RETURN_IF_ERROR(read_mesh_payload(sec->data, p));
+    s.vertex_tree = p.vertex_tree;
+    s.triangle_tree = p.triangle_tree;
+    s.topology = p.topology;
+    s.geometry = p.geometry;
+    s.attributes = p.attributes;
     streams.assign(1, s);
     parts.resize(1);
     parts[0].counts = PartCounts{h.vertex_count, h.face_count, h.corner_count, 0};
@@ -216,7 +194,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
     if (sec.id != kSectionSegment) continue;
     PartStreams s;
     PartCounts c;
-    TSM_RETURN_IF_ERROR(read_part(sec, h.version, s, c));
+    TSM_RETURN_IF_ERROR(read_part(sec, s, c));
     streams.push_back(s);
     parts.emplace_back();
     parts.back().counts = c;
@@ -342,38 +320,13 @@ Status decode_parts(const Header& h, std::vector<Section>& sections, int threads
   return Status::Ok();
 }
 
-// The oldest format version that reads a geometry stream: 8 for residuals
-// through tables, 7 for lattice planes coded from the top, 6 for residual
-// mixing, else 5.
-// encode()'s options as its parts see them, with what every part of the
-// file must agree on: whether their topology streams have the mode byte.
-struct PartOptions : EncodeOptions {
-  bool mode_byte = false;
-};
-
-// Version 9 (FORMAT.md §8.12.1): the fast levels' attribute residuals
-// through tables where they pay, in files that say version 9 anyway.
-bool attribute_tables(const PartOptions& options) { return options.mode_byte && options.level <= kTableLevel; }
-
-uint16_t needed_version(const ConnectivityStreams& streams, const std::string& geometry) {
-  const uint8_t kind = geometry.empty() ? 0 : static_cast<uint8_t>(geometry[0]);
-  if (streams.stitch_candidates) return kCandidateVersion;
-  if ((kind & 7) == static_cast<uint8_t>(Predictor::fan)) return kFanVersion;
-  if (streams.mode_byte) return 9;
-  return kind & kTableFlag ? 8 : kind & kTopFlag ? 7 : kind & kMixFlag ? 6 : 5;
-}
-// The newest geometry features a part may use: version 10's fan predictor
-// only in a file whose parts have the mode byte (every file of version 9 or
-// newer has it), else at most version 8's.
-int geometry_version(const PartOptions& options) {
-  const int v = written_version(options);
-  return options.mode_byte ? v : std::min(v, 8);
-}
+// FORMAT.md §8.12.1: the fast levels' attribute residuals through tables
+// where they pay.
+bool attribute_tables(const EncodeOptions& options) { return options.level <= kTableLevel; }
 
 // Encoder: one part (the whole mesh or a segment) coded.
 struct EncodedPart {
   ConnectivityStreams streams;
-  std::shared_ptr<const CandidateTail> candidate_tail;  // ConnectivityEncoding::candidate_tail
   std::string geometry;
   std::string attributes;
   std::vector<uint32_t> order;     // output vertex id -> the part's input vertex id
@@ -445,21 +398,12 @@ bool in_anchor_order(const ConnectivityEncoding& ce, const std::vector<uint32_t>
   return true;
 }
 
-// Version 9 (FORMAT.md §8.3.1): at the fast levels, a part of
-// kRunTableFaces faces or more codes its run values through tables (every
-// value is below 2^30 when vertices + 2 corners are below 2^28); smaller
-// parts keep the adaptive models, whose few values cost less than tables.
-// Every part of a file has the mode byte or none (the file's version says
-// which): a mesh of that many faces at a fast level, or any mesh when
-// version 9 is asked for, has it (and says version 9); others keep the
-// version-8 layout and their bytes.
+// FORMAT.md §8.3.1: at the fast levels, a part of kRunTableFaces faces or
+// more codes its run values through tables where they pay (every value is
+// below 2^30 when vertices + 2 corners are below 2^28); smaller parts keep
+// the adaptive models, whose few values cost less than tables.
 constexpr size_t kRunTableFaces = 256;
-bool file_has_mode_byte(const Mesh& mesh, const EncodeOptions& options) {
-  return written_version(options) >= 9 &&
-         (options.format_version >= 9 || (options.level <= kTableLevel && mesh.face_count() >= kRunTableFaces));
-}
-RunCoding run_coding(const Mesh& part, const PartOptions& options) {
-  if (!options.mode_byte) return RunCoding::v8;
+RunCoding run_coding(const Mesh& part, const EncodeOptions& options) {
   const bool fits = part.vertex_count() + 2 * part.corner_count() < (size_t{1} << 28);
   return options.level <= kTableLevel && fits && part.face_count() >= kRunTableFaces ? RunCoding::tables
                                                                                      : RunCoding::adaptive;
@@ -475,7 +419,7 @@ struct TreeChoice {
 // triangle have a nearby surface vertex to predict them (their anchor), a
 // second pass that orders them by it.
 Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                         const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+                         const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
   CutHints hints;
   hints.qpos = &qin;
   hints.root_rule = tree.root_rule;
@@ -535,7 +479,18 @@ int canonical_rounds(size_t faces) {
 
 bool same_faces(const Mesh& a, const Mesh& b) { return a.indices == b.indices && a.face_offsets == b.face_offsets; }
 
-bool streams_before(const ConnectivityStreams& a, const ConnectivityStreams& b) {
+// The order of the codings on a cycle: by their streams' size, then bytes,
+// with the stitch targets coded as distances (ConnectivityEncoding::
+// distance_topology; any fixed order would do, this one keeps the bytes
+// files have had).
+struct CycleKey {
+  std::string vertex_tree, triangle_tree, topology;
+};
+CycleKey cycle_key(const ConnectivityEncoding& ce) {
+  const ConnectivityStreams& s = ce.streams;
+  return {s.vertex_tree, s.triangle_tree, ce.distance_topology.empty() ? s.topology : ce.distance_topology};
+}
+bool key_before(const CycleKey& a, const CycleKey& b) {
   const size_t na = a.vertex_tree.size() + a.triangle_tree.size() + a.topology.size();
   const size_t nb = b.vertex_tree.size() + b.triangle_tree.size() + b.topology.size();
   if (na != nb) return na < nb;
@@ -543,7 +498,7 @@ bool streams_before(const ConnectivityStreams& a, const ConnectivityStreams& b) 
 }
 
 Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                              const PartOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+                              const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
   const size_t n = mesh.vertex_count();
   std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids (empty: the same)
   Mesh coded;                  // that mesh (faces only), once it is not `mesh`
@@ -568,7 +523,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
   // streams and its base.
   std::vector<Mesh> coded_in;
-  std::vector<ConnectivityStreams> streams_of;
+  std::vector<CycleKey> key_of;
   std::vector<std::vector<uint32_t>> base_of;
   auto coded_by = [&](size_t r) -> const Mesh& { return r == 0 ? mesh : coded_in[r - 1]; };
   const int rounds = canonical_rounds(mesh.face_count());
@@ -589,7 +544,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       break;
     }
     if (round > 0) coded_in.push_back(std::move(coded));
-    streams_of.push_back(ce.streams);
+    key_of.push_back(cycle_key(ce));
     base_of.push_back(base);
     // Back at a mesh coded in round i: the cycle is rounds i..round.
     size_t i = 0;
@@ -597,7 +552,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     if (i <= static_cast<size_t>(round)) {
       size_t best = i;
       for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
-        if (streams_before(streams_of[k], streams_of[best])) best = k;
+        if (key_before(key_of[k], key_of[best])) best = k;
       if (best != static_cast<size_t>(round)) {  // (else `ce` is it)
         base = base_of[best];
         TSM_RETURN_IF_ERROR(code(coded_by(best)));
@@ -632,7 +587,7 @@ bool same_streams(const ConnectivityStreams& a, const ConnectivityStreams& b) {
 // qin: grid indices per part input vertex; is_ref: per part input vertex,
 // 1 when an earlier segment holds it (empty: none).
 Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                        const std::vector<AttributeHeader>& headers, const PartOptions& options, TreeChoice tree,
+                        const std::vector<AttributeHeader>& headers, const EncodeOptions& options, TreeChoice tree,
                         EncodedPart& out, bool& usable, bool& stitched, TriedCodings* tried) {
   const int bits = options.quantization_bits;
   ConnectivityEncoding ce;
@@ -651,7 +606,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   std::vector<uint32_t>& q = view.q;
   GeometryLayout& layout = view.layout;
   const Lattice lattice = find_lattice(q, layout.vertex_count);
-  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice, nullptr, geometry_version(options));
+  out.geometry = encode_geometry(layout, q, bits, options.level, &lattice);
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
@@ -665,7 +620,6 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   if (!is_ref.empty()) out.contexts = reference_contexts(ce.layout);
   out.order = std::move(ce.vertex_order);
   out.streams = std::move(ce.streams);
-  out.candidate_tail = std::move(ce.candidate_tail);
   if (!headers.empty() && is_ref.empty())  // a whole mesh: its attributes now
     TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, attribute_tables(options), out));
   return Status::Ok();
@@ -704,7 +658,7 @@ size_t part_bytes(const EncodedPart& p) {
 }
 
 Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                   const std::vector<AttributeHeader>& headers, const PartOptions& options, EncodedPart& out) {
+                   const std::vector<AttributeHeader>& headers, const EncodeOptions& options, EncodedPart& out) {
   bool usable = true, stitched = false;
   TriedCodings tried;
   const bool small = options.level >= kSmallSearchLevel && is_ref.empty() && mesh.face_count() <= kSmallSearchFaces;
@@ -740,7 +694,6 @@ Status encode_part(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
       best = size;
       // What encode_part_from fills (the caller's other fields stay).
       out.streams = std::move(alt.streams);
-      out.candidate_tail = std::move(alt.candidate_tail);
       out.geometry = std::move(alt.geometry);
       out.attributes = std::move(alt.attributes);
       out.order = std::move(alt.order);
@@ -866,44 +819,13 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
   return out;
 }
 
-// Version 11 (FORMAT.md §8.3.2): stitch targets by their rank among
-// candidates instead of as distances. Every part of a file has the mode
-// byte or none, so the parts take their version-11 topology streams (and
-// those without stitches the mode byte) only when that makes the file
-// smaller, and only where version 11 may be written; always when version
-// 11 is asked for (the file says 11, so its stitches must be read so).
-// Decided on the coded streams, which a decoded mesh codes alike: canonical.
-void take_candidate_stitches(const EncodeOptions& options, std::vector<EncodedPart*> parts) {
-  if (written_version(options) < kCandidateVersion) return;
-  std::vector<std::string> topology(parts.size());
-  int64_t gain = 0;
-  for (size_t k = 0; k < parts.size(); ++k) {
-    const EncodedPart* p = parts[k];
-    topology[k] = candidate_topology(p->candidate_tail.get());
-    if (!topology[k].empty())
-      gain += static_cast<int64_t>(p->streams.topology.size()) - static_cast<int64_t>(topology[k].size());
-    else if (!p->streams.mode_byte)
-      gain -= 1;
-  }
-  if (gain <= 0 && options.format_version < kCandidateVersion) return;
-  for (size_t k = 0; k < parts.size(); ++k) {
-    EncodedPart* p = parts[k];
-    if (!topology[k].empty())
-      p->streams.topology = std::move(topology[k]);
-    else if (!p->streams.mode_byte)
-      p->streams.topology.insert(0, 1, '\0');
-    p->streams.mode_byte = true;
-    p->streams.stitch_candidates = true;
-  }
-}
-
 // The segmented file's parts: each segment's mesh with its own vertex ids
 // (the vertices its faces use, the last one also the vertices on no face,
 // numbered by canonical_part_order), coded in parallel; then the
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const PartOptions& options, ContainerWriter& cw, uint16_t& needed) {
+                       const EncodeOptions& options, ContainerWriter& cw) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -949,11 +871,6 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
     parts[k].part = std::move(part);
   });
-  {
-    std::vector<EncodedPart*> all;
-    for (EncodedPart& p : parts) all.push_back(&p);
-    take_candidate_stitches(options, all);
-  }
   // Per corner attribute, per value of the mesh: its id in the file's value
   // list once a segment has added it.
   std::vector<std::vector<uint32_t>> value_id(mesh.attributes.size());
@@ -1001,7 +918,6 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     sp.geometry = p.geometry;
     sp.attributes = p.attributes;
     cw.add_section(kSectionSegment, write_segment(sp), 0);
-    needed = std::max(needed, needed_version(p.streams, p.geometry));
     p = EncodedPart();
   }
   return Status::Ok();
@@ -1017,16 +933,13 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
                   "quantization bits must be 1..30, got " + std::to_string(options.quantization_bits));
   if (options.level < 0 || options.level > 9)
     return Status(ErrorCode::invalid_argument, "level must be 0..9, got " + std::to_string(options.level));
-  if (options.format_version != 0 && (options.format_version < 4 || options.format_version > kFormatVersion))
-    return Status(ErrorCode::invalid_argument, "format version must be 4.." + std::to_string(kFormatVersion) +
-                                                   " (0 = the newest), got " + std::to_string(options.format_version));
   if (!mesh.all_finite())
     return Status(ErrorCode::invalid_argument,
                   "mesh has NaN or infinite coordinates, which no quantization grid can hold; fix or drop those "
                   "vertices first");
 
   Header h;
-  h.version = written_version(options);
+  h.version = kFormatVersion;
   h.vertex_count = mesh.vertex_count();
   h.face_count = mesh.face_count();
   h.corner_count = mesh.corner_count();
@@ -1071,24 +984,14 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     const std::string md = write_metadata(mesh.metadata);
     cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
   }
-  uint16_t needed = 5;
-  PartOptions po;
-  static_cast<EncodeOptions&>(po) = options;
-  po.mode_byte = file_has_mode_byte(mesh, options);
   if (segments.size() == 1) {
     EncodedPart p;
-    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, po, p));
-    take_candidate_stitches(options, {&p});
+    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
-    needed = needed_version(p.streams, p.geometry);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, po, cw, needed));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
   }
-  // Unless asked for a version: the oldest that holds what was coded (version
-  // 6 only adds residual mixing, 7 the lattice planes from the top), so that
-  // most files stay readable by decoders of version 5.
-  if (options.format_version == 0 && needed < kFormatVersion) cw.set_version(needed);
   out = cw.finish();
   return Status::Ok();
 }
@@ -1201,7 +1104,7 @@ struct StreamDecoder::Impl {
   Status segment(const Section& sec) {
     PartStreams s;
     DecodedPart part;
-    TSM_RETURN_IF_ERROR(read_part(sec, h.version, s, part.counts));
+    TSM_RETURN_IF_ERROR(read_part(sec, s, part.counts));
     const PartCounts& p = part.counts;
     // Against the header before anything is allocated: the header's counts
     // passed the caller's limits.

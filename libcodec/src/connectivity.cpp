@@ -7,10 +7,11 @@
 //                  count), marching bits, polygon-edge flags
 //   topology:      component count, jump edges, virtual vertices, stitches,
 //                  side faces (degenerate faces kept verbatim)
-// At the fast levels (format version 9, FORMAT.md §8.3.1) the run values
-// (vertex-run lengths, march counts, stitch and virtual-vertex positions,
-// stitch distances) go through static prefix codes instead (table_coder),
-// stored at the start of the topology stream: one lookup per value.
+// The topology stream starts with a mode byte (FORMAT.md §8.3.1): at the
+// fast levels the run values (vertex-run lengths, march counts, stitch and
+// virtual-vertex positions, stitch distances) may go through static prefix
+// codes instead (table_coder), stored after it: one lookup per value.
+// Stitch targets are coded by their rank among candidates (§8.3.2).
 // The decoder reverses it and reassembles the exact input faces.
 #include <algorithm>
 #include <memory>
@@ -44,13 +45,13 @@ struct TriangleTreeModels {
 
 struct TopologyModels {
   UIntModel count, corner, partner, position, distance, face_size, index;
-  // Version 11: a stitch target's candidate rank + 1 (0: its distance
-  // follows), by StitchCandidates::context.
+  // A stitch target's candidate rank + 1 (0: its distance follows), by
+  // StitchCandidates::context.
   UIntModel rank[2];
   Prob has_polygons;
 };
 
-// Version 11 (FORMAT.md §8.3.2): the candidates for a stitch's target. A
+// FORMAT.md §8.3.2: the candidates for a stitch's target. A
 // stitched position d is a copy of a vertex T; each of d's neighbours in
 // the cut surface whose vertex is known (a position not stitched, or one
 // stitched before d: its target) is a neighbour of T in the mesh, so T is
@@ -195,9 +196,10 @@ struct TopologyTail {
   std::vector<uint32_t> side;  // per side face: its size, then its corners (output ids)
 };
 
-// Codes the tail: stitch targets as distances (versions up to 10), or with
-// `sc` by their rank among the candidates (version 11, §8.3.2; positions
-// all first).
+// Codes the tail: with `sc`, stitch targets by their rank among the
+// candidates (§8.3.2; positions all first), as the file has them; without,
+// every target as a distance, after its position (what the encoder
+// measures the run tables on and orders codings by, encode_connectivity).
 void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const TopologyTail& t,
                StitchCandidates* sc = nullptr, std::vector<uint32_t>* target = nullptr) {
   o.count.encode(e, static_cast<uint32_t>(t.virtual_pos.size()));
@@ -228,11 +230,9 @@ void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const Topology
   }
 }
 
-}  // namespace
-
-// What version 11's topology stream of a coding needs beyond the lists:
-// the coder, models and run values where the tail starts, and the cut
-// surface in decode order (corners as pre-order positions, twins).
+// What the topology stream with stitch targets by candidates needs beyond
+// the lists: the coder, models and run values where the tail starts, and
+// the cut surface in decode order (corners as pre-order positions, twins).
 struct CandidateTail {
   RangeEncoder coder;
   TopologyModels models;
@@ -242,18 +242,19 @@ struct CandidateTail {
   uint32_t positions = 0;
 };
 
-std::string candidate_topology(const CandidateTail* tail) {
-  if (!tail) return std::string();
-  CandidateTail c = *tail;  // its coder and models go on from where they are
+// The topology stream (mode byte first) with the tail coded from where `c`
+// left off, stitch targets by candidates.
+std::string candidate_topology(CandidateTail& c) {
   std::vector<uint8_t> is_virtual(c.positions, 0), stitched(c.positions, 0);
   for (uint32_t p : c.tail.virtual_pos) is_virtual[p] = 1;
   for (auto [dup, orig] : c.tail.stitches) stitched[dup] = 1;
   std::vector<uint32_t> target(c.positions, kNone);
   StitchCandidates sc(c.corner, c.twin, is_virtual, stitched, target);
   code_tail(c.coder, c.models, c.runs, c.tail, &sc, &target);
-  // The mode byte always (adaptive without tables).
   return (c.runs.tables ? c.runs.block() : std::string(1, '\0')) + c.coder.finish();
 }
+
+}  // namespace
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
   out = ConnectivityEncoding();
@@ -424,8 +425,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   if (dec_tri.size() != m.triangle_count()) return Status(ErrorCode::internal, "triangle trees lost triangles");
   g.corner.resize(3 * dec_tri.size());
   g.twin.resize(3 * dec_tri.size());
-  // With stitches also the corners as pre-order positions (version 11's cut
-  // surface, candidate_topology).
+  // With stitches also the corners as pre-order positions (the cut surface
+  // the stitch candidates are found on, candidate_topology).
   std::vector<uint32_t> cut_corner(stitches.empty() ? 0 : g.corner.size());
   for (size_t k = 0; k < dec_tri.size(); ++k) {
     const uint32_t t = dec_tri[k];
@@ -439,9 +440,10 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   }
 
   // The rest of the topology stream: virtual vertices, stitches, side
-  // faces (corners as output vertex ids). With stitches, what version 11
-  // codes from here on instead (targets by candidates) is kept for
-  // candidate_topology, which codes it for the one coding a file keeps.
+  // faces (corners as output vertex ids). Coded first with every stitch
+  // target as a distance (what the choice of run tables below is measured
+  // on); with stitches, the coder's state where the tail starts is kept for
+  // candidate_topology, which codes the tail as the file has it.
   {
     std::vector<uint32_t> input_to_out(mesh.vertex_count());
     for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
@@ -451,9 +453,9 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       for (uint32_t i = 0; i < mesh.face_size(face); ++i) tail.side.push_back(input_to_out[mesh.face(face)[i]]);
     }
   }
-  std::shared_ptr<CandidateTail> c;
+  std::unique_ptr<CandidateTail> c;
   if (!stitches.empty()) {
-    c = std::make_shared<CandidateTail>();
+    c = std::make_unique<CandidateTail>();
     c->coder = eo;
     c->models = om;
     c->runs = runs;
@@ -467,30 +469,31 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     c->twin = g.twin;
     c->positions = P;
     c->tail = std::move(tail);
-    out.candidate_tail = std::move(c);
   }
   st.side_faces = prep.side_faces.size();
   st.polygons = prep.polygon_count;
   out.streams.vertex_tree = ev.finish();
   out.streams.triangle_tree = et.finish();
   out.streams.topology = eo.finish();
-  if (hints.runs != RunCoding::v8) {  // version 9: the mode byte (and the tables) first
-    const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
-    if (runs.tables) {
-      // Tables where they cost at most 1/8 more than the adaptive models
-      // (the corpus scans: 3-11% more, tables included). On regular meshes,
-      // whose runs repeat, the models learn the values down to a small
-      // fraction of a bit while a prefix code spends at least one bit on
-      // each (40-500% more): those are coded again without tables.
-      const size_t adaptive = runs.adaptive.finish().size();
-      if (block.size() > adaptive + adaptive / 8) {
-        CutHints again = hints;
-        again.runs = RunCoding::adaptive;
-        return encode_connectivity(mesh, out, again);
-      }
+  // The mode byte (and the tables) first.
+  const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
+  if (runs.tables) {
+    // Tables where they cost at most 1/8 more than the adaptive models
+    // (the corpus scans: 3-11% more, tables included). On regular meshes,
+    // whose runs repeat, the models learn the values down to a small
+    // fraction of a bit while a prefix code spends at least one bit on
+    // each (40-500% more): those are coded again without tables.
+    const size_t adaptive = runs.adaptive.finish().size();
+    if (block.size() > adaptive + adaptive / 8) {
+      CutHints again = hints;
+      again.runs = RunCoding::adaptive;
+      return encode_connectivity(mesh, out, again);
     }
-    out.streams.mode_byte = true;
-    out.streams.topology = block + out.streams.topology;
+  }
+  out.streams.topology = block + out.streams.topology;
+  if (c) {  // the stitch targets by candidates, as the file has them
+    out.distance_topology = std::move(out.streams.topology);
+    out.streams.topology = candidate_topology(*c);
   }
   st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
   return Status::Ok();
@@ -499,13 +502,13 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
                            uint64_t corner_count, Mesh& out, GeometryLayout& layout,
                            ConnectivityStats* stats) {
-  // Version 9 (§8.3.1): the mode byte, and with tables the bit stream's
-  // length, the run tables and the bit stream before the range-coded rest.
+  // §8.3.1: the mode byte, and with tables the bit stream's length, the run
+  // tables and the bit stream before the range-coded rest.
   std::string_view topology = in.topology;
   bool tables = false;
   TableSet run_tables;
   BitReader run_bits;
-  if (in.mode_byte) {
+  {
     ByteReader r(topology);
     uint8_t mode;
     if (!r.u8(mode)) return corrupt("topology stream is empty (no run coding mode)");
@@ -704,16 +707,7 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   if (nstitch > P) return corrupt("more stitches than vertices");
   std::vector<uint32_t> stitch_to(P, kNone);
   at = 0;
-  if (!in.stitch_candidates) {
-    for (uint32_t i = 0; i < nstitch; ++i) {
-      const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-      const uint32_t dist = run_value(om.distance, dop, kRunDistanceCtx);
-      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
-      at += d;
-      if (dist >= at) return corrupt("stitch target out of range");
-      stitch_to[at] = at - dist - 1;
-    }
-  } else if (nstitch > 0) {  // version 11 (§8.3.2): every position, then every target
+  if (nstitch > 0) {  // §8.3.2: every position, then every target by its candidate rank
     std::vector<uint8_t> stitched(P, 0);
     std::vector<uint32_t> at_list(nstitch);
     for (uint32_t i = 0; i < nstitch; ++i) {

@@ -49,13 +49,12 @@ struct UnionFind {
 };
 
 // The connectivity's run values (vertex-run lengths, march counts, the
-// positions of virtual and stitched vertices and the stitch distances):
-// v8: adaptive models, the topology stream as in version 8 and before;
-// adaptive: the same, behind a mode byte 0 (version 9); tables: mode byte
-// 1, static prefix codes per context in a bit stream (version 9, the fast
-// levels: one table lookup per value instead of about eight adaptive
-// decisions).
-enum class RunCoding : uint8_t { v8 = 0, adaptive = 1, tables = 2 };
+// positions of virtual and stitched vertices and the stitch distances;
+// FORMAT.md §8.3.1): adaptive: their adaptive models, behind a mode byte 0
+// at the start of the topology stream; tables: mode byte 1, static prefix
+// codes per context in a bit stream (the fast levels: one table lookup per
+// value instead of about eight adaptive decisions).
+enum class RunCoding : uint8_t { adaptive = 1, tables = 2 };
 constexpr int kRunContexts = 8;   // 2 vertex-run lengths, 4 march counts, position, distance
 constexpr int kRunMapBytes = 1;   // the run tables' used-context map
 
@@ -111,8 +110,8 @@ struct CutHints {
   // mesh has the same positions, so a rule picks the same roots and edges
   // there (the encoder tries several and keeps the smallest file).
   int root_rule = 0;
-  // How the run values are coded (format version 9, FORMAT.md §8.3.1).
-  RunCoding runs = RunCoding::v8;
+  // How the run values are coded (FORMAT.md §8.3.1; tables: where they pay).
+  RunCoding runs = RunCoding::adaptive;
 };
 
 // Lexicographic order of quantized positions (3 per input vertex), from
@@ -277,7 +276,7 @@ Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, cons
 struct ConnectivityStats {
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, polygons = 0, marching_bits = 0;
-  uint64_t run_tables = 0;  // 1 when the run values were table-coded (version 9, mode 1)
+  uint64_t run_tables = 0;  // 1 when the run values were table-coded (mode 1)
   uint64_t bytes = 0;
 };
 
@@ -285,17 +284,11 @@ struct ConnectivityStats {
 struct ConnectivityStreams {
   std::string vertex_tree;    // VST runs per component
   std::string triangle_tree;  // root, runs, marching bits, polygon-edge flags per component
-  std::string topology;       // components, jumps, virtual vertices, stitches, side faces
-  // Version 9 and later: the topology stream starts with the run coding's
-  // mode byte (0 adaptive, 1 tables; FORMAT.md §8.3.1).
-  bool mode_byte = false;
-  // Version 11 and later (implies mode_byte): the topology stream lists all
-  // stitch positions first, then each target by its rank among candidates
-  // (FORMAT.md §8.3.2).
-  bool stitch_candidates = false;
+  // The run coding's mode byte (0 adaptive, 1 tables; FORMAT.md §8.3.1),
+  // then components, jumps, virtual vertices, stitches (all positions, then
+  // each target by its rank among candidates, §8.3.2), side faces.
+  std::string topology;
 };
-
-struct CandidateTail;  // connectivity.cpp
 
 struct ConnectivityEncoding {
   ConnectivityStreams streams;
@@ -304,18 +297,15 @@ struct ConnectivityEncoding {
   // The cut surface as the decoder will rebuild it, for the geometry coder.
   GeometryLayout layout;
   ConnectivityStats stats;
-  // With stitches: what the topology stream as version 11 codes it needs
-  // (candidate_topology), null without stitches.
-  std::shared_ptr<const CandidateTail> candidate_tail;
+  // With stitches: the topology stream as it would be with every stitch
+  // target coded as a distance after its position instead of by candidates
+  // (empty without stitches). Not a stream of the file: the canonical rounds
+  // (codec.cpp) order the codings of a cycle by it.
+  std::string distance_topology;
   bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
 };
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints = CutHints());
-// The topology stream of a coding (its candidate_tail) as version 11 codes
-// it: the mode byte, stitch targets by candidates (FORMAT.md §8.3.2), the
-// other streams unchanged; for the file to take when it pays (codec.cpp).
-// Empty for null (no stitches).
-std::string candidate_topology(const CandidateTail* tail);
 // Fills out.face_offsets / out.indices (positions are the geometry stage's
 // job) and the layout the geometry decoder walks. The counts come from the
 // header and are checked against what the streams say.

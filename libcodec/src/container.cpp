@@ -2,10 +2,9 @@
 // then self-delimiting sections, each with an id, a codec (raw or zstd), its
 // lengths and an XXH32 checksum, ended by an end marker. The method's streams
 // (seed 004 §3-4: vertex tree, triangle tree, marching pattern, geometry) go
-// in one section per segment (version 4: a mesh of one segment has its own,
-// the mesh section; version 3 files, which the decoder still reads, had a
-// section per stream); side data is zstd-compressed where that wins. Sections are read in
-// order, so a decoder can start on a section as soon as its bytes are in.
+// in one section per segment (a mesh of one segment: the mesh section);
+// side data is zstd-compressed where that wins. Sections are read in order,
+// so a decoder can start on a section as soon as its bytes are in.
 //
 // Every length is checked against the bytes that remain before anything is
 // allocated, and every section's checksum is verified before it is used.
@@ -25,16 +24,12 @@ namespace tsm {
 const char* section_name(uint16_t id) {
   switch (id) {
     case kSectionEnd: return "end";
-    case kSectionVertexTree: return "vertex-tree";
-    case kSectionTriangleTree: return "triangle-tree";
-    case kSectionTopology: return "topology";
-    case kSectionGeometry: return "geometry";
     case kSectionSegment: return "segment";
-    case kSectionAttributes: return "attributes";
+    case kSectionRetiredAttributes: return "retired";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
   }
-  return "unknown";
+  return id >= kSectionRetiredFirst && id <= kSectionRetiredLast ? "retired" : "unknown";
 }
 
 uint32_t checksum32(std::string_view bytes) { return XXH32(bytes.data(), bytes.size(), 0); }
@@ -70,15 +65,7 @@ ContainerWriter::ContainerWriter(const Header& header) {
   write_header_fields(fw, header);
   w.varint(fields.size());
   w.bytes(fields);
-  header_end_ = out_.size();
   w.u32(checksum32(std::string_view(out_)));
-}
-
-void ContainerWriter::set_version(uint16_t version) {
-  out_[4] = static_cast<char>(version & 0xFF);
-  out_[5] = static_cast<char>(version >> 8);
-  const uint32_t c = checksum32(std::string_view(out_).substr(0, header_end_));
-  for (int i = 0; i < 4; ++i) out_[header_end_ + i] = static_cast<char>((c >> (8 * i)) & 0xFF);
 }
 
 void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zstd_level) {
@@ -121,11 +108,11 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
     missing = "file ends inside the header";
     return Status::Ok();
   }
-  if (version < kOldestFormatVersion || version > kFormatVersion)
+  if (version != kFormatVersion)
     return Status(ErrorCode::unsupported, "format version " + std::to_string(version) +
-                                              " is not supported by this decoder (it reads versions " +
-                                              std::to_string(kOldestFormatVersion) + " to " +
-                                              std::to_string(kFormatVersion) + ")");
+                                              ": this decoder reads only format version " +
+                                              std::to_string(kFormatVersion) +
+                                              " (tsm keeps one format until 1.0; re-encode from the source mesh)");
   header.version = version;
   if (!r.u16(flags)) {
     missing = "file ends inside the header";
@@ -238,12 +225,10 @@ Status SectionRules::admit(const Section& s, const Header& h) {
       return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
     return Status::Ok();
   }
-  const bool v3_whole = (s.id >= kSectionVertexTree && s.id <= kSectionGeometry) || s.id == kSectionAttributes;
-  if (h.version >= 4 && v3_whole)
-    return corrupt_at(at, s.id, "a version-3 section in a version-" + std::to_string(h.version) +
-                                    " file (its streams belong in the mesh section)");
-  const bool whole = h.version >= 4 ? s.id == kSectionMesh : v3_whole;
-  if (segment_count > 1 && whole)
+  if ((s.id >= kSectionRetiredFirst && s.id <= kSectionRetiredLast) || s.id == kSectionRetiredAttributes)
+    return corrupt_at(at, s.id, "retired section id " + std::to_string(s.id) +
+                                    " (a mesh's streams belong in the mesh or segment sections)");
+  if (segment_count > 1 && s.id == kSectionMesh)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
   for (uint16_t prev : seen)
     if (prev == s.id) return corrupt_at(at, s.id, "appears twice");

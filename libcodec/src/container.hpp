@@ -11,9 +11,9 @@
 namespace tsm {
 
 constexpr char kMagic[4] = {'T', 'S', 'M', '\x1a'};
-constexpr uint16_t kFormatVersion = 11;       // what the encoder writes
-constexpr uint16_t kOldestFormatVersion = 3;  // the decoder reads versions 3 to 11
-constexpr uint16_t kCandidateVersion = 11;    // stitch targets by candidates (FORMAT.md §8.3.2)
+// The preamble's version field. tsm keeps one format until 1.0: the encoder
+// writes this version and the decoder reads only it.
+constexpr uint16_t kFormatVersion = 12;
 
 enum class SectionCodec : uint8_t { raw = 0, zstd = 1 };
 // A stored section may expand at most this much through its codec; the encoder
@@ -23,20 +23,19 @@ constexpr uint64_t kMaxExpansion = 1024;
 
 enum SectionId : uint16_t {
   kSectionEnd = 0,
-  // 1 and 2 were the foundation codec's raw sections; retired, never reused.
-  kSectionVertexTree = 3,     // vertex spanning tree runs (range coded)
-  kSectionTriangleTree = 4,   // triangle tree runs, marching pattern, polygon flags (range coded)
-  kSectionTopology = 5,       // components, jumps, virtual vertices, stitches, side faces (range coded)
-  kSectionGeometry = 6,       // predicted quantized positions (range coded)
+  // Ids 1-6 and 8 are retired and never reused: 1 and 2 are ignored like
+  // any unknown id, 3-6 and 8 refused (SectionRules).
+  kSectionRetiredFirst = 3,   // 3-6: retired
+  kSectionRetiredLast = 6,
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
-  kSectionAttributes = 8,     // normals, colours, texture coordinates, ... (headers + range coded)
+  kSectionRetiredAttributes = 8,  // retired
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
-  kSectionMesh = 10,          // version 4: a one-segment mesh's streams 3-6 and attributes in one section
+  kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
 };
 const char* section_name(uint16_t id);
 
 struct Header {
-  uint16_t version = kFormatVersion;  // as read from the file (kOldestFormatVersion .. kFormatVersion)
+  uint16_t version = kFormatVersion;  // the preamble's version field (read_header accepts only kFormatVersion)
   uint64_t vertex_count = 0;
   uint64_t face_count = 0;
   uint64_t corner_count = 0;
@@ -61,15 +60,11 @@ class ContainerWriter {
   explicit ContainerWriter(const Header& header);
   // Adds a section; tries zstd at `zstd_level` (0 = never) and keeps it when smaller.
   void add_section(uint16_t id, std::string_view payload, int zstd_level);
-  // Rewrites the preamble's version (and the header checksum over it): the
-  // encoder writes the oldest version that holds what it coded.
-  void set_version(uint16_t version);
   // Finishes the file (end marker) and returns the bytes.
   std::string finish();
 
  private:
   std::string out_;
-  size_t header_end_ = 0;  // offset of the header checksum
 };
 
 // Incremental reading, for bytes that may still be arriving: each reads one
@@ -84,16 +79,16 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
                     size_t base = 0);
 
 // Which ids may follow which (FORMAT.md §4.3): segment sections only in a
-// file of several segments, at most segment_count of them; the whole-mesh
-// sections only in a file of one (version 3: sections 3-6 and 8; version 4:
-// section 10); any other id at most once.
+// file of several segments, at most segment_count of them; the mesh section
+// only in a file of one; the retired ids 3-6 and 8 never; any other id at
+// most once.
 struct SectionRules {
   std::vector<uint16_t> seen;
   uint32_t segments = 0;
   Status admit(const Section& s, const Header& h);
 };
 
-// The mesh section's payload (version 4, FORMAT.md §4.7): the byte lengths
+// The mesh section's payload (FORMAT.md §4.7): the byte lengths
 // of the vertex-tree, triangle-tree, topology and geometry streams, the
 // streams, then the attribute payload (the rest; empty when none).
 struct MeshPayload {

@@ -21,7 +21,7 @@
 //  - ancestors: the paper's predictor, vertex-tree order, P = sum lambda_i
 //    v_{n-i} over the K nearest tree ancestors, lambda fitted per mesh by
 //    least squares (Eigen) and stored as 16.16 fixed point.
-//  - raw (format version 4): no prediction; every coordinate as plain bits
+//  - raw: no prediction; every coordinate as plain bits
 //    (a plane index where its axis has lattice planes). On a mesh of a few
 //    vertices fresh adaptive models cost more than they save.
 // Residuals: per axis an adaptive signed-integer model chosen by the
@@ -119,7 +119,7 @@ __attribute__((always_inline)) inline int64_t div_round(int64_t sum, int64_t n) 
   return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
-// Residual mixing (version 6, kMixFlag): the second model of each residual
+// Residual mixing (kMixFlag): the second model of each residual
 // decision, by the second context, and the mixing weights by coding
 // position and first context (capped at kMixCtx - 1). Only allocated for a
 // mixed stream (about 1.8 MB of mostly untouched lazy rows).
@@ -186,7 +186,7 @@ struct CollectSink {
   bool truncated() const { return false; }
 };
 
-// Version 8 (kTableFlag): the surface residuals through static prefix codes
+// Tables (kTableFlag): the surface residuals through static prefix codes
 // per context, everything else through the range coder as before. The
 // encoder counts the symbols in a first pass, builds the codes, then codes.
 struct TableCountSink : CollectSink {
@@ -258,19 +258,19 @@ struct Coder {
   std::vector<uint8_t> act;  // per output vertex: bit length of its residuals' sum, kUnknown until coded
   int64_t qmax;
   Lattice lattice;
-  bool planes_from_top = false;  // version 7: each axis's last plane coded first, from the top (code_lattice)
+  bool planes_from_top = false;  // each axis's last plane coded first, from the top (code_lattice)
   // Per parallelogram class (1, 2, 3+ parallelograms): the weight of the
   // parallelogram average against the neighbour average, 4.12 fixed point
   // (4096 = parallelograms only), fitted per mesh by least squares.
   int32_t alpha[3] = {kAlphaOne, kAlphaOne, kAlphaOne};
-  // Residual mixing (version 6): each residual from two models, the second by
+  // Residual mixing: each residual from two models, the second by
   // the largest residual of this vertex's axes coded so far (the first axis:
   // the neighbours' activity where the first context is the spread, else the
   // previous vertex's activity), mixed (range_coder.hpp).
   std::unique_ptr<MixModels> mix;  // null: no mixing
   int prev_act = 0;  // activity of the vertex coded last (0 before the first)
   bool spread_ctx = false;  // predictor spread: contexts from the parallelograms' spread
-  // Tangent step (version 5, kTangentFlag): a vertex with a local normal codes
+  // Tangent step (kTangentFlag): a vertex with a local normal codes
   // the two axes across the normal first, then the axis nearest it, predicted
   // through the tangent plane from the first two residuals with the weight
   // beta[set] (4.12; set 0: surface vertices, 1: vertices with an anchor).
@@ -970,7 +970,7 @@ void fit_lambda(const GeometryLayout& g, const std::vector<uint32_t>& q, int K, 
 }
 
 // The lattice values per axis: count, then increasing values as gaps; with
-// `top` (version 7, kTopFlag) an axis of two or more planes codes its last
+// `top` (kTopFlag) an axis of two or more planes codes its last
 // plane first, as qmax minus it, and then the others as gaps below it.
 template <class Sink>
 bool code_lattice(Sink& s, Lattice& lattice, int64_t qmax, size_t vertex_count, bool top) {
@@ -1002,9 +1002,9 @@ bool code_lattice(Sink& s, Coder& c) {
   return code_lattice(s, c.lattice, c.qmax, c.act.size(), c.planes_from_top);
 }
 
-// Version 7: whether the planes cost fewer bytes with each axis's last plane
-// coded from the top (the planes alone, fresh models; a tie keeps the
-// version 5 form, readable by older decoders).
+// Whether the planes cost fewer bytes with each axis's last plane coded
+// from the top (the planes alone, fresh models; a tie keeps them all
+// from the bottom).
 bool top_pays(const Lattice& lattice, int bits, uint32_t vertex_count) {
   auto size = [&](bool top) {
     EncodeSink s;
@@ -1093,7 +1093,7 @@ void fit_betas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits
   for (int i = 0; i < 2; ++i) beta[i] = fit.tan_samples[i].empty() ? 0 : fit_alpha(fit.tan_samples[i]);
 }
 
-// Predictor raw (version 4): the lattice planes, then every coordinate of
+// Predictor raw: the lattice planes, then every coordinate of
 // every vertex in output order as equiprobable bits: the index of its plane
 // when its axis has planes (every value of the axis is one), else its grid
 // value. No models to train: on a mesh of a few vertices this beats any
@@ -1313,10 +1313,9 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 }
 
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats, int version) {
-  const bool tangent = version >= 5, mix = version >= 6;
-  // The fast levels: residuals through static prefix codes (version 8).
-  const bool tables = version >= 8 && level <= kTableLevel;
+                            const Lattice* candidate, GeometryStats* stats) {
+  // The fast levels: residuals through static prefix codes.
+  const bool tables = level <= kTableLevel;
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   st.tables = tables;
@@ -1329,7 +1328,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   int32_t beta[2];
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
                       bool mixed = false) {
-    const bool top = version >= 7 && top_pays(lattice, bits, g.vertex_count);
+    const bool top = top_pays(lattice, bits, g.vertex_count);
     std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
@@ -1358,15 +1357,15 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
         }
     }
   }
-  // Levels 1-2 (version 10): the prediction from every triangle around the
+  // Levels 1-2: the prediction from every triangle around the
   // new vertex, still in march order (predictor fan), and at level 2 the
   // tangent step on whichever of gate and fan is smaller; each kept only
   // where it makes the file smaller.
   int32_t fan_lsq[3], fan_est[3];
-  if ((level == 1 || level == 2) && version >= kFanVersion) {
+  if (level == 1 || level == 2) {
     fit_alphas(g, q, bits, Predictor::fan, fan_lsq, fan_est);
     consider(Predictor::fan, 0, st.lattice, fan_est);
-    if (level == 2 && tangent) {
+    if (level == 2) {
       fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
       consider(st.predictor, 0, st.lattice, weights, beta);
     }
@@ -1408,13 +1407,13 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     }
     consider(Predictor::raw, 0, Lattice(), nullptr);
   }
-  // The tangent step (version 5) on whatever surface predictor won.
-  if (tangent && level >= 3 && surface_predictor(st.predictor)) {
+  // The tangent step on whatever surface predictor won.
+  if (level >= 3 && surface_predictor(st.predictor)) {
     fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
     consider(st.predictor, 0, st.lattice, weights, beta);
   }
-  // Residual mixing (version 6) on whatever won: smaller, slower to decode.
-  if (mix && level >= kMixLevel && st.predictor != Predictor::raw)
+  // Residual mixing on whatever won: smaller, slower to decode.
+  if (level >= kMixLevel && st.predictor != Predictor::raw)
     consider(st.predictor, st.ancestors, st.lattice, weights, st.tangent ? beta : nullptr, true);
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
@@ -1422,45 +1421,42 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
 }
 
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats, int version) {
+                       GeometryStats* stats) {
   auto corrupt = [](const std::string& what) { return Status(ErrorCode::corrupt_data, "geometry: " + what); };
   ByteReader r(bytes);
   GeometryStats st;
   uint8_t kind;
   if (!r.u8(kind)) return corrupt("empty section");
-  const uint8_t newest = static_cast<uint8_t>(version >= kFanVersion ? Predictor::fan
-                                              : version >= 4           ? Predictor::raw
-                                                                       : Predictor::spread);
   bool default_weights = false;
-  if (version >= 8 && (kind & kTableFlag)) {
+  if (kind & kTableFlag) {
     kind = static_cast<uint8_t>(kind & ~kTableFlag);
     st.tables = true;
   }
-  if (version >= 7 && (kind & kTopFlag)) {
+  if (kind & kTopFlag) {
     kind = static_cast<uint8_t>(kind & ~kTopFlag);
     st.top = true;
   }
-  if (version >= 6 && (kind & kMixFlag)) {
+  if (kind & kMixFlag) {
     kind = static_cast<uint8_t>(kind & ~kMixFlag);
     st.mix = true;
     const int base = kind & ~(kDefaultWeightsFlag | kTangentFlag);
     if (base > static_cast<int>(Predictor::spread) && base != static_cast<int>(Predictor::fan))
       return corrupt("predictor " + std::to_string(base) + " has no residual models to mix");
   }
-  if (version >= 5 && (kind & kTangentFlag)) {
+  if (kind & kTangentFlag) {
     kind = static_cast<uint8_t>(kind & ~kTangentFlag);
     st.tangent = true;
     const uint8_t base = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
     if (!surface_predictor(static_cast<Predictor>(base)))
       return corrupt("predictor " + std::to_string(base) + " has no tangent step");
   }
-  if (version >= 4 && (kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
+  if ((kind & kDefaultWeightsFlag) && kind != kDefaultWeightsFlag) {
     kind = static_cast<uint8_t>(kind & ~kDefaultWeightsFlag);
     default_weights = true;
     if (kind > static_cast<uint8_t>(Predictor::spread) && kind != static_cast<uint8_t>(Predictor::fan))
       return corrupt("predictor " + std::to_string(kind) + " has no weights to leave out");
   }
-  if (kind > newest) return corrupt("unknown predictor " + std::to_string(kind));
+  if (kind > static_cast<uint8_t>(Predictor::fan)) return corrupt("unknown predictor " + std::to_string(kind));
   st.predictor = static_cast<Predictor>(kind);
   if (st.tables && (st.predictor == Predictor::raw || st.mix))
     return corrupt(st.mix ? "residual mixing and tables at once" : "the raw predictor has no residuals for tables");
@@ -1535,7 +1531,7 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     s.d.init(bytes.substr(r.offset()));
     return run(s);
   }
-  // Version 8 (§8.5.11): the bit stream's length, the tables, the bit
+  // With tables (§8.5.11): the bit stream's length, the tables, the bit
   // stream, then the range-coded stream.
   auto s = std::make_unique<TableDecodeSink>();
   std::string why;

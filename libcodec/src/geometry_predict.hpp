@@ -35,31 +35,30 @@ enum class Predictor : uint8_t {
   parallelograms = 1, // march order; average of every parallelogram around the new vertex
   gate = 2,           // march order; the single parallelogram across the gate (fast)
   spread = 3,         // as parallelograms; residual contexts from the parallelograms' spread
-  raw = 4,            // version 4: no prediction, every coordinate as `bits` equiprobable bits (tiny meshes)
-  fan = 5,            // version 10: march order (as gate) predicted from every triangle around the new vertex,
+  raw = 4,            // no prediction, every coordinate as `bits` equiprobable bits (tiny meshes)
+  fan = 5,            // march order (as gate) predicted from every triangle around the new vertex,
                       // residual contexts from the parallelograms' spread (as spread): levels 1-2
 };
-// The format version that introduced Predictor::fan.
-constexpr int kFanVersion = 10;
-// Version 4: the predictor byte of 1, 2 or 3 with this bit set says the
+// The predictor byte of 1, 2, 3 or 5 with this bit set says the
 // parallelogram weights are all 1.0 and not stored (6 bytes less).
 constexpr uint8_t kDefaultWeightsFlag = 0x80;
-// Version 5: the predictor byte of 1, 2 or 3 (with or without 0x80) with this
-// bit set says the tangent step is on; its two weights follow the
+// The predictor byte of 1, 2, 3 or 5 (with or without 0x80) with this bit
+// set says the tangent step is on; its two weights follow the
 // parallelogram weights.
 constexpr uint8_t kTangentFlag = 0x40;
-// Version 6: the predictor byte of 0, 1, 2 or 3 (with the flags above) with
-// this bit set says residuals are coded with two mixed models each.
+// The predictor byte of 0, 1, 2, 3 or 5 (with the flags above) with this bit
+// set says residuals are coded with two mixed models each.
 constexpr uint8_t kMixFlag = 0x20;
-// Version 7: the predictor byte (any of the above) with this bit set says
-// that each axis of two or more lattice planes codes its last plane first,
-// as qmax minus it (a box's far corners: a few bits instead of ~20).
+// The predictor byte (any of the above) with this bit set says that each
+// axis of two or more lattice planes codes its last plane first, as qmax
+// minus it (a box's far corners: a few bits instead of ~20).
 constexpr uint8_t kTopFlag = 0x10;
-// Version 8: the predictor byte of 0, 1, 2 or 3 (any flag above but mixing)
-// with this bit set says the residuals are coded with static prefix codes
-// per context (table_coder.hpp), stored before the streams: the fast levels.
+// The predictor byte of 0, 1, 2, 3 or 5 (any flag above but mixing) with
+// this bit set says the residuals are coded with static prefix codes per
+// context (table_coder.hpp), stored before the streams: the fast levels.
 constexpr uint8_t kTableFlag = 0x08;
-// The highest encoder level that codes residuals with tables (version 8).
+// The highest encoder level that codes residuals (and the connectivity's
+// run values and attribute residuals, where they pay) with tables.
 constexpr int kTableLevel = 2;
 // The lowest encoder level that tries residual mixing (slower to decode).
 constexpr int kMixLevel = 7;
@@ -73,10 +72,10 @@ struct Lattice {
 struct GeometryStats {
   Predictor predictor = Predictor::parallelograms;
   int ancestors = 0;  // K for the ancestor predictor
-  bool tangent = false;  // version 5: the tangent step
-  bool mix = false;      // version 6: residual mixing
-  bool top = false;      // version 7: lattice planes' last coded from the top
-  bool tables = false;   // version 8: residuals through static prefix codes
+  bool tangent = false;  // the tangent step
+  bool mix = false;      // residual mixing
+  bool top = false;      // lattice planes' last coded from the top
+  bool tables = false;   // residuals through static prefix codes
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -93,26 +92,24 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
 Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 
 // q: 3 quantized coordinates per output vertex. The encoder picks the
-// predictor by level, and the lattice (if a candidate is given) by size.
-// version: what the file may use: from 5 the tangent step, from 6 residual
-// mixing (at level kMixLevel and up), from 7 planes coded from the top,
-// from 8 residuals through tables (at level kTableLevel and below).
+// predictor by level, and the lattice (if a candidate is given) by size:
+// residual mixing at level kMixLevel and up, residuals through tables at
+// level kTableLevel and below, the fan predictor at levels 1-2, planes
+// coded from the top and the tangent step where they pay.
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
-                            const Lattice* candidate, GeometryStats* stats = nullptr, int version = 8);
+                            const Lattice* candidate, GeometryStats* stats = nullptr);
 // One predictor, lattice and set of parallelogram weights (per class of 1,
 // 2, 3+ parallelograms, 4.12 fixed point; null = 1.0), no search (tests and
 // experiments). tangent: the tangent step's two weights (4.12, surface
-// vertices and vertices with an anchor; version 5), null for none. mix:
-// residual mixing (version 6; not with the raw predictor). top: the lattice
-// planes' last coded from the top (version 7). tables: residuals through
-// static prefix codes (version 8; not with mixing or the raw predictor).
+// vertices and vertices with an anchor), null for none. mix: residual
+// mixing (not with the raw predictor). top: the lattice planes' last coded
+// from the top. tables: residuals through static prefix codes (not with
+// mixing or the raw predictor).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
                                const int32_t* tangent = nullptr, bool mix = false, bool top = false,
                                bool tables = false);
-// `version`: the file's format version (3 knows neither the raw predictor
-// nor the default-weights flag).
 Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits, std::vector<uint32_t>& q,
-                       GeometryStats* stats = nullptr, int version = 8);
+                       GeometryStats* stats = nullptr);
 
 }  // namespace tsm

@@ -278,7 +278,7 @@ struct SIntModelT {
   }
 };
 
-// Logistic mixing (format version 6, FORMAT.md §8.1.1): a decision coded
+// Logistic mixing (FORMAT.md §8.1.1): a decision coded
 // with two adaptive models at once, A and B, each seeing a different
 // context. Their probabilities are mapped to the logistic domain
 // (stretch), weighted by a small online-trained weight vector, and mapped

@@ -1,5 +1,5 @@
 // Static prefix codes per context: see table_coder.hpp (entropy coding
-// stage, format version 8; FORMAT.md §8.5.11).
+// stage; FORMAT.md §8.5.11).
 #include "table_coder.hpp"
 
 #include <algorithm>

@@ -1,10 +1,10 @@
-// Static prefix codes per context (entropy coding stage, format version 8;
-// FORMAT.md §8.5.11; version 9 codes the connectivity's run values with
-// them too, §8.3.1). The fast levels code the geometry residuals with one
+// Static prefix codes per context (entropy coding stage; FORMAT.md
+// §8.5.11; the connectivity's run values and the attribute residuals use
+// them too where they pay, §8.3.1, §8.12.1). The fast levels code the geometry residuals with one
 // canonical prefix code per residual context, stored in the file, instead
 // of the adaptive binary models of range_coder.hpp: one table lookup per
 // value instead of about ten adaptive decisions (6-9x faster to decode,
-// 1-2% larger; README "Format version 8 (session 16)"). The
+// 1-2% larger; README, session 16). The
 // contexts are the adaptive coder's (seed 004 §3.2 predicts, the contexts
 // of design notes §6 say how much was known); only the coder changes.
 //

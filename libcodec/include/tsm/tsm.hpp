@@ -34,22 +34,6 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
-  // The format version to write: 0 = the newest (11; the file says the
-  // oldest version that reads it: 5 unless it uses residual mixing, 6,
-  // lattice planes coded from the top, 7, residuals through tables, 8, the
-  // connectivity's run values through tables, which levels 0-2 use on
-  // meshes of 256 faces or more, 9, the fan predictor of levels 1-2, 10,
-  // or stitch targets by candidates, where a non-manifold mesh's stitches
-  // cost less so, 11); 10 writes files that decoders of version 10 read
-  // (stitch targets as distances); 9 without the fan predictor; 8 writes files that decoders of
-  // version 8 read (levels 0-2 then code run values adaptively); 7 files
-  // that decoders of version 7 read (levels 0-2 then code residuals
-  // adaptively too: slower to decode); 6 or 5 write files that decoders of that
-  // version read (without version 7's planes from the top, a few bytes on a
-  // box; 5 also without residual mixing, which only levels 7-9 use); 4 files
-  // that decoders of version 4 read (without version 5's tangent step
-  // either, so usually a little larger).
-  int format_version = 0;
 };
 
 struct DecodeOptions {
@@ -106,7 +90,7 @@ struct SegmentSummary {
   uint64_t faces = 0;
 };
 struct FileInfo {
-  uint32_t format_version = 0;
+  uint32_t format_version = 0;  // the header's (a file this library reads says 12)
   uint64_t vertex_count = 0;
   uint64_t face_count = 0;
   uint64_t corner_count = 0;
@@ -120,11 +104,11 @@ struct FileInfo {
   // Topology figures (from decoding the connectivity streams).
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, marching_bits = 0;
-  // Parts (segments) whose connectivity run values are table-coded (format
-  // version 9, the fast levels; FORMAT.md §8.3.1).
+  // Parts (segments) whose connectivity run values are table-coded (the
+  // fast levels; FORMAT.md §8.3.1).
   uint64_t run_table_parts = 0;
   // Attributes whose residuals are table-coded, summed over the parts
-  // (format version 9, the fast levels; FORMAT.md §8.12.1).
+  // (the fast levels; FORMAT.md §8.12.1).
   uint64_t table_coded_attributes = 0;
   // Stored bytes by kind; other = header, framing, references, side data.
   uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;
@@ -132,9 +116,10 @@ struct FileInfo {
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
-  // "gate", "fan" (format version 10), "ancestors" (with K) or "raw", followed by "+tangent" (tangent
-  // step), "+mix" (residual mixing), "+top" (lattice planes from the top)
-  // where used, and the lattice planes per axis (0 = unused).
+  // "gate", "fan", "ancestors" (with K) or "raw", followed by "+tangent" (tangent
+  // step), "+mix" (residual mixing), "+top" (lattice planes from the top),
+  // "+tables" (residuals through static prefix codes) where used, and the
+  // lattice planes per axis (0 = unused).
   std::string geometry_predictor;
   int ancestors = 0;
   uint32_t lattice_planes[3] = {0, 0, 0};
