@@ -25,8 +25,11 @@
 #   --add-metadata inserts a raw section 9 into an encoded file; well-formed
 #   ones must decode (and compare) on both sides, malformed ones must be
 #   refused by both.
-# * forged attribute headers (test_meshes.py --replace-in-mesh rewrites bytes
-#   of a mesh section and its checksum) must be refused by both.
+# * forged files (test_meshes.py --replace-in-mesh rewrites bytes of a mesh
+#   section and its checksum, --forge-topology the run coding mode or the
+#   length of the topology stream, --set-version the version field) must be
+#   refused by both. A forging step that fails is a failed case.
+# The last line gives the number of cases checked; none is a failure.
 # Exit status: 0 when every case is IDENTICAL (and every malformed file
 # refused by both), 1 otherwise.
 here=$(cd "$(dirname "$0")" && pwd)
@@ -83,6 +86,11 @@ refused() {  # name: both decoders must refuse $work/name.tsm (corrupt_data)
     echo "$1: DIFFERENT: reference_decoder.py exit $py ($out), tsm decode exit $cpp"; result "$1" 1
   fi
 }
+forged() {  # name command...: runs a forging command; its failure is a failed case
+  name=$1; shift
+  if "$@"; then return 0; fi
+  echo "$name: forging failed"; result "$name" 1; return 1
+}
 corpus_case() {  # check-function name file q level [segment_faces]
   fn=$1; shift
   if [ -f "$2" ]; then "$fn" "$@"; else echo "$1: skipped, $2 not found"; fi
@@ -91,16 +99,18 @@ corpus_case() {  # check-function name file q level [segment_faces]
 # ---- connectivity and geometry
 check triangle "$work/triangle.obj" 8 0
 for l in 0 6 9; do check mixed_l$l "$work/mixed.obj" 16 $l; done
-check mixed_q30_l0 "$work/mixed.obj" 30 0  # version 8 tables: residuals of every bit length
+check mixed_q30_l0 "$work/mixed.obj" 30 0  # table-coded residuals of every bit length
 check mixed_small_l9 "$work/mixed_small.obj" 10 9
 check fan_l9 "$work/fan.obj" 12 9
+for l in 0 6; do check irregular_l$l "$work/irregular.obj" 12 $l; done  # level 0: table-coded run values
+check irregular_segments_l0 "$work/irregular.obj" 12 0 600
 for l in 0 6 9; do check lattice_l$l "$work/lattice.obj" 12 $l; done
 for q in 11 16; do check box_q$q "$work/box.obj" $q 6; done
 for l in 0 6; do check mixed_segments_l$l "$work/mixed.obj" 12 $l 7; done
 check lattice_segments "$work/lattice.obj" 12 6 50
-for l in 0 6; do check double_sided_l$l "$work/double_sided.obj" 12 $l; done  # version 11: stitch targets by candidates
+for l in 0 6; do check double_sided_l$l "$work/double_sided.obj" 12 $l; done  # stitch targets by candidates
 check double_sided_segments "$work/double_sided.obj" 12 6 300
-for l in 1 2; do check mixed_l$l "$work/mixed.obj" 16 $l; done  # levels 1-2 where the gate still wins (its planes)
+for l in 1 2; do check mixed_l$l "$work/mixed.obj" 16 $l; done  # levels 1-2: gate or fan, lattice planes
 dragon=$corpus/dragon_vrip_res4.ply
 for l in 0 1 2 6 9; do corpus_case check dragon_l$l "$dragon" 11 $l; done
 corpus_case check dragon_segments "$dragon" 11 6 2000
@@ -115,69 +125,69 @@ for f in cube_att.obj cube_att.ply sphere.obj test_nm.obj Box.ply test_pos_color
   corpus_case acheck "$(echo "$f" | tr . _)" "$edge/$f" 11 6
 done
 corpus_case acheck sphere_obj_segments "$edge/sphere.obj" 11 6 50
-corpus_case acheck sphere_obj_q14 "$edge/sphere.obj" 14 6  # parallelograms with planes from the top (version 7)
+corpus_case acheck sphere_obj_q14 "$edge/sphere.obj" 14 6  # parallelograms with planes from the top
 corpus_case acheck test_pos_color_ply_segments "$edge/test_pos_color.ply" 11 6 40
 # predictor 2 (texture placement): vertex and corner domain, whole and segmented
 acheck uv_vertex "$work/uv_vertex.ply" 12 6
 acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150
 acheck uv_corner "$work/uv_corner.obj" 12 6
 acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
-# version 9, the fast level: table-coded attribute residuals (§8.12.1) for
-# predictor 2 in both domains, and in segments with values shared across borders
+# the fast level: table-coded attribute residuals (§8.12.1) for predictor 2
+# in both domains, and in segments with values shared across borders
 acheck uv_vertex_l0 "$work/uv_vertex.ply" 12 0
 acheck uv_corner_l0 "$work/uv_corner.obj" 12 0
 acheck uv_corner_segments_l0 "$work/uv_corner.obj" 12 0 600
 acheck unused_vt_l0 "$work/unused_vt.obj" 12 0
 corpus_case check bunny "$corpus/bun_zipper.ply" 12 6
-corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # version 8 tables, the fast level
-corpus_case check bunny_l2 "$corpus/bun_zipper.ply" 14 2  # version 10: fan with the tangent step
-corpus_case check bunny_segments_l1 "$corpus/bun_zipper.ply" 12 1 20000  # version 10: fan in segments
+corpus_case check bunny_l0 "$corpus/bun_zipper.ply" 14 0  # table-coded residuals and run values
+corpus_case check bunny_l2 "$corpus/bun_zipper.ply" 14 2  # fan with the tangent step
+corpus_case check bunny_segments_l1 "$corpus/bun_zipper.ply" 12 1 20000  # fan in segments
 corpus_case check bunny_segments "$corpus/bun_zipper.ply" 12 6 20000
 
 # ---- metadata (§4.6)
 meta="$PY $here/test_meshes.py --add-metadata"
-$meta "$work/attributes_ply_l0.tsm" "$work/metadata.tsm" gltf='{"asset":{"version":"2.0"}}' note=hello empty= &&
-  compare_file metadata
-$meta "$work/attributes_ply_segments.tsm" "$work/metadata_segments.tsm" k=v && compare_file metadata_segments
-$meta "$work/triangle.tsm" "$work/metadata_none.tsm" --raw 00 && compare_file metadata_none
+forged metadata $meta "$work/attributes_ply_l0.tsm" "$work/metadata.tsm" \
+  gltf='{"asset":{"version":"2.0"}}' note=hello empty= && compare_file metadata
+forged metadata_segments $meta "$work/attributes_ply_segments.tsm" "$work/metadata_segments.tsm" k=v &&
+  compare_file metadata_segments
+forged metadata_none $meta "$work/triangle.tsm" "$work/metadata_none.tsm" --raw 00 && compare_file metadata_none
 if command -v zstd > /dev/null; then  # codec 1: checked if python3 has the zstandard module, else skipped
-  $meta "$work/mixed_l6.tsm" "$work/metadata_zstd.tsm" --zstd "gltf=$(head -c 3000 "$work/mixed.obj")" &&
-    compare_file metadata_zstd
+  forged metadata_zstd $meta "$work/mixed_l6.tsm" "$work/metadata_zstd.tsm" --zstd \
+    "gltf=$(head -c 3000 "$work/mixed.obj")" && compare_file metadata_zstd
+else
+  echo "metadata_zstd: skipped, no zstd command"
 fi
 for bad in duplicate_key:02016100016100 empty_key:01000000 trailing_byte:01016100ff \
            count_too_large:02016100 value_too_long:0101610500 truncated_count:80; do
-  $meta "$work/triangle.tsm" "$work/metadata_${bad%%:*}.tsm" --raw "${bad#*:}" && refused "metadata_${bad%%:*}"
+  forged "metadata_${bad%%:*}" $meta "$work/triangle.tsm" "$work/metadata_${bad%%:*}.tsm" --raw "${bad#*:}" &&
+    refused "metadata_${bad%%:*}"
 done
 
-# ---- forged attribute headers (§8.12): an integer type on a grid, f32 as exact integers
-# Version 9 run tables (§8.3.1): an asked-for version 9 with mode 0, and
-# forged modes and cut tables, which both decoders refuse.
-if "$tsm" encode "$work/mixed.obj" -o "$work/mixed_v9_l6.tsm" -q 12 -l 6 --format-version 9 -f --quiet; then
-  compare_file mixed_v9_l6
-else
-  echo "mixed_v9_l6: tsm failed"; result mixed_v9_l6 1
-fi
-if [ -f "$work/dragon_l0.tsm" ]; then
-  topo="$PY $here/test_meshes.py --forge-topology"
-  for forged in mode=2 mode=0 cut=1 cut=7 cut=40 cut=300; do
-    name="run_tables_$(echo "$forged" | tr = _)"
-    $topo "$work/dragon_l0.tsm" "$work/$name.tsm" "$forged" && refused "$name"
-  done
-fi
-
-# Version 10's fan predictor (§8.5.1) in a file that says version 9: refused.
-if [ -f "$work/dragon_l1.tsm" ]; then
-  $PY "$here/test_meshes.py" --set-version "$work/dragon_l1.tsm" "$work/fan_as_v9.tsm" 9 && refused fan_as_v9
-fi
-
+# ---- forged files, refused by both
+# The version field (§2): only 12 is read.
+for v in 0 3 11 13 65535; do
+  forged "version_$v" "$PY" "$here/test_meshes.py" --set-version "$work/mixed_l6.tsm" "$work/version_$v.tsm" $v &&
+    refused "version_$v"
+done
+# Run tables (§8.3.1): forged modes and cut tables (irregular.obj at level 0 has mode 1).
+topo="$PY $here/test_meshes.py --forge-topology"
+for op in mode=2 mode=0 cut=1 cut=7 cut=40 cut=300; do
+  name="run_tables_$(echo "$op" | tr = _)"
+  forged "$name" $topo "$work/irregular_l0.tsm" "$work/$name.tsm" "$op" && refused "$name"
+done
+# Attribute headers (§8.12): an integer type on a grid, f32 as exact integers.
 forge="$PY $here/test_meshes.py --replace-in-mesh"
-$forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 056c6162656c000002010000 \
+forged forged_u16_grid $forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 056c6162656c000002010000 \
   056c6162656c000002010108000000000000000000000000 && refused forged_u16_grid
-$forge "$work/attributes_ply_l0.tsm" "$work/forged_f32_exact.tsm" 0b74656d70657261747572650000000101 \
-  0b74656d70657261747572650000000100 && refused forged_f32_exact
+forged forged_f32_exact $forge "$work/attributes_ply_l0.tsm" "$work/forged_f32_exact.tsm" \
+  0b74656d70657261747572650000000101 0b74656d70657261747572650000000100 && refused forged_f32_exact
 
-if [ -n "$failed" ]; then
-  echo "$cases cases, FAILED:$failed"
+if [ "$cases" -eq 0 ]; then
+  echo "0 cases checked: FAILED"
   exit 1
 fi
-echo "$cases cases, all IDENTICAL"
+if [ -n "$failed" ]; then
+  echo "$cases cases checked, FAILED:$failed"
+  exit 1
+fi
+echo "$cases cases checked, all IDENTICAL"

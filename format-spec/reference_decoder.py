@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""An independent decoder for .tsm files (format versions 3 to 11), written from
+"""An independent decoder for .tsm files (format version 12, the only one), written from
 format-spec/FORMAT.md alone (section numbers below refer to it). Pure Python 3,
 no third-party modules (zstd-compressed sections, codec 1, need the optional
 `zstandard` module; the reference encoder writes them only for the metadata
@@ -125,6 +125,7 @@ def read_varint(buf, pos, end):
 # ---------------------------------------------------------------- §2-§4 container
 
 MAGIC = b'TSM\x1a'
+FORMAT_VERSION = 12
 
 
 def read_container(data):
@@ -134,12 +135,13 @@ def read_container(data):
     if n < 8:
         reject('truncated preamble')                                # step 2
     version, flags = struct.unpack_from('<HH', data, 4)
-    if version not in (3, 4, 5, 6, 7, 8, 9, 10, 11):
-        raise Unsupported('version %d' % version)                   # step 3
+    if version != FORMAT_VERSION:
+        raise Unsupported('format version %d (this decoder reads version %d only)'
+                          % (version, FORMAT_VERSION))              # step 3
     if flags != 0:
         reject('flags')                                             # step 4
     hlen, pos = read_varint(data, 8, n)                             # step 5
-    if hlen > n - pos:
+    if hlen > 1 << 20 or hlen > n - pos:
         reject('header length')
     hstart = pos
     hend = pos + hlen
@@ -209,10 +211,10 @@ def read_container(data):
                 reject('segment section')
         elif sid in sections:
             reject('duplicate section id')
-        elif version >= 4 and (3 <= sid <= 6 or sid == 8):
-            reject('version-3 section in a version-4 file')
-        elif (sid == 10 if version >= 4 else (3 <= sid <= 6 or sid == 8)) and h['segment_count'] > 1:
-            reject('whole-mesh section in a segmented file')
+        elif 3 <= sid <= 6 or sid == 8:
+            reject('reserved section id %d' % sid)
+        elif sid == 10 and h['segment_count'] > 1:
+            reject('mesh section in a segmented file')
         if codec == 1:                                              # step 21
             try:
                 import zstandard
@@ -320,7 +322,7 @@ def adapt(probs, i, b):
     probs[i] = p | (min(n + 1, 128) << 16)
 
 
-# §8.1.1 (version 6) logistic mixing
+# §8.1.1 logistic mixing
 SQUASH_T = [1, 2, 4, 6, 10, 17, 27, 45, 74, 120, 194, 311, 488, 747, 1102, 1546, 2048, 2550, 2994, 3349,
             3608, 3785, 3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095]
 
@@ -656,7 +658,7 @@ def triangle_walk(L, root, march, branch, loop, n, read_bit):
 
 def stitch_targets_by_candidates(nstitch, P, tri, twin, virtual, stitch_to, run_value,
                                  o_position, o_distance, o_rank, do, overrun):
-    """§8.3.2 (version 11): every stitch position, then each target by its
+    """§8.3.2: every stitch position, then each target by its
     rank among the candidates (or, rank 0, as a distance)."""
     stitched = [0] * P
     at_list = []
@@ -721,18 +723,17 @@ def stitch_targets_by_candidates(nstitch, P, tri, twin, virtual, stitch_to, run_
         stitch_to[d] = t
 
 
-def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, version=4):
+def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     tables = rbits = None
-    if version >= 9:                                        # §8.3.1: the mode byte
-        if len(s5) < 1:
-            reject('topology stream is empty (no run coding mode)')
-        if s5[0] > 1:
-            reject('run coding mode %d' % s5[0])
-        if s5[0] == 1:
-            tables, rbits, p = read_tables(s5, 1, 8, 1, 'run values')
-            s5 = s5[p:]
-        else:
-            s5 = s5[1:]
+    if len(s5) < 1:                                         # §8.3.1: the mode byte
+        reject('topology stream is empty (no run coding mode)')
+    if s5[0] > 1:
+        reject('run coding mode %d' % s5[0])
+    if s5[0] == 1:
+        tables, rbits, p = read_tables(s5, 1, 8, 1, 'run values')
+        s5 = s5[p:]
+    else:
+        s5 = s5[1:]
 
     def run_value(model, d, c):                             # §8.3.1: with mode 1 from the tables
         if tables is None:
@@ -751,7 +752,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, vers
     t_bit = probs(8 * 8 * 3 * 9)   # bit[va][vb][prev][vr][vl] at ((8 va + vb) 3 + prev) 9 + 3 vr + vl
     t_diag = probs(2)
     o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
-    o_rank = [UIntModel(), UIntModel()]                      # §8.3.2 (version 11)
+    o_rank = [UIntModel(), UIntModel()]                      # §8.3.2
     o_has_poly = probs(1)
 
     def overrun():
@@ -907,18 +908,7 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count, vers
     if nstitch > P:
         reject('stitch count')
     stitch_to = [NONE] * P
-    at = 0
-    if version < 11:
-        for i in range(nstitch):
-            d = run_value(o_position, do, 6)
-            dist = run_value(o_distance, do, 7)
-            if overrun() or at + d >= P or (i > 0 and d == 0):
-                reject('stitch position')
-            at += d
-            if dist >= at:
-                reject('stitch target')
-            stitch_to[at] = at - dist - 1
-    elif nstitch > 0:
+    if nstitch > 0:
         stitch_targets_by_candidates(nstitch, P, tri, twin, virtual, stitch_to, run_value,
                                      o_position, o_distance, o_rank, do, overrun)
     # §8.7 numbering
@@ -1071,7 +1061,7 @@ PREDICTOR_NAMES = ['ancestors', 'parallelograms', 'gate', 'spread', 'raw', 'fan'
 
 
 def decode_lattice(d, qmax, vc, top=False):
-    """§8.5.2: per axis the sorted lattice planes; with top (version 7) an
+    """§8.5.2: per axis the sorted lattice planes; with top an
     axis of two or more planes has its last plane first, as qmax minus it."""
     lattice_count, lattice_gap = SIntModel(6), SIntModel(6)
     lattice = [[], [], []]
@@ -1099,7 +1089,7 @@ def decode_lattice(d, qmax, vc, top=False):
 
 
 def decode_geometry_raw(payload, vc, qbits, top=False):
-    """§8.5.10 (version 4): the lattice planes, then each coordinate as
+    """§8.5.10: the lattice planes, then each coordinate as
     equiprobable bits: a plane index where its axis has planes, else the grid value."""
     d = RangeDecoder(payload[1:])
     qmax = (1 << qbits) - 1
@@ -1216,7 +1206,7 @@ def table_residual(tables, bits, c, what='geometry'):
     return -mag if (sym - 7) & 1 else mag
 
 
-def decode_geometry(payload, layout, qbits, trace=None, version=4):
+def decode_geometry(payload, layout, qbits, trace=None):
     vc = layout['vertex_count']
     tri, twin, ids, vparent = layout['tri'], layout['twin'], layout['id'], layout['vparent']
     H = len(tri)
@@ -1228,30 +1218,29 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     default_weights = False
     tangent = False
     mix = False
-    planes_from_top = False  # version 7; `top` in code_vertex is the largest residual so far
-    tables = None            # version 8: the prefix codes of §8.5.11
+    planes_from_top = False  # bit 4; `top` in code_vertex is the largest residual so far
+    tables = None            # bit 3: the prefix codes of §8.5.11
     table_flag = False
-    if version >= 8 and predictor & 0x08:                           # §8.5.1, version 8
+    if predictor & 0x08:                                            # §8.5.1 bit 3: tables
         predictor &= 0xF7
         table_flag = True
-    if version >= 7 and predictor & 0x10:                           # §8.5.1, version 7
+    if predictor & 0x10:                                            # §8.5.1 bit 4: top
         predictor &= 0xEF
         planes_from_top = True
-    if version >= 6 and predictor & 0x20:                           # §8.5.1, version 6
+    if predictor & 0x20:                                            # §8.5.1 bit 5: mix
         predictor &= 0xDF
         mix = True
         if (predictor & 0x3F) > 3 and (predictor & 0x3F) != 5:
             reject('geometry: predictor without residual models to mix')
-    if version >= 5 and predictor in (0x41, 0x42, 0x43, 0xC1, 0xC2, 0xC3) or \
-            version >= 10 and predictor in (0x45, 0xC5):              # §8.5.1, versions 5 and 10
+    if predictor in (0x41, 0x42, 0x43, 0x45, 0xC1, 0xC2, 0xC3, 0xC5):  # §8.5.1 bit 6: tangent
         predictor &= 0xBF
         tangent = True
-    if version >= 4 and predictor & 0x80 and predictor != 0x80:      # §8.5.1, version 4
+    if predictor & 0x80 and predictor != 0x80:                       # §8.5.1 bit 7: default weights
         predictor &= 0x7F
         default_weights = True
         if predictor > 3 and predictor != 5:
             reject('geometry: predictor without weights')
-    if predictor > (5 if version >= 10 else 4 if version >= 4 else 3):
+    if predictor > 5:
         reject('geometry: predictor')
     if table_flag and (predictor == 4 or mix):
         reject('geometry: tables with the raw predictor or with mixing')
@@ -1280,14 +1269,14 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         alpha = list(struct.unpack_from('<3h', payload, 1))
         pos = 7
     beta = [4096, 4096]
-    if tangent:                                                      # §8.5.1, version 5
+    if tangent:                                                      # §8.5.1
         if len(payload) < pos + 4:
             reject('geometry: tangent weights missing')
         beta = list(struct.unpack_from('<2H', payload, pos))
         if beta[0] > 8192 or beta[1] > 8192:
             reject('geometry: tangent weight range')
         pos += 4
-    if table_flag:                                                   # §8.5.11, version 8
+    if table_flag:                                                   # §8.5.11
         tables, bits, pos = read_tables(payload, pos)
     d = RangeDecoder(payload[pos:])
     # §8.2 models
@@ -1296,7 +1285,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     index = [[[SIntModel(6) for _ in range(14)] for _ in range(3)] for _ in range(3)]
     has_anchor = probs(1)
     anchor_gap = UIntModel(2)
-    if mix:                                                          # version 6
+    if mix:                                                          # §8.1.1
         residual2 = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
         mixw = [[mix_weights() for _ in range(8)] for _ in range(3)]
     lattice = decode_lattice(d, qmax, vc, planes_from_top)
@@ -1325,7 +1314,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         top = 0
         n_on = 0
         order = (0, 1, 2)
-        kn = None                                            # the axis nearest the normal (version 5)
+        kn = None                                            # the axis nearest the normal
         res = [0, 0, 0]
         if normal is not None:                               # the tangent step
             kn = 0
@@ -1363,10 +1352,10 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
                     n_on += 1
                     coded = True
             if not coded:
-                if mix:                                      # version 6: two models mixed
+                if mix:                                      # §8.1.1: two models mixed
                     ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
                     r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
-                elif tables is not None:                     # version 8: the context's prefix code
+                elif tables is not None:                     # §8.5.11: the context's prefix code
                     r = table_residual(tables, bits, (i * 5 + cls) * 14 + ctx)
                 else:
                     r = residual[i][cls][ctx].decode(d)      # by coding position i (= a without a normal)
@@ -1405,7 +1394,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
     def div_round(s, n):
         return floordiv(2 * s + n, 2 * n)
 
-    # §8.5.4, version 5: a normal at c from the triangles (c, u, w), (u, w) in T
+    # §8.5.4: a normal at c from the triangles (c, u, w), (u, w) in T
     def tangent_normal(c, T):
         if len(T) == 0 or len(T) > 4096:
             return None
@@ -1428,7 +1417,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         lo = [0, 0, 0]                 # per axis the smallest and largest single parallelogram
         hi = [0, 0, 0]
         cnt = {'npara': 0, 'nnb': 0, 'actsum': 0}
-        T = []                         # version 5: the pairs (u, w) found decoded
+        T = []                         # the pairs (u, w) found decoded
 
         def neighbour(u):
             for a in range(3):
@@ -1495,7 +1484,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
         return first_he_cache
 
     # §8.5.7
-    def anchor_normal(A):                                    # §8.5.7, version 5
+    def anchor_normal(A):                                    # §8.5.7
         h0 = first_half_edges()[A]
         if h0 == NONE:
             return None
@@ -1531,7 +1520,7 @@ def decode_geometry(payload, layout, qbits, trace=None, version=4):
             if v % 4096 == 0 and d.truncated():
                 reject('geometry: truncated')
 
-    if predictor in (2, 5):                                  # §8.5.5 (5: version 10)
+    if predictor in (2, 5):                                  # §8.5.5
         for h0 in range(H):
             p = tri[h0]
             if ids[p] == NONE or act[ids[p]] != UNKNOWN:
@@ -2043,7 +2032,7 @@ def predictor_allowed(h, pr):
     return False
 
 
-def decode_attributes(payload, faces, glob, q, segmented=False, version=4):
+def decode_attributes(payload, faces, glob, q, segmented=False):
     """§8.12 for one part. faces: the part's faces (part-local ids); glob: per part
     vertex NONE (own) or a reference; q: the own vertices' grid indices;
     segmented: a segment of a segmented file (new corner values may stand for an
@@ -2066,7 +2055,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False, version=4):
             reject('attributes: bad predictor')
         pr = payload[p]
         p += 1
-        t = version >= 9 and pr & 0x08 != 0                  # §8.12.1: table-coded residuals
+        t = pr & 0x08 != 0                                   # §8.12.1: table-coded residuals
         if t:
             pr &= ~0x08
         if not predictor_allowed(h, pr):
@@ -2220,8 +2209,8 @@ def f32(x):
     return struct.unpack('<f', struct.pack('<f', x))[0]
 
 
-def decode_part(streams, counts, bits, earlier, trace, version=4):
-    """Steps 26-31 for the whole mesh or one segment (§4.5, §8.11, §8.12). Returns
+def decode_part(streams, counts, bits, earlier, trace):
+    """Steps 26-29 for the whole mesh or one segment (§4.5, §8.11, §8.12). Returns
     faces (part-local ids), q (per own vertex), glob (per part vertex: the
     output id of a reference, NONE for an own vertex), info, attributes (§8.12)."""
     vc, fc, cc, rc = counts
@@ -2235,7 +2224,7 @@ def decode_part(streams, counts, bits, earlier, trace, version=4):
         reject('stream budget')
     if sr is not None and vc > D(sr):
         reject('references budget')
-    faces, layout, info = decode_connectivity(s3, s4, s5, vc, fc, cc, version)   # step 29
+    faces, layout, info = decode_connectivity(s3, s4, s5, vc, fc, cc)   # step 27
     glob = [NONE] * vc
     if sr is not None:                                               # §8.11
         ids, tri = layout['id'], layout['tri']
@@ -2280,9 +2269,9 @@ def decode_part(streams, counts, bits, earlier, trace, version=4):
                 vparent[rank[v]] = rank[layout['vparent'][v]]
         own['vparent'] = vparent
         layout = own
-    q, ginfo = decode_geometry(s6, layout, bits, trace, version)    # step 30
+    q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 28
     info.update(ginfo)
-    attrs = decode_attributes(sa, faces, glob, q, sr is not None, version)   # step 31
+    attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 29
     return faces, q, glob, info, attrs
 
 
@@ -2305,18 +2294,13 @@ def read_streams(body, p, n, what):
 def decode(data, trace=None):
     h, sections = read_container(data)
     vc, fc, cc = h['vertex_count'], h['face_count'], h['corner_count']
-    if h['segment_count'] == 1 and h['version'] >= 4:              # §4.7
+    if not (vc < 0x3FFFFFFF and cc < 0x3FFFFFFF and fc <= cc):
+        reject('counts')                                             # §9 the parts
+    if h['segment_count'] == 1:                                      # §4.7
         if 10 not in sections:
-            reject('mesh section missing')                           # step 27
+            reject('mesh section missing')
         s3, s4, s5, s6, rest = read_streams(sections[10], 0, 4, 'mesh section stream length')
         parts = [((s3, s4, s5, None, s6, rest), (vc, fc, cc, 0))]
-    elif h['segment_count'] == 1:
-        for sid in (3, 4, 5):
-            if sid not in sections:
-                reject('connectivity section missing')               # step 27
-        if 6 not in sections:
-            reject('geometry section missing')                       # step 28
-        parts = [((sections[3], sections[4], sections[5], None, sections[6], sections.get(8, b'')), (vc, fc, cc, 0))]
     else:                                                            # §4.5
         parts = []
         for body in sections[7]:
@@ -2340,7 +2324,7 @@ def decode(data, trace=None):
     info = None
     part_attrs = []
     for streams, counts in parts:
-        pf, pq, glob, pinfo, pattrs = decode_part(streams, counts, h['bits'], len(q), trace, h['version'])
+        pf, pq, glob, pinfo, pattrs = decode_part(streams, counts, h['bits'], len(q), trace)
         part_attrs.append(pattrs)
         base = len(q)
         out_id = []
@@ -2359,8 +2343,8 @@ def decode(data, trace=None):
             for k in ('components', 'jump_edges', 'virtual', 'stitches', 'side_faces', 'polygons'):
                 info[k] += pinfo[k]
     info['segments'] = len(parts)
-    attrs = join_attributes(part_attrs)                              # step 31, §8.12
-    info['metadata'] = read_metadata(sections[9]) if sections.get(9) is not None else None   # step 32, §4.6
+    attrs = join_attributes(part_attrs)                              # step 29, §8.12
+    info['metadata'] = read_metadata(sections[9]) if sections.get(9) is not None else None   # step 30, §4.6
     info['metadata_skipped'] = 9 in sections and sections[9] is None  # zstd-coded, no zstandard module
     step = h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
     positions = []

@@ -7,7 +7,11 @@
                 a fin of three triangles on one edge (a non-manifold edge), a
                 hexagon, a degenerate face (a side face), three isolated vertices
   mixed_small.obj  the same with a 6 x 10 sphere (at -q 10 -l 9: the gate
-                predictor with its weights left out, version 4)
+                predictor with its weights left out, §8.5.1 bit 7)
+  irregular.obj  a 30 x 30 grid of jittered points on a wavy sheet, quads
+                split along random diagonals, then 2,000 random edge flips:
+                irregular valences, so at level 0 its run values take tables
+                (mode 1, §8.3.1), which the forged cases then damage
   fan.obj       a fan of 300 triangles around a wavy rim: the rim is a path of
                 the vertex tree whose coordinates follow a linear recurrence,
                 so at -l 9 the ancestor predictor (K = 3 or 4) wins
@@ -15,11 +19,12 @@
                 vertex lies on a grid edge, so many coordinates share voxel planes
                 (the geometry lattice), plus an isolated vertex
   box.obj       a box of 6 quads, each with its own 4 corners (24 vertices on 2
-                planes per axis, the far ones at qmax: version 7 codes them
-                from the top)
+                planes per axis, the far ones at qmax: coded from the top,
+                §8.5.2)
   unused_vt.obj  an irregular grid of 338 triangles on one texture coordinate,
-                and 100,000 texture coordinates no corner uses (version 9:
-                table-coded, they test the decoder's bound on unused values)
+                and 100,000 texture coordinates no corner uses (table-coded
+                at level 0, §8.12.1, they test the decoder's bound on unused
+                values)
 
   attributes.obj  mixed(12, 20) with vertex colours, corner `vt u v w` (a
                 3-component generic 'texcoord3') and corner `vn` with seams,
@@ -39,8 +44,11 @@ Usage: test_meshes.py DIR
          (with --zstd: the section zstd-coded, by the zstd command)
        test_meshes.py --replace-in-mesh SRC.tsm DST.tsm OLD_HEX NEW_HEX   (a forged mesh section)
        test_meshes.py --forge-topology SRC.tsm DST.tsm mode=N | cut=K
-         (the mesh section's topology stream with its first byte, the
-         version 9 run coding mode, set to N, or cut to its first K bytes)
+         (the mesh section's topology stream with its first byte, the run
+         coding mode of §8.3.1, set to N, or cut to its first K bytes)
+       test_meshes.py --set-version SRC.tsm DST.tsm N
+         (the preamble's version field set to N, the header checksum
+         rewritten to match)
 """
 import math
 import os
@@ -67,8 +75,7 @@ def fan(n=300):
 def unused_vt(path, n=14, unused=100000):
     """An n x n grid, quads split along random diagonals (irregular runs: at
     level 0 the run values take tables), every corner on texture coordinate 1,
-    then `unused` random ones no corner uses: table-coded (format version 9,
-    §8.12.1) they fill the bit stream while the range-coded stream stays
+    then `unused` random ones no corner uses: table-coded (§8.12.1) they fill the bit stream while the range-coded stream stays
     short, which the decoder's bound on unused values has to allow."""
     import random
     rng = random.Random(7)
@@ -85,6 +92,46 @@ def unused_vt(path, n=14, unused=100000):
                 tris = [(a, b, d), (a, d, c)] if rng.randrange(2) else [(a, b, c), (b, d, c)]
                 for t in tris:
                     f.write('f %d/1 %d/1 %d/1\n' % t)
+
+
+def irregular(n=30, flips=2000, seed=5):
+    """An n x n grid of jittered points on a wavy sheet, quads split along
+    random diagonals, then random edge flips (each keeps the orientation and
+    makes no edge twice): valences from 3 to about 12, irregular enough that
+    at level 0 the run values take tables (§8.3.1)."""
+    import random
+    rng = random.Random(seed)
+    V = [(x + rng.uniform(-.2, .2), y + rng.uniform(-.2, .2), 3 * math.sin(x / 7.0) * math.cos(y / 9.0))
+         for y in range(n) for x in range(n)]
+    F = []
+    for y in range(n - 1):
+        for x in range(n - 1):
+            a, b, c, d = y * n + x, y * n + x + 1, (y + 1) * n + x, (y + 1) * n + x + 1
+            F += [[a, b, d], [a, d, c]] if rng.randrange(2) else [[a, b, c], [b, d, c]]
+    he = {}                                                # half-edge -> face
+    for i, f in enumerate(F):
+        for k in range(3):
+            he[f[k], f[(k + 1) % 3]] = i
+    keys = list(he)
+    for _ in range(flips):
+        a, b = keys[rng.randrange(len(keys))]
+        if (a, b) not in he or (b, a) not in he:
+            continue
+        i, j = he[a, b], he[b, a]                          # (a, b, c) and (b, a, d)
+        c = [v for v in F[i] if v not in (a, b)][0]
+        d = [v for v in F[j] if v not in (a, b)][0]
+        if c == d or (c, d) in he or (d, c) in he:
+            continue
+        for f in (F[i], F[j]):
+            for k in range(3):
+                del he[f[k], f[(k + 1) % 3]]
+        F[i], F[j] = [a, d, c], [b, c, d]                  # the quad a d b c, cut along c-d
+        for idx in (i, j):
+            f = F[idx]
+            for k in range(3):
+                he[f[k], f[(k + 1) % 3]] = idx
+        keys += [(c, d), (d, c)]
+    return V, F
 
 
 def box():
@@ -116,7 +163,7 @@ def sphere_rings(v, n_, m_):
 def double_sided(V, F):
     """Every face also given reversed on the same vertices (as exporters
     write thin geometry): one stitch per vertex, coded by candidates
-    (version 11, §8.3.2)."""
+    (§8.3.2)."""
     return V, [list(f) for f in F] + [list(f[::-1]) for f in F]
 
 
@@ -601,7 +648,7 @@ def replace_in_mesh(src, dst, old, new):
 def forge_topology(src, dst, op):
     """Copies the one-segment .tsm file src to dst with its mesh section's
     topology stream (the third of §4.7) changed by op: 'mode=N' sets its first
-    byte (version 9: the run coding mode, §8.3.1), 'cut=K' keeps its first K
+    byte (the run coding mode, §8.3.1), 'cut=K' keeps its first K
     bytes; the stream lengths, the section's lengths and its checksum are
     rewritten to match."""
     from reference_decoder import read_varint
@@ -628,7 +675,7 @@ def forge_topology(src, dst, op):
 def set_version(src, dst, version):
     """Copies the .tsm file src to dst saying format version `version`, with
     the header checksum (§3) rewritten to match: a file that only the
-    version's payload rules can refuse."""
+    version check (§2) can refuse."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from reference_decoder import read_varint, xxh32
     data = bytearray(open(src, 'rb').read())
@@ -668,6 +715,7 @@ def main():
     write_obj(os.path.join(out, 'mixed_small.obj'), *mixed(6, 10))
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
     write_obj(os.path.join(out, 'fan.obj'), *fan())
+    write_obj(os.path.join(out, 'irregular.obj'), *irregular())
     write_obj(os.path.join(out, 'box.obj'), *box())
     write_obj(os.path.join(out, 'double_sided.obj'), *double_sided(*mixed(16, 30)))
     unused_vt(os.path.join(out, 'unused_vt.obj'))
