@@ -19,21 +19,20 @@ namespace {
 // failing input of the batch (exit code 4), never a reason to stop the
 // others (see commands.cpp).
 
-// Edit distance between two names (case-insensitive), for suggestions.
+// Edit distance between two names (case-insensitive; insertions,
+// deletions, substitutions and swaps of neighbours count 1), for suggestions.
 size_t edit_distance(const std::string& a, const std::string& b) {
   auto low = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diag = row[0];
-    row[0] = i;
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
     for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (low(a[i - 1]) == low(b[j - 1]) ? 0 : 1)});
-      diag = up;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (low(a[i - 1]) == low(b[j - 1]) ? 0 : 1)});
+      if (i > 1 && j > 1 && low(a[i - 1]) == low(b[j - 2]) && low(a[i - 2]) == low(b[j - 1]))
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
     }
-  }
-  return row[b.size()];
+  return d[a.size()][b.size()];
 }
 
 // The nearest of `names` to `word`, or "" when none is near enough to be a
@@ -58,7 +57,8 @@ std::string option_names(const CLI::Option* o) {
 
 // A suggestion for an unknown option of `cmd`: the option whose long name is
 // nearest (a misspelling), that it begins (an abbreviation), or whose short
-// name is its first letter ("--qbits": -q); "" when nothing fits.
+// name is its first letter when the rest names what it sets ("--qbits": -q,
+// "Position quantization bits"); "" when nothing fits.
 std::string suggest_option(const CLI::App* cmd, const std::string& unknown) {
   std::string word = unknown.substr(unknown.find_first_not_of('-'));
   std::vector<std::string> longs;
@@ -71,10 +71,27 @@ std::string suggest_option(const CLI::App* cmd, const std::string& unknown) {
       if ((!near.empty() && l == near) || (near.empty() && word.size() >= 2 && l.compare(0, word.size(), word) == 0))
         found = found ? found : o;
   }
-  if (!found && word.size() > 1)
-    for (const CLI::Option* o : cmd->get_options())
-      for (const std::string& s : o->get_snames())
-        if (s.size() == 1 && s[0] == word[0]) found = found ? found : o;
+  if (!found && word.size() > 1) {
+    // The word's parts ("format-version": format, version), and the first
+    // part without its first letter ("qbits": bits).
+    std::vector<std::string> parts;
+    for (size_t at = 0; at < word.size();) {
+      const size_t end = std::min(word.find('-', at), word.find('_', at));
+      parts.push_back(word.substr(at, end == std::string::npos ? std::string::npos : end - at));
+      if (end == std::string::npos) break;
+      at = end + 1;
+    }
+    parts.push_back(parts[0].substr(1));
+    for (const CLI::Option* o : cmd->get_options()) {
+      std::string about = o->get_description();
+      for (const std::string& l : o->get_lnames()) about += " " + l;
+      for (char& c : about) c = c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+      bool named = false;
+      for (const std::string& p : parts) named = named || (p.size() >= 3 && about.find(p) != std::string::npos);
+      for (const std::string& sn : o->get_snames())
+        if (named && sn.size() == 1 && sn[0] == word[0]) found = found ? found : o;
+    }
+  }
   return found ? option_names(found) : std::string();
 }
 
@@ -100,10 +117,10 @@ bool refuse_unknown_words(const CLI::App& app, int argc, char** argv) {
     const std::string near = nearest(first, commands);
     if (!near.empty())
       std::fprintf(stderr, "tsm: error: unknown command '%s'; did you mean 'tsm %s'? (the commands: %s)\n",
-                   first.c_str(), near.c_str(), all.c_str());
+                   printable(first).c_str(), near.c_str(), all.c_str());
     else
       std::fprintf(stderr, "tsm: error: unknown command '%s'; the commands are %s (tsm --help shows them)\n",
-                   first.c_str(), all.c_str());
+                   printable(first).c_str(), all.c_str());
     return true;
   }
   for (int i = 2; i < argc; ++i) {
@@ -114,8 +131,8 @@ bool refuse_unknown_words(const CLI::App& app, int argc, char** argv) {
     std::string name = arg[1] == '-' ? arg.substr(0, arg.find('=')) : arg.substr(0, 2);
     if (cmd->get_option_no_throw(name) || name == "--help" || name == "-h") continue;
     const std::string hint = suggest_option(cmd, name);
-    std::fprintf(stderr, "tsm: error: unknown option %s for tsm %s; %s(tsm %s --help lists the options)\n",
-                 name.c_str(), first.c_str(), hint.empty() ? "" : ("did you mean " + hint + "? ").c_str(),
+    std::fprintf(stderr, "tsm: error: unknown option %s for tsm %s%s (tsm %s --help lists the options)\n",
+                 printable(name).c_str(), first.c_str(), hint.empty() ? "" : ("; did you mean " + hint + "?").c_str(),
                  first.c_str());
     return true;
   }

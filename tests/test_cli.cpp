@@ -1120,6 +1120,10 @@ TEST_F(CliBatch, EveryHintLeadsSomewhere) {
   r = tsm("encode " + q("in.ply") + " --levle 3");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("did you mean -l/--level?"), std::string::npos) << r.err;
+  r = tsm("encode " + q("in.ply") + " --frobnicate");  // nothing near: no guess
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown option --frobnicate"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("did you mean"), std::string::npos) << r.err;
   r = tsm("encdoe " + q("in.ply"));
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("did you mean 'tsm encode'?"), std::string::npos) << r.err;
