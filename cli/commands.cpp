@@ -128,7 +128,7 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
   if (dir_mode && occupied(o) && !fs::is_directory(o, ec))
     return usage_error(o + ": is a file, but with several inputs -o names a folder (created if missing), e.g. -o out/");
   // "-o both.obj" for several inputs would become a folder named like a file.
-  if (n > 1 && o.back() != '/' && !fs::is_directory(o, ec) && file_like_name(o))
+  if (n > 1 && !o.empty() && o.back() != '/' && !fs::is_directory(o, ec) && file_like_name(o))
     return usage_error("-o " + o + " names one file, but there are " + std::to_string(n) +
                        " inputs; give a folder for their outputs, e.g. -o " +
                        (fs::path(o).parent_path() / "out/").string());
@@ -237,7 +237,7 @@ MeshFormat parse_format(const std::string& s) {
 
 // A mesh from bytes: the format the user named, else content, else extension.
 Status parse_mesh_as(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
-                  const ReadOptions& read_options, ReadInfo& info) {
+                     const ReadOptions& read_options, ReadInfo& info) {
   const std::string name = shown_input(input);
   ReadOptions ro = read_options;  // a .gltf file's buffers may be files beside it
   if (input != "-" && ro.external_files_dir.empty()) {
@@ -309,13 +309,13 @@ bool obj_statement(std::string_view w) {
   return false;
 }
 
-// Bytes that no text file holds (NUL and the other C0 controls but tab,
-// line feed, vertical tab, form feed, carriage return and escape; DEL):
-// the offset of the first, or npos.
+// Bytes that no mesh text file holds (NUL and the other C0 controls but
+// tab, line feed, vertical tab, form feed and carriage return; DEL): the
+// offset of the first, or npos.
 size_t binary_offset(std::string_view bytes) {
   for (size_t i = 0; i < bytes.size(); ++i) {
     const auto c = static_cast<unsigned char>(bytes[i]);
-    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r' && c != 0x1B) || c == 0x7F) return i;
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') || c == 0x7F) return i;
   }
   return std::string_view::npos;
 }
