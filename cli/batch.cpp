@@ -120,51 +120,77 @@ Status read_stdin(std::string& out) {
 
 // ---------------------------------------------------------------- JSON
 
-void JsonObject::key(const char* k) {
-  if (text_.size() > 1) text_ += ", ";
-  text_ += "\"";
-  text_ += k;
-  text_ += "\": ";
+std::string json_line(const nlohmann::ordered_json& value) {
+  if (value.is_object()) {
+    std::string out = "{";
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      if (out.size() > 1) out += ", ";
+      out += json_line(nlohmann::ordered_json(it.key())) + ": " + json_line(it.value());
+    }
+    return out + "}";
+  }
+  if (value.is_array()) {
+    std::string out = "[";
+    for (const auto& item : value) {
+      if (out.size() > 1) out += ", ";
+      out += json_line(item);
+    }
+    return out + "]";
+  }
+  return value.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 JsonObject& JsonObject::str(const char* k, const std::string& value) {
-  key(k);
-  text_ += "\"" + json_escape(value) + "\"";
+  json_[k] = value;
   return *this;
 }
 
 JsonObject& JsonObject::str_or_null(const char* k, const std::string& value) {
-  if (value.empty()) return raw(k, "null");
+  if (value.empty()) return null(k);
   return str(k, value);
 }
 
 JsonObject& JsonObject::num(const char* k, unsigned long long value) {
-  key(k);
-  text_ += std::to_string(value);
+  json_[k] = value;
   return *this;
 }
 
 JsonObject& JsonObject::num(const char* k, double value, int decimals) {
-  key(k);
-  text_ += std::isfinite(value) ? fixed(value, decimals) : std::string("null");
+  if (!std::isfinite(value)) return null(k);
+  // Rounded to `decimals` places; the library prints the shortest form.
+  const double scale = std::pow(10.0, decimals);
+  json_[k] = std::round(value * scale) / scale;
   return *this;
 }
 
 JsonObject& JsonObject::boolean(const char* k, bool value) {
-  key(k);
-  text_ += value ? "true" : "false";
+  json_[k] = value;
   return *this;
 }
 
-JsonObject& JsonObject::raw(const char* k, const std::string& json) {
-  key(k);
-  text_ += json;
+JsonObject& JsonObject::null(const char* k) {
+  json_[k] = nullptr;
   return *this;
 }
+
+std::string JsonObject::done() const { return json_line(json_); }
 
 // ---------------------------------------------------------------- batch
 
 namespace {
+
+// A multi-line report, each line made printable.
+std::string printable_lines(const std::string& text) {
+  std::string out;
+  size_t start = 0;
+  for (;;) {
+    const size_t end = text.find('\n', start);
+    out += printable(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) return out;
+    out += '\n';
+    start = end + 1;
+  }
+}
 
 int terminal_width() {
   struct winsize ws = {};
@@ -237,7 +263,7 @@ class Batch {
     if (!r.status.ok()) {
       if (g_stopping.load()) return;  // interrupted: the signal thread says so and ends the process
       erase_bar();
-      std::fprintf(stderr, "tsm: error: %s\n", r.status.message().c_str());
+      std::fprintf(stderr, "tsm: error: %s\n", printable(r.status.message()).c_str());
       std::fflush(stderr);
       failures_.emplace_back(i, r.status);
     }
@@ -262,10 +288,10 @@ class Batch {
     }
     if (!r.status.ok() || o_.quiet) return;
     erase_bar();
-    if (!r.note.empty()) std::fprintf(stderr, "tsm: note: %s\n", r.note.c_str());
+    if (!r.note.empty()) std::fprintf(stderr, "tsm: note: %s\n", printable(r.note).c_str());
     if (!r.text.empty()) {
       FILE* f = o_.text_to_stderr ? stderr : stdout;
-      std::fprintf(f, "%s\n", r.text.c_str());
+      std::fprintf(f, "%s\n", printable_lines(r.text).c_str());
       std::fflush(f);
     }
   }
@@ -278,11 +304,11 @@ class Batch {
     for (const auto& f : failures_) code = std::max(code, exit_code_for(f.second));
     if (n > 1) {
       if (!o_.quiet)
-        std::fprintf(stderr, "tsm: %s %zu of %zu files in %s s\n", o_.verb.c_str(), n - failures_.size(), n,
-                     fixed(sw_.ms() / 1000.0, 1).c_str());
+        std::fprintf(stderr, "tsm: %s %zu of %zu files in %s\n", o_.verb.c_str(), n - failures_.size(), n,
+                     duration_text(sw_.ms()).c_str());
       if (!failures_.empty()) {
         std::fprintf(stderr, "tsm: %zu of %zu files failed:\n", failures_.size(), n);
-        for (const auto& f : failures_) std::fprintf(stderr, "  %s\n", f.second.message().c_str());
+        for (const auto& f : failures_) std::fprintf(stderr, "  %s\n", printable(f.second.message()).c_str());
       }
     }
     return code;
@@ -317,7 +343,7 @@ class Batch {
       const int filled = static_cast<int>(static_cast<double>(width) * static_cast<double>(done) / static_cast<double>(n));
       line += "[" + std::string(static_cast<size_t>(filled), '#') + std::string(static_cast<size_t>(width - filled), '.') + "] ";
     }
-    std::string name = names_[cur] == "-" ? std::string("<stdin>") : std::filesystem::path(names_[cur]).filename().string();
+    std::string name = names_[cur] == "-" ? std::string("<stdin>") : printable(std::filesystem::path(names_[cur]).filename().string());
     std::string tail;
     const char* phase = phases_[cur].get();
     if (phase && *phase) tail += std::string(" ") + phase;

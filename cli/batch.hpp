@@ -3,6 +3,8 @@
 // interruption (Ctrl-C, SIGTERM, SIGHUP) that never leaves a temporary or a
 // partial file behind.
 #pragma once
+#include <nlohmann/json.hpp>
+
 #include <atomic>
 #include <cstdio>
 #include <functional>
@@ -66,20 +68,26 @@ Status read_stdin(std::string& out);
 
 bool is_terminal(FILE* f);
 
-// A JSON object built field by field: {"a": 1, "b": "x"}.
+// A JSON object built field by field with the JSON library, written on one
+// line as {"a": 1, "b": "x"} (keys in the order added). Strings that are not
+// valid UTF-8 (a file name in another encoding) have their odd bytes
+// replaced by U+FFFD, so every line is valid JSON.
 class JsonObject {
  public:
   JsonObject& str(const char* key, const std::string& value);
   JsonObject& str_or_null(const char* key, const std::string& value);  // null when empty
   JsonObject& num(const char* key, unsigned long long value);
-  JsonObject& num(const char* key, double value, int decimals);
+  JsonObject& num(const char* key, double value, int decimals);         // null when not finite
   JsonObject& boolean(const char* key, bool value);
-  JsonObject& raw(const char* key, const std::string& json);
-  std::string done() const { return text_ + "}"; }
+  JsonObject& null(const char* key);
+  std::string done() const;
 
  private:
-  void key(const char* k);
-  std::string text_ = "{";
+  nlohmann::ordered_json json_ = nlohmann::ordered_json::object();
 };
+
+// One line of JSON for `value`, with ", " and ": " between items (the
+// layout of every JSON line the tool prints); invalid UTF-8 as U+FFFD.
+std::string json_line(const nlohmann::ordered_json& value);
 
 }  // namespace tsm::cli

@@ -1,6 +1,8 @@
 // `tsm bench`: tsm beside Draco (cl7, cl10) on each mesh, in one process:
 // sizes, bits per vertex, encode/decode medians, maximum error, exactness of
 // the round trip (the oracle), and reader speed (tsm's reader vs Draco's).
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -119,7 +121,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       rr.tsm_ms = sw.ms();
       if (!s.ok()) {
         failures.push_back(s.message());
-        std::fprintf(stderr, "tsm bench: skipped: %s\n", s.message().c_str());
+        std::fprintf(stderr, "tsm bench: skipped: %s\n", printable(s.message()).c_str());
         continue;
       }
       // Positions and faces only, as the in-process Draco adapter codes them:
@@ -184,27 +186,40 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
 
   auto bpv = [](size_t bytes, size_t v) { return v ? 8.0 * static_cast<double>(bytes) / static_cast<double>(v) : 0.0; };
   if (json) {
-    std::printf("{\"draco\": %s, \"rows\": [", have_draco ? "true" : "false");
-    for (size_t i = 0; i < rows.size(); ++i) {
-      const Row& r = rows[i];
-      std::printf("%s\n  {\"mesh\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"q\": %d, \"tsm_bytes\": %zu, "
-                  "\"tsm_bpv\": %.4f, \"tsm_encode_ms\": %.3f, \"tsm_decode_ms\": %.3f, \"tsm_exact\": %s, "
-                  "\"tsm_max_error_steps\": %.4f",
-                  i ? "," : "", json_escape(r.mesh).c_str(), r.vertices, r.faces, r.q, r.tsm_bytes,
-                  bpv(r.tsm_bytes, r.vertices), r.tsm_enc, r.tsm_dec, r.tsm_exact ? "true" : "false", r.tsm_err);
-      for (const auto& [name, d] : {std::pair<const char*, const bench::DracoRun*>{"draco_cl10", &r.cl10},
+    // Built with the JSON library: a mesh name that is not UTF-8 still gives valid JSON (U+FFFD).
+    using ojson = nlohmann::ordered_json;
+    auto rounded = [](double v, double scale) { return std::isfinite(v) ? ojson(std::round(v * scale) / scale) : ojson(); };
+    ojson doc = ojson::object();
+    doc["draco"] = have_draco;
+    doc["rows"] = ojson::array();
+    for (const Row& r : rows) {
+      ojson o = ojson::object();
+      o["mesh"] = r.mesh;
+      o["vertices"] = r.vertices;
+      o["faces"] = r.faces;
+      o["q"] = r.q;
+      o["tsm_bytes"] = r.tsm_bytes;
+      o["tsm_bpv"] = rounded(bpv(r.tsm_bytes, r.vertices), 1e4);
+      o["tsm_encode_ms"] = rounded(r.tsm_enc, 1e3);
+      o["tsm_decode_ms"] = rounded(r.tsm_dec, 1e3);
+      o["tsm_exact"] = r.tsm_exact;
+      o["tsm_max_error_steps"] = rounded(r.tsm_err, 1e4);
+      for (const auto& [name, d] : {std::pair<std::string, const bench::DracoRun*>{"draco_cl10", &r.cl10},
                                     {"draco_cl7", &r.cl7}})
-        if (d->ok)
-          std::printf(", \"%s_bytes\": %zu, \"%s_bpv\": %.4f, \"%s_encode_ms\": %.3f, \"%s_decode_ms\": %.3f", name,
-                      d->bytes, name, bpv(d->bytes, r.vertices), name, d->encode_ms, name, d->decode_ms);
-      if (have_draco) std::printf(", \"draco_cl10_exact\": %s", r.draco_exact ? "true" : "false");
-      std::printf("}");
+        if (d->ok) {
+          o[name + "_bytes"] = d->bytes;
+          o[name + "_bpv"] = rounded(bpv(d->bytes, r.vertices), 1e4);
+          o[name + "_encode_ms"] = rounded(d->encode_ms, 1e3);
+          o[name + "_decode_ms"] = rounded(d->decode_ms, 1e3);
+        }
+      if (have_draco) o["draco_cl10_exact"] = r.draco_exact;
+      doc["rows"].push_back(std::move(o));
     }
-    std::printf("\n], \"reads\": [");
-    for (size_t i = 0; i < reads.size(); ++i)
-      std::printf("%s{\"mesh\": \"%s\", \"tsm_ms\": %.3f, \"draco_ms\": %.3f}", i ? ", " : "",
-                  json_escape(reads[i].mesh).c_str(), reads[i].tsm_ms, reads[i].draco_ms);
-    std::printf("], \"failures\": %zu}\n", failures.size());
+    doc["reads"] = ojson::array();
+    for (const ReadRow& r : reads)
+      doc["reads"].push_back({{"mesh", r.mesh}, {"tsm_ms", rounded(r.tsm_ms, 1e3)}, {"draco_ms", rounded(r.draco_ms, 1e3)}});
+    doc["failures"] = failures.size();
+    std::printf("%s\n", doc.dump(2, ' ', false, ojson::error_handler_t::replace).c_str());
     return failures.empty() ? kExitOk : kExitBadInput;
   }
 

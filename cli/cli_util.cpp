@@ -1,5 +1,8 @@
 #include "cli_util.hpp"
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
 #include <cstdarg>
 #include <cstdlib>
 #include <filesystem>
@@ -21,25 +24,62 @@ int exit_code_for(const Status& s) {
 }
 
 std::string json_escape(const std::string& s) {
+  const std::string quoted = nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return quoted.substr(1, quoted.size() - 2);
+}
+
+namespace {
+// Length of the valid UTF-8 sequence at s[i] (1 to 4), or 0 when the bytes
+// there are not one (overlong forms, surrogates and values past U+10FFFF
+// included).
+size_t utf8_length(const std::string& s, size_t i) {
+  const auto b = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = b(i);
+  if (c < 0x80) return 1;
+  size_t n;
+  unsigned cp;
+  if (c >= 0xC2 && c <= 0xDF) n = 2, cp = c & 0x1Fu;
+  else if (c >= 0xE0 && c <= 0xEF) n = 3, cp = c & 0x0Fu;
+  else if (c >= 0xF0 && c <= 0xF4) n = 4, cp = c & 0x07u;
+  else return 0;
+  if (i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k) {
+    if ((b(i + k) & 0xC0) != 0x80) return 0;
+    cp = (cp << 6) | (b(i + k) & 0x3Fu);
+  }
+  if ((n == 3 && (cp < 0x800 || (cp >= 0xD800 && cp <= 0xDFFF))) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF)))
+    return 0;
+  return n;
+}
+}  // namespace
+
+std::string printable(const std::string& s) {
   std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const size_t n = utf8_length(s, i);
+    // C1 controls (U+0080..U+009F) are C2 80..C2 9F in UTF-8.
+    const bool control = c < 0x20 || c == 0x7F || (n == 2 && c == 0xC2 && static_cast<unsigned char>(s[i + 1]) < 0xA0);
+    if (n == 0 || control) {
+      const size_t bad = n == 0 ? 1 : n;
+      for (size_t k = 0; k < bad; ++k) out += strf("\\x%02X", static_cast<unsigned char>(s[i + k]));
+      i += bad;
+    } else {
+      out.append(s, i, n);
+      i += n;
     }
   }
   return out;
+}
+
+std::string count_of(unsigned long long n, const char* one, const char* many) {
+  return thousands(n) + " " + (n == 1 ? one : many);
+}
+
+std::string duration_text(double ms) {
+  if (ms < 1000) return fixed(ms < 10 ? ms : std::round(ms), ms < 10 ? 1 : 0) + " ms";
+  return fixed(ms / 1000.0, 1) + " s";
 }
 
 std::string thousands(unsigned long long n) {

@@ -29,7 +29,19 @@ class Stopwatch {
   std::chrono::steady_clock::time_point t0_;
 };
 
+// The inside of a JSON string (without the quotes), made by the JSON
+// library: bytes that are not valid UTF-8 become U+FFFD (the replacement
+// character), so the JSON is always valid (a file name that is not UTF-8
+// shows with U+FFFD in place of its odd bytes).
 std::string json_escape(const std::string& s);
+// Text for the terminal: control characters (C0, DEL, C1) and bytes that
+// are not valid UTF-8 are shown as \xNN, never sent raw (a file's content or
+// name cannot move the cursor or garble the terminal).
+std::string printable(const std::string& s);
+// "1 face", "2 faces", "1,234 faces".
+std::string count_of(unsigned long long n, const char* one, const char* many);
+// A duration for people: "12 ms" below a second, "1.3 s" above.
+std::string duration_text(double ms);
 // 1234567 -> "1,234,567"
 std::string thousands(unsigned long long n);
 std::string fixed(double v, int decimals);

@@ -40,6 +40,12 @@ std::string with_extension(const std::string& path, const std::string& ext) {
   return p.replace_extension(ext).string();
 }
 
+std::string lower(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
 unsigned effective_jobs(unsigned jobs) {
   if (jobs > 0) return jobs;
   unsigned cores = std::thread::hardware_concurrency();
@@ -73,6 +79,29 @@ struct Job {
   Status refused;      // set when the file must not be processed (the reason)
 };
 
+// Why an input cannot be read at all (missing, a folder), or Ok. Such an
+// input is one failure of the batch (exit code 4, like any file that cannot
+// be read); the others are still processed. `pattern` is the kind of file
+// the command reads, for the hint ("*.ply").
+Status input_problem(const std::string& input, const char* pattern) {
+  if (input == "-") return Status::Ok();
+  struct stat st = {};
+  if (::stat(input.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR)
+      return Status(ErrorCode::io_error, input + ": no such file; check the name");
+    return Status(ErrorCode::io_error, input + ": cannot open: " + std::strerror(errno));
+  }
+  if (S_ISDIR(st.st_mode))
+    return Status(ErrorCode::io_error, input + ": is a folder, not a file; name the files in it (e.g. " +
+                                           (fs::path(input) / pattern).string() + ")");
+  return Status::Ok();
+}
+
+// An output name that says "a file" by its extension: a mesh format or .tsm.
+bool file_like_name(const std::string& o) {
+  return format_from_extension(o) != MeshFormat::unknown || lower(fs::path(o).extension().string()) == ".tsm";
+}
+
 // "-" may only be the only input, and stdin must not be a terminal.
 int check_stdin_input(const std::vector<std::string>& inputs, const char* what) {
   const bool has_stdin = std::find(inputs.begin(), inputs.end(), "-") != inputs.end();
@@ -88,7 +117,7 @@ int check_stdin_input(const std::vector<std::string>& inputs, const char* what) 
 // or the exit code when the whole command is refused (message printed).
 // Files that must not be written get Job::refused; the others still run.
 int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, const std::string& ext, bool force,
-                 const char* what_in, std::vector<Job>& jobs) {
+                 const char* what_in, const char* pattern, std::vector<Job>& jobs) {
   if (int rc = check_stdin_input(inputs, what_in)) return rc;
   const size_t n = inputs.size();
   const bool has_stdin = n == 1 && inputs[0] == "-";
@@ -98,6 +127,11 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
   const bool dir_mode = !o.empty() && o != "-" && (n > 1 || o.back() == '/' || fs::is_directory(o, ec));
   if (dir_mode && occupied(o) && !fs::is_directory(o, ec))
     return usage_error(o + ": is a file, but with several inputs -o names a folder (created if missing), e.g. -o out/");
+  // "-o both.obj" for several inputs would become a folder named like a file.
+  if (n > 1 && !o.empty() && o.back() != '/' && !fs::is_directory(o, ec) && file_like_name(o))
+    return usage_error("-o " + o + " names one file, but there are " + std::to_string(n) +
+                       " inputs; give a folder for their outputs, e.g. -o " +
+                       (fs::path(o).parent_path() / "out/").string());
   if (dir_mode && has_stdin)
     return usage_error("-o " + o + " is a folder, and stdin has no name to derive a file name from; give -o FILE or -o -");
 
@@ -105,6 +139,7 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
   for (size_t i = 0; i < n; ++i) {
     Job& j = jobs[i];
     j.input = inputs[i];
+    j.refused = input_problem(inputs[i], pattern);
     if (inputs[i] == "-")
       j.output = o.empty() ? "-" : o;
     else if (o.empty())
@@ -119,7 +154,7 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
   std::map<std::string, size_t> claimed;
   std::vector<std::string> clashes;
   for (size_t i = 0; i < n; ++i) {
-    if (jobs[i].output == "-") continue;
+    if (jobs[i].output == "-" || !jobs[i].refused.ok()) continue;
     fs::path key = fs::weakly_canonical(fs::absolute(jobs[i].output, ec), ec);
     if (ec) key = fs::path(jobs[i].output).lexically_normal();
     auto [it, fresh] = claimed.emplace(key.string(), i);
@@ -148,7 +183,7 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
   }
   for (size_t i = 0; i < n; ++i) {
     Job& j = jobs[i];
-    if (j.output == "-") continue;
+    if (j.output == "-" || !j.refused.ok()) continue;
     FileId id;
     auto it = file_id(j.output, id) ? input_ids.find(id) : input_ids.end();
     if (it != input_ids.end()) {
@@ -158,6 +193,19 @@ int plan_outputs(const std::vector<std::string>& inputs, const std::string& o, c
                                                ", an input of this run; choose another -o");
     } else if (!force && occupied(j.output)) {
       j.refused = Status(ErrorCode::invalid_argument, j.output + ": already exists; pass -f (--force) to overwrite it");
+    }
+  }
+
+  // -o a/b/c.tsm: the folders of a single output are created, as -o a/b/ creates its folder.
+  if (!dir_mode && n == 1 && jobs[0].output != "-" && jobs[0].refused.ok()) {
+    const fs::path parent = fs::path(jobs[0].output).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent, ec)) {
+      fs::create_directories(parent, ec);
+      if (ec) {
+        std::fprintf(stderr, "tsm: error: %s: cannot create the output's folder %s: %s\n", jobs[0].output.c_str(),
+                     parent.string().c_str(), ec.message().c_str());
+        return kExitIo;
+      }
     }
   }
   return kExitOk;
@@ -187,15 +235,9 @@ MeshFormat parse_format(const std::string& s) {
   return MeshFormat::unknown;
 }
 
-std::string lower(std::string s) {
-  for (char& c : s)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
-}
-
 // A mesh from bytes: the format the user named, else content, else extension.
-Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
-                  const ReadOptions& read_options, ReadInfo& info) {
+Status parse_mesh_as(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
+                     const ReadOptions& read_options, ReadInfo& info) {
   const std::string name = shown_input(input);
   ReadOptions ro = read_options;  // a .gltf file's buffers may be files beside it
   if (input != "-" && ro.external_files_dir.empty()) {
@@ -223,6 +265,116 @@ Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat f
     case MeshFormat::unknown: break;
   }
   return Status(ErrorCode::internal, name + ": no reader for the format");
+}
+
+// parse_mesh_as, with the library's advice replaced where the command line
+// offers another remedy.
+Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat forced, Mesh& mesh,
+                  const ReadOptions& read_options, ReadInfo& info) {
+  Status s = parse_mesh_as(bytes, input, forced, mesh, read_options, info);
+  if (s.ok()) return s;
+  std::string m = s.message();
+  // A .gltf on stdin has no folder in which to find its buffer files.
+  const size_t ext = m.find("external files are not read here");
+  if (input == "-" && ext != std::string::npos)
+    return Status(s.code(), m.substr(0, ext) +
+                                "a .gltf read from stdin cannot name buffer files: give the .gltf file's path instead "
+                                "of - (its buffers are then read from its folder), or embed the buffers (a .glb, or "
+                                "data: URIs)");
+  // The readers offer --allow-nonfinite for NaN / infinite values, but the
+  // encoder refuses such meshes all the same: say what does work.
+  const size_t flag = m.find("--allow-nonfinite");
+  if (flag != std::string::npos) {
+    const size_t from = m.rfind("; ", flag);
+    const size_t to = m.find("; ", flag);
+    if (from != std::string::npos)
+      return Status(s.code(), m.substr(0, from) +
+                                  "; tsm cannot compress NaN or infinite values (no quantization grid holds them): "
+                                  "fix or drop them in the file" +
+                                  (to == std::string::npos ? std::string() : m.substr(to)));
+  }
+  return s;
+}
+
+// Words that begin an OBJ line (statements of the OBJ specification).
+bool obj_statement(std::string_view w) {
+  static const char* const kWords[] = {"v",     "vt",   "vn",      "vp",      "f",        "fo",       "l",
+                                       "p",     "o",    "g",       "s",       "mg",       "mtllib",   "usemtl",
+                                       "cstype", "deg", "bmat",    "step",    "curv",     "curv2",    "surf",
+                                       "parm",  "trim", "hole",    "scrv",    "sp",       "end",      "con",
+                                       "lod",   "usemap", "maplib", "shadow_obj", "trace_obj", "ctech", "stech",
+                                       "bevel", "c_interp", "d_interp", "call", "csh"};
+  for (const char* k : kWords)
+    if (w == k) return true;
+  return false;
+}
+
+// Bytes that no mesh text file holds (NUL and the other C0 controls but
+// tab, line feed, vertical tab, form feed and carriage return; DEL): the
+// offset of the first, or npos.
+size_t binary_offset(std::string_view bytes) {
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\v' && c != '\f' && c != '\r') || c == 0x7F) return i;
+  }
+  return std::string_view::npos;
+}
+
+// A mesh read with no vertex and no face is either an empty mesh (Ok; the
+// note says so) or a file that is not a mesh: text read as OBJ (which has no
+// signature: anything "reads") that holds binary bytes or lines that are no
+// OBJ statement (bad input: what was found, with bytes escaped).
+Status check_empty_mesh(std::string_view bytes, const std::string& input, MeshFormat forced, const ReadInfo& info,
+                        std::string& note) {
+  const std::string name = shown_input(input);
+  if (info.format != MeshFormat::obj) {
+    note = name + ": empty mesh (no vertex, no face); the .tsm holds an empty mesh";
+    return Status::Ok();
+  }
+  const std::string why_obj = forced == MeshFormat::obj ? "as --input-format obj says"
+                              : format_from_extension(input) == MeshFormat::obj
+                                  ? "as its .obj name says"
+                                  : "OBJ being the only format without a signature";
+  const MeshFormat looks = sniff_format(bytes);
+  const std::string looks_like =
+      forced == MeshFormat::obj && looks != MeshFormat::unknown && looks != MeshFormat::obj
+          ? std::string("; the content looks like ") + mesh_format_name(looks) + ": drop --input-format obj"
+          : std::string("; give a mesh file (PLY, OBJ, STL, OFF, glTF/GLB)");
+  const size_t bin = binary_offset(bytes);
+  if (bin != std::string_view::npos) {
+    return Status(ErrorCode::parse_error,
+                  name + ": not a mesh: read as OBJ text (" + why_obj + "), but it holds binary data (byte " +
+                      std::to_string(bin) + " is " + strf("0x%02X", static_cast<unsigned char>(bytes[bin])) +
+                      "; it starts with \"" + printable(std::string(bytes.substr(0, 16))) + "\")" + looks_like);
+  }
+  size_t line = 0;
+  for (size_t at = 0; at < bytes.size();) {
+    size_t end = bytes.find('\n', at);
+    if (end == std::string_view::npos) end = bytes.size();
+    ++line;
+    std::string_view text = bytes.substr(at, end - at);
+    at = end + 1;
+    const size_t b = text.find_first_not_of(" \t\r\v\f");
+    if (b == std::string_view::npos || text[b] == '#') continue;
+    const size_t e = text.find_first_of(" \t\r\v\f", b);
+    const std::string_view word = text.substr(b, e == std::string_view::npos ? std::string_view::npos : e - b);
+    if (obj_statement(word)) continue;
+    std::string shown = printable(std::string(text.substr(b, 60)));
+    if (text.size() - b > 60) shown += "...";
+    return Status(ErrorCode::parse_error,
+                  name + ": not a mesh: read as OBJ (" + why_obj + "), no vertex and no face found, and line " +
+                      std::to_string(line) + " (\"" + shown + "\") is not an OBJ statement" + looks_like);
+  }
+  note = name + ": empty mesh: no vertex and no face in the OBJ" +
+         (bytes.empty() ? std::string(" (the file is empty)") : std::string()) + "; the .tsm holds an empty mesh";
+  return Status::Ok();
+}
+
+// Compression ratio, input bytes to output bytes: "8.31:1", "12.4:1".
+std::string ratio_text(uint64_t in, uint64_t out) {
+  if (out == 0 || in == 0) return "-";
+  const double r = static_cast<double>(in) / static_cast<double>(out);
+  return fixed(r, r < 10 ? 2 : 1) + ":1";
 }
 
 double bits_per_vertex(uint64_t bytes, uint64_t vertices) {
@@ -255,6 +407,7 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
     o.num("vertices", static_cast<unsigned long long>(mesh.vertex_count()));
     o.num("faces", static_cast<unsigned long long>(mesh.face_count()));
     o.num("bits_per_vertex", bits_per_vertex(bytes_out, mesh.vertex_count()), 4);
+    o.num("compression_ratio", bytes_out ? static_cast<double>(bytes_in) / static_cast<double>(bytes_out) : 0.0, 3);
     o.num("quantization_bits", static_cast<unsigned long long>(a.qbits)).num("level", static_cast<unsigned long long>(a.level));
     o.num("read_ms", read_ms, 1).num("encode_ms", encode_ms, 1).num("write_ms", write_ms, 1).num("ms", total.ms(), 1);
     r.json = o.done();
@@ -272,6 +425,11 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   ro.allow_nonfinite = a.allow_nonfinite;
   s = parse_mesh(in_bytes, j.input, forced, mesh, ro, info);
   if (!s.ok()) return finish(s);
+  std::string empty_note;
+  if (mesh.vertex_count() == 0 && mesh.face_count() == 0) {
+    s = check_empty_mesh(in_bytes, j.input, forced, info, empty_note);
+    if (!s.ok()) return finish(s);
+  }
   std::string().swap(in_bytes);
   read_ms = sw.ms();
 
@@ -297,9 +455,11 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   bytes_out = bytes.size();
 
   if (!info.notes.empty()) r.note = shown_input(j.input) + ": " + info.notes;
-  r.text = strf("%s: %s vertices, %s faces -> %s: %s bytes, %s bits/vertex (q=%d, level %d), read %s ms, encode %s ms",
-                shown_input(j.input).c_str(), thousands(mesh.vertex_count()).c_str(),
-                thousands(mesh.face_count()).c_str(), shown_output(j.output).c_str(), thousands(bytes.size()).c_str(),
+  if (!empty_note.empty()) r.note += (r.note.empty() ? "" : "; ") + empty_note;
+  r.text = strf("%s: %s, %s -> %s: %s (ratio %s), %s bits/vertex (q=%d, level %d), read %s ms, encode %s ms",
+                shown_input(j.input).c_str(), count_of(mesh.vertex_count(), "vertex", "vertices").c_str(),
+                count_of(mesh.face_count(), "face", "faces").c_str(), shown_output(j.output).c_str(),
+                count_of(bytes.size(), "byte", "bytes").c_str(), ratio_text(bytes_in, bytes.size()).c_str(),
                 fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(), a.qbits, a.level,
                 fixed(read_ms, 1).c_str(), fixed(encode_ms, 1).c_str());
   return finish(Status::Ok());
@@ -386,9 +546,10 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   write_ms = sw.ms();
   bytes_out = out.size();
 
-  r.text = strf("%s: %s bytes -> %s: %s vertices, %s faces, decode %s ms", shown_input(j.input).c_str(),
-                thousands(bytes_in).c_str(), shown_output(j.output).c_str(), thousands(mesh.vertex_count()).c_str(),
-                thousands(mesh.face_count()).c_str(), fixed(decode_ms, 1).c_str());
+  r.text = strf("%s: %s -> %s: %s, %s, decode %s ms", shown_input(j.input).c_str(),
+                count_of(bytes_in, "byte", "bytes").c_str(), shown_output(j.output).c_str(),
+                count_of(mesh.vertex_count(), "vertex", "vertices").c_str(),
+                count_of(mesh.face_count(), "face", "faces").c_str(), fixed(decode_ms, 1).c_str());
   return finish(Status::Ok());
 }
 
@@ -480,10 +641,34 @@ std::vector<std::string> shown_inputs(const std::vector<std::string>& inputs) {
 
 }  // namespace
 
+// -o NAME for a single input that is a file name (not -, not a folder).
+bool single_file_output(const std::vector<std::string>& inputs, const std::string& o) {
+  std::error_code ec;
+  return inputs.size() == 1 && !o.empty() && o != "-" && o.back() != '/' && !fs::is_directory(o, ec);
+}
+
+// The formats decode writes, and how messages list them.
+bool writable_format(MeshFormat f) {
+  return f == MeshFormat::ply || f == MeshFormat::obj || f == MeshFormat::gltf || f == MeshFormat::glb;
+}
+const char* const kWritableNames = ".ply, .obj, .gltf or .glb";
+const char* const kWritableFormats = "ply|obj|gltf|glb";
+
 int cmd_encode(const EncodeArgs& a) {
   install_signal_guard();
+  // encode writes .tsm data: a mesh file name for it would be a lie.
+  if (single_file_output(a.inputs, a.output)) {
+    const MeshFormat f = format_from_extension(a.output);
+    const std::string tsm_name = with_extension(a.output, ".tsm");
+    if (f == MeshFormat::gltf || f == MeshFormat::glb)
+      return usage_error(a.output + ": encode writes .tsm files; glTF output of compressed meshes is not supported "
+                         "yet: give -o " + tsm_name + " (tsm decode turns the .tsm back into glTF)");
+    if (f != MeshFormat::unknown)
+      return usage_error(a.output + ": encode writes .tsm files, not " + mesh_format_name(f) + "; give -o " +
+                         tsm_name + " (tsm decode turns the .tsm back into " + mesh_format_name(f) + ")");
+  }
   std::vector<Job> jobs;
-  if (int rc = plan_outputs(a.inputs, a.output, ".tsm", a.force, "a mesh", jobs)) return rc;
+  if (int rc = plan_outputs(a.inputs, a.output, ".tsm", a.force, "a mesh", "*.ply", jobs)) return rc;
   const bool to_stdout = jobs.size() == 1 && jobs[0].output == "-";
   if (to_stdout && a.json)
     return usage_error("--json prints to stdout, which already carries the .tsm data; give -o FILE or drop --json");
@@ -508,25 +693,34 @@ int cmd_decode(const DecodeArgs& a) {
                           : wanted == MeshFormat::gltf ? ".gltf"
                           : wanted == MeshFormat::glb  ? ".glb"
                                                        : ".ply";
-  std::vector<Job> jobs;
-  if (int rc = plan_outputs(a.inputs, a.output, ext, a.force, "a .tsm file", jobs)) return rc;
-  // One output format for the run: --format, else the extension of -o FILE, else PLY.
+  // One output format for the run: --format, else the extension of a single
+  // -o FILE, else PLY. A name is checked before anything is created.
   MeshFormat format = wanted == MeshFormat::unknown ? MeshFormat::ply : wanted;
-  for (Job& j : jobs) {
-    if (j.output == "-") continue;
-    const MeshFormat by_name = format_from_extension(j.output);
-    if (wanted != MeshFormat::unknown) {
-      if (by_name != MeshFormat::unknown && by_name != wanted)
-        return usage_error(j.output + ": the name says " + mesh_format_name(by_name) + " but --format says " +
-                           mesh_format_name(wanted) + "; drop one of them");
-    } else if (by_name == MeshFormat::ply || by_name == MeshFormat::obj || by_name == MeshFormat::gltf ||
-               by_name == MeshFormat::glb) {
-      format = by_name;  // only a single -o FILE can name another format than .ply
-    } else {
-      j.refused = Status(ErrorCode::invalid_argument,
-                         j.output + ": output must end in .ply, .obj, .gltf or .glb (or pass --format ply|obj|gltf|glb)");
+  if (single_file_output(a.inputs, a.output)) {
+    const MeshFormat by_name = format_from_extension(a.output);
+    if (by_name != MeshFormat::unknown && !writable_format(by_name))
+      return usage_error(a.output + ": tsm does not write " + mesh_format_name(by_name) + " files; name the output " +
+                         with_extension(a.output, ".ply") + " (or end it in " + kWritableNames + ")");
+    if (wanted != MeshFormat::unknown && by_name != MeshFormat::unknown && by_name != wanted)
+      return usage_error(a.output + ": the name says " + mesh_format_name(by_name) + " but --format says " +
+                         mesh_format_name(wanted) + "; drop one of them");
+    if (wanted == MeshFormat::unknown) {
+      if (by_name == MeshFormat::unknown)
+        return usage_error(a.output + ": the name does not say which format to write; end it in " + kWritableNames +
+                           ", or pass --format " + kWritableFormats);
+      format = by_name;
     }
   }
+  if (a.ascii && format != MeshFormat::ply) {
+    const char* why = format == MeshFormat::glb ? "GLB is binary only: drop --ascii, or write .gltf for JSON text"
+                      : format == MeshFormat::gltf ? ".gltf is JSON text already: drop --ascii"
+                      : format == MeshFormat::obj  ? "OBJ is text already: drop --ascii"
+                                                   : nullptr;
+    if (why) return usage_error(std::string("--ascii chooses ASCII PLY output, but the output is ") +
+                                mesh_format_name(format) + "; " + why);
+  }
+  std::vector<Job> jobs;
+  if (int rc = plan_outputs(a.inputs, a.output, ext, a.force, "a .tsm file", "*.tsm", jobs)) return rc;
   const bool to_stdout = jobs.size() == 1 && jobs[0].output == "-";
   if (to_stdout && a.json)
     return usage_error("--json prints to stdout, which already carries the mesh; give -o FILE or drop --json");
@@ -556,7 +750,16 @@ int cmd_info(const InfoArgs& a) {
   bo.verb = "inspected";
   return run_batch(shown_inputs(a.inputs), bo, [&](size_t i, Phase& phase) {
     phase.set("reading");
-    return info_one(a.inputs[i]);
+    // A missing file or a folder is one failed input; the others go on.
+    const Status problem = input_problem(a.inputs[i], "*.tsm");
+    if (problem.ok()) return info_one(a.inputs[i]);
+    FileResult r;
+    r.status = problem;
+    JsonObject o;
+    o.str("file", a.inputs[i]).str("status", "error");
+    o.num("exit_code", static_cast<unsigned long long>(exit_code_for(problem))).str("error", problem.message());
+    r.json = o.done();
+    return r;
   });
 }
 

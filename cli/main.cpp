@@ -1,6 +1,7 @@
 // The tsm command-line tool: encode, decode, info, bench.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -14,21 +15,138 @@ using namespace tsm::cli;
 
 namespace {
 
-// An existing file, or "-" for stdin.
-const CLI::Validator kFileOrStdin(
-    [](std::string& path) -> std::string {
-      if (path == "-") return std::string();
-      std::string copy = path;
-      return CLI::ExistingFile(copy);
-    },
-    "FILE|-", "file or -");
+// Input files are not checked here: a missing file or a folder is one
+// failing input of the batch (exit code 4), never a reason to stop the
+// others (see commands.cpp).
+
+// Edit distance between two names (case-insensitive; insertions,
+// deletions, substitutions and swaps of neighbours count 1), for suggestions.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  auto low = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+    for (size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (low(a[i - 1]) == low(b[j - 1]) ? 0 : 1)});
+      if (i > 1 && j > 1 && low(a[i - 1]) == low(b[j - 2]) && low(a[i - 2]) == low(b[j - 1]))
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// The nearest of `names` to `word`, or "" when none is near enough to be a
+// likely misspelling.
+std::string nearest(const std::string& word, const std::vector<std::string>& names) {
+  std::string best;
+  size_t best_d = std::string::npos;
+  for (const std::string& n : names) {
+    const size_t d = edit_distance(word, n);
+    if (d < best_d) best_d = d, best = n;
+  }
+  return best_d <= std::max<size_t>(1, std::min(word.size(), best.size()) / 3) ? best : std::string();
+}
+
+// All the names of an option, as the user types them: "-q/--quantization".
+std::string option_names(const CLI::Option* o) {
+  std::string r;
+  for (const std::string& s : o->get_snames()) r += (r.empty() ? "-" : "/-") + s;
+  for (const std::string& l : o->get_lnames()) r += (r.empty() ? "--" : "/--") + l;
+  return r;
+}
+
+// A suggestion for an unknown option of `cmd`: the option whose long name is
+// nearest (a misspelling), that it begins (an abbreviation), or whose short
+// name is its first letter when the rest names what it sets ("--qbits": -q,
+// "Position quantization bits"); "" when nothing fits.
+std::string suggest_option(const CLI::App* cmd, const std::string& unknown) {
+  std::string word = unknown.substr(unknown.find_first_not_of('-'));
+  std::vector<std::string> longs;
+  for (const CLI::Option* o : cmd->get_options())
+    for (const std::string& l : o->get_lnames()) longs.push_back(l);
+  const CLI::Option* found = nullptr;
+  const std::string near = nearest(word, longs);
+  for (const CLI::Option* o : cmd->get_options()) {
+    for (const std::string& l : o->get_lnames())
+      if ((!near.empty() && l == near) || (near.empty() && word.size() >= 2 && l.compare(0, word.size(), word) == 0))
+        found = found ? found : o;
+  }
+  if (!found && word.size() > 1) {
+    // The word's parts ("format-version": format, version), and the first
+    // part without its first letter ("qbits": bits).
+    std::vector<std::string> parts;
+    for (size_t at = 0; at < word.size();) {
+      const size_t end = std::min(word.find('-', at), word.find('_', at));
+      parts.push_back(word.substr(at, end == std::string::npos ? std::string::npos : end - at));
+      if (end == std::string::npos) break;
+      at = end + 1;
+    }
+    parts.push_back(parts[0].substr(1));
+    for (const CLI::Option* o : cmd->get_options()) {
+      std::string about = o->get_description();
+      for (const std::string& l : o->get_lnames()) about += " " + l;
+      for (char& c : about) c = c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+      bool named = false;
+      for (const std::string& p : parts) named = named || (p.size() >= 3 && about.find(p) != std::string::npos);
+      for (const std::string& sn : o->get_snames())
+        if (named && sn.size() == 1 && sn[0] == word[0]) found = found ? found : o;
+    }
+  }
+  return found ? option_names(found) : std::string();
+}
+
+// Looks for what CLI11 would only call "not expected" or "a subcommand is
+// required": a misspelt command, an unknown option. Returns true (message
+// printed) when the command line is refused.
+bool refuse_unknown_words(const CLI::App& app, int argc, char** argv) {
+  std::vector<std::string> commands;
+  for (const CLI::App* c : app.get_subcommands([](const CLI::App*) { return true; })) commands.push_back(c->get_name());
+  std::string all;
+  for (size_t i = 0; i < commands.size(); ++i)
+    all += (i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ") + commands[i];
+  if (argc < 2) {
+    std::fprintf(stderr, "tsm: error: give a command: %s (tsm --help shows what each does)\n", all.c_str());
+    return true;
+  }
+  const std::string first = argv[1];
+  if (first.empty() || first[0] == '-') return false;  // --help, --version, or CLI11 says what is wrong
+  const CLI::App* cmd = nullptr;
+  for (const CLI::App* c : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (c->get_name() == first) cmd = c;
+  if (!cmd) {
+    const std::string near = nearest(first, commands);
+    if (!near.empty())
+      std::fprintf(stderr, "tsm: error: unknown command '%s'; did you mean 'tsm %s'? (the commands: %s)\n",
+                   printable(first).c_str(), near.c_str(), all.c_str());
+    else
+      std::fprintf(stderr, "tsm: error: unknown command '%s'; the commands are %s (tsm --help shows them)\n",
+                   printable(first).c_str(), all.c_str());
+    return true;
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;  // the rest are file names
+    if (arg.size() < 2 || arg[0] != '-') continue;
+    if (arg[1] >= '0' && arg[1] <= '9') continue;  // a negative number: the option before it says
+    std::string name = arg[1] == '-' ? arg.substr(0, arg.find('=')) : arg.substr(0, 2);
+    if (cmd->get_option_no_throw(name) || name == "--help" || name == "-h") continue;
+    const std::string hint = suggest_option(cmd, name);
+    std::fprintf(stderr, "tsm: error: unknown option %s for tsm %s%s (tsm %s --help lists the options)\n",
+                 printable(name).c_str(), first.c_str(), hint.empty() ? "" : ("; did you mean " + hint + "?").c_str(),
+                 first.c_str());
+    return true;
+  }
+  return false;
+}
 
 // The options every file command shares.
 void add_batch_options(CLI::App* cmd, BatchArgs& b, bool quiet) {
   cmd->add_option("-j,--jobs", b.jobs,
                   "Worker threads: files processed at once, or for one file its segments; 0 = number of cores")
       ->check(CLI::Range(0, 1024))->default_str("cores");
-  cmd->add_flag("--json", b.json, "One JSON object per input file on stdout (JSON lines), success or failure");
+  cmd->add_flag("--json", b.json,
+                "One JSON object per input file on stdout (JSON lines), success or failure; bytes of a file name "
+                "that are not UTF-8 show as U+FFFD");
   if (quiet) cmd->add_flag("--quiet", b.quiet, "Print nothing on success: no report, progress bar or summary");
 }
 
@@ -46,16 +164,17 @@ int main(int argc, char** argv) {
       "  tsm encode - --input-format obj < a.obj | tsm decode - --format ply > a.ply\n"
       "  tsm info bunny.tsm --json\n"
       "  tsm bench                                   # the corpus beside the project, else the default mesh\n"
-      "Exit codes: 0 ok, 2 bad command line, 3 bad input file, 4 I/O failure, 5 internal error;\n"
+      "Exit codes: 0 ok, 2 bad command line, 3 bad input file, 4 I/O failure (an input missing,\n"
+      "a folder or unreadable; an output not writable), 5 internal error;\n"
       "for several files, the worst of them. `tsm COMMAND --help` shows each command's options.");
 
   EncodeArgs ea;
   CLI::App* enc = app.add_subcommand("encode", "Compress meshes (PLY, OBJ, STL, OFF, glTF/GLB) into .tsm files");
   enc->add_option("inputs", ea.inputs, "Mesh files to compress; - reads one mesh from stdin")
-      ->required()->check(kFileOrStdin);
+      ->required();
   enc->add_option("-o,--output", ea.output,
-                  "Output: a .tsm file (one input), a folder (DIR/, or several inputs: DIR/NAME.tsm), or - for "
-                  "stdout (default: beside each input, NAME.tsm; stdout for stdin)");
+                  "Output: a .tsm file (one input; missing folders are created), a folder (DIR/, or several inputs: "
+                  "DIR/NAME.tsm), or - for stdout (default: beside each input, NAME.tsm; stdout for stdin)");
   enc->add_option("-q,--quantization", ea.qbits, "Position quantization bits, 1..30")
       ->check(CLI::Range(1, 30))->capture_default_str();
   enc->add_option("-l,--level", ea.level, "Level 0 (fastest decode) .. 9 (smallest): 0 decodes about 2x faster than Draco, 1-2 a little "
@@ -78,7 +197,9 @@ int main(int argc, char** argv) {
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
-  enc->add_flag("--allow-nonfinite", ea.allow_nonfinite, "Read NaN/inf coordinates (the encoder still refuses them)");
+  enc->add_flag("--allow-nonfinite", ea.allow_nonfinite,
+                "Let the readers accept NaN/inf values (the encoder refuses them all the same, so this only moves the "
+                "error from the reader to the encoder; kept for scripts)");
   add_batch_options(enc, ea, true);
   enc->footer(
       "Examples:\n"
@@ -91,13 +212,13 @@ int main(int argc, char** argv) {
 
   DecodeArgs da;
   CLI::App* dec = app.add_subcommand("decode", "Decompress .tsm files into PLY, OBJ or glTF/GLB");
-  dec->add_option("inputs", da.inputs, ".tsm files; - reads one from stdin")->required()->check(kFileOrStdin);
+  dec->add_option("inputs", da.inputs, ".tsm files; - reads one from stdin")->required();
   dec->add_option("-o,--output", da.output,
                   "Output: a .ply/.obj file (one input), a folder (DIR/, or several inputs: DIR/NAME.ply), or - for "
                   "stdout (default: beside each input, NAME.ply; stdout for stdin)");
   dec->add_option("--format", da.format, "Output format (default: the extension of -o FILE, else ply)")
       ->check(CLI::IsMember({"ply", "obj", "gltf", "glb"}, CLI::ignore_case));
-  dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary");
+  dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary (PLY output only)");
   dec->add_flag("-f,--force", da.force, "Overwrite existing output files (never an input)");
   dec->add_option("--max-vertices", da.max_vertices, "Refuse files with more vertices (memory bound)")
       ->check(CLI::NonNegativeNumber);
@@ -117,7 +238,7 @@ int main(int argc, char** argv) {
 
   InfoArgs ia;
   CLI::App* inf = app.add_subcommand("info", "Show the header and sections of .tsm files");
-  inf->add_option("inputs", ia.inputs, ".tsm files; - reads one from stdin")->required()->check(kFileOrStdin);
+  inf->add_option("inputs", ia.inputs, ".tsm files; - reads one from stdin")->required();
   add_batch_options(inf, ia, false);
   inf->footer(
       "Examples:\n"
@@ -141,6 +262,7 @@ int main(int argc, char** argv) {
       "  tsm bench ../shared/corpus/bun_zipper.ply -q 11 -q 14 --runs 5\n"
       "  tsm bench --json --quiet > bench.json");
 
+  if (refuse_unknown_words(app, argc, argv)) return kExitUsage;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

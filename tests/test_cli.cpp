@@ -17,6 +17,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
 #include "tsm/tsm.hpp"
@@ -185,11 +187,16 @@ TEST_F(Cli, DefaultOutputNamesAndOverwriteRules) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(slurp(file("in.ply")), original_ply);
 
-  // Encode does not clobber an existing mesh file without -f...
+  // Encode does not clobber an existing mesh file (its name is refused
+  // before anything: encode writes .tsm) or any other file without -f...
   spit(file("other.obj"), "v 0 0 0\n");
   r = tsm("encode " + q("in.ply") + " -o " + q("other.obj"));
-  EXPECT_EQ(r.code, 3);
+  EXPECT_EQ(r.code, 2);
   EXPECT_EQ(slurp(file("other.obj")), "v 0 0 0\n");
+  spit(file("other.dat"), "data");
+  r = tsm("encode " + q("in.ply") + " -o " + q("other.dat"));
+  EXPECT_EQ(r.code, 3);
+  EXPECT_EQ(slurp(file("other.dat")), "data");
   // ...nor a previous .tsm (it may be the only copy left): -f replaces it.
   const std::string previous = slurp(file("in.tsm"));
   r = tsm("encode " + q("in.ply") + " -q 6 --quiet");
@@ -207,14 +214,20 @@ TEST_F(Cli, DefaultOutputNamesAndOverwriteRules) {
 TEST_F(Cli, RefusesToOverwriteTheInput) {
   write_input();
   const std::string before = slurp(file("in.ply"));
+  // A PLY under a name that says nothing of its format, so that only the
+  // rule about inputs stops the write (encode refuses .ply output names).
+  fs::copy_file(file("in.ply"), file("in.dat"));
   for (const char* force : {"", " -f"}) {
-    Result r = tsm("encode " + q("in.ply") + " -o " + q("in.ply") + force);
+    Result r = tsm("encode " + q("in.dat") + " -o " + q("in.dat") + force);
     EXPECT_EQ(r.code, 3) << force;
     EXPECT_NE(r.err.find("overwrite the input"), std::string::npos) << r.err;
-    EXPECT_EQ(slurp(file("in.ply")), before);
+    EXPECT_EQ(slurp(file("in.dat")), before);
     // The same file under another name.
-    r = tsm("encode " + q("in.ply") + " -o " + quote(dir.path.string() + "/./in.ply") + force);
+    r = tsm("encode " + q("in.dat") + " -o " + quote(dir.path.string() + "/./in.dat") + force);
     EXPECT_EQ(r.code, 3) << force;
+    EXPECT_EQ(slurp(file("in.dat")), before);
+    r = tsm("encode " + q("in.ply") + " -o " + q("in.ply") + force);
+    EXPECT_NE(r.code, 0) << force;
     EXPECT_EQ(slurp(file("in.ply")), before);
   }
   // decode: a .tsm file that happens to be named .ply, decoded onto itself.
@@ -233,7 +246,7 @@ TEST_F(Cli, BadArgumentsExitTwo) {
   for (const std::string& args : std::vector<std::string>{std::string(""), std::string("frobnicate"), "encode " + q("in.ply") + " -q 31",
         "encode " + q("in.ply") + " -q 0", "encode " + q("in.ply") + " -l 10", "encode " + q("in.ply") + " -q x",
         "encode " + q("in.ply") + " --no-such-flag", "encode", "decode", "info",
-        "encode " + q("in.ply") + " " + q("extra.ply"), "bench " + q("in.ply") + " --runs 0",
+        "bench " + q("in.ply") + " --runs 0",
         "bench " + q("in.ply") + " -q 40", "decode " + q("in.ply") + " --max-vertices x",
         "encode " + q("in.ply") + " --format-version 11"}) {  // one format: no such option
     Result r = tsm(args);
@@ -255,11 +268,14 @@ TEST_F(Cli, NegativeLimitIsABadArgument) {
   }
 }
 
-TEST_F(Cli, MissingInputExitTwo) {
+// A missing input is a file that cannot be read (exit code 4), reported by
+// name like any other failed input, not a command-line error.
+TEST_F(Cli, MissingInputIsAFailedInput) {
   for (const char* cmd : {"encode", "decode", "info"}) {
     Result r = tsm(std::string(cmd) + " " + q("missing.file"));
-    EXPECT_EQ(r.code, 2) << cmd << ": " << r.err;
-    EXPECT_NE(r.err.find("missing.file"), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_EQ(r.code, 4) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find("missing.file: no such file; check the name"), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_EQ(r.err.find("File does not exist"), std::string::npos) << cmd << ": " << r.err;
   }
   EXPECT_EQ(temporaries(), 0);
   EXPECT_TRUE(fs::is_empty(dir.path));
@@ -292,10 +308,10 @@ TEST_F(Cli, CorruptInputExitThreeNamesTheFile) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("limit"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(file("out.obj")));
-  // Decode refuses an output format it cannot write.
-  r = tsm("decode " + q("good.tsm") + " -o " + q("out.stl"));
-  EXPECT_EQ(r.code, 3) << r.err;
-  EXPECT_FALSE(fs::exists(file("out.stl")));
+  // Decode refuses an output name that does not say a format it writes.
+  r = tsm("decode " + q("good.tsm") + " -o " + q("out.xyz"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(file("out.xyz")));
   // A malformed mesh file given to encode.
   spit(file("bad.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
   r = tsm("encode " + q("bad.ply") + " -o " + q("bad.tsm"));
@@ -674,13 +690,13 @@ TEST_F(CliBatch, BadBatchArgumentsExitTwo) {
   for (const std::string& args : std::vector<std::string>{
            "encode " + q("a.ply") + " -j -1", "encode " + q("a.ply") + " -j x", "encode " + q("a.ply") + " --input-format fbx",
            "decode " + q("a.ply") + " --format stl", "decode " + q("a.ply") + " -o " + q("x.ply") + " --format obj",
-           "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("plain"), "info " + q("a.ply") + " " + q("missing.tsm"),
-           "encode " + q("a.ply") + " " + q("missing.ply") + " -o " + q("out")}) {
+           "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("plain"),
+           "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("out.tsm")}) {
     Result r = tsm(args);
     EXPECT_EQ(r.code, 2) << "tsm " << args << "\n" << r.out << r.err;
     EXPECT_FALSE(r.err.empty()) << "tsm " << args << ": says nothing";
   }
-  EXPECT_FALSE(fs::exists(file("out")));
+  EXPECT_FALSE(fs::exists(file("out.tsm")));
   EXPECT_EQ(slurp(file("plain")), "x");
 }
 
@@ -866,6 +882,283 @@ TEST_F(CliBatch, AWriteThatFailsLeavesNothing) {
   EXPECT_NE(r.err.find("nothing was written"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(file("out.ply")));
   EXPECT_EQ(temporaries(), 0);
+}
+
+// ---------------------------------------------------------------- inputs, outputs, messages
+
+// Every line of the text is one valid JSON object (parsed by the JSON library).
+::testing::AssertionResult json_lines(const std::string& text, size_t expected) {
+  std::vector<std::string> lines = lines_of(text);
+  if (lines.size() != expected)
+    return ::testing::AssertionFailure() << lines.size() << " lines, expected " << expected << ":\n" << text;
+  for (const std::string& l : lines) {
+    try {
+      if (!nlohmann::json::parse(l).is_object()) return ::testing::AssertionFailure() << "not an object: " << l;
+    } catch (const std::exception& e) {
+      return ::testing::AssertionFailure() << "invalid JSON (" << e.what() << "): " << l;
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// No byte of the text is a control character other than a line feed, and
+// it is valid UTF-8 (the tool never echoes raw bytes of a file).
+::testing::AssertionResult clean_text(const std::string& text) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if ((c < 0x20 && c != '\n') || c == 0x7F || c >= 0x80)  // the tool's messages are ASCII
+      return ::testing::AssertionFailure() << "byte " << i << " is 0x" << std::hex << static_cast<int>(c) << ": " << text;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST_F(CliBatch, MissingFilesAndFoldersAreFailedInputsTheOthersGoOn) {
+  write_three();
+  fs::create_directories(file("folder"));
+  Result r = tsm("encode " + q("missing.ply") + " " + q("a.ply") + " " + q("folder") + " " + q("b.obj") + " -o " +
+                 q("out/") + " --json");
+  EXPECT_EQ(r.code, 4) << r.err;  // cannot read a file: I/O (the worst class here)
+  EXPECT_TRUE(fs::is_regular_file(file("out/a.tsm")));
+  EXPECT_TRUE(fs::is_regular_file(file("out/b.tsm")));
+  EXPECT_FALSE(fs::exists(file("out/missing.tsm")));
+  EXPECT_FALSE(fs::exists(file("out/folder.tsm")));
+  ASSERT_TRUE(json_lines(r.out, 4));
+  const std::vector<std::string> lines = lines_of(r.out);
+  const auto j0 = nlohmann::json::parse(lines[0]), j1 = nlohmann::json::parse(lines[1]),
+             j2 = nlohmann::json::parse(lines[2]), j3 = nlohmann::json::parse(lines[3]);
+  EXPECT_EQ(j0["input"], file("missing.ply"));
+  EXPECT_EQ(j0["status"], "error");
+  EXPECT_EQ(j0["exit_code"], 4);
+  EXPECT_NE(j0["error"].get<std::string>().find("no such file"), std::string::npos) << lines[0];
+  EXPECT_EQ(j1["status"], "ok");
+  EXPECT_EQ(j2["exit_code"], 4);
+  EXPECT_NE(j2["error"].get<std::string>().find("is a folder"), std::string::npos) << lines[2];
+  EXPECT_EQ(j3["status"], "ok");
+  EXPECT_NE(r.err.find("2 of 4 files failed"), std::string::npos) << r.err;
+
+  // decode and info likewise.
+  r = tsm("decode " + q("missing.tsm") + " " + q("out/a.tsm") + " -o " + q("dec/") + " --quiet");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(file("dec/a.ply")));
+  r = tsm("info " + q("missing.tsm") + " " + q("out/a.tsm") + " " + q("folder") + " --json");
+  EXPECT_EQ(r.code, 4) << r.err;
+  ASSERT_TRUE(json_lines(r.out, 3));
+  EXPECT_NE(lines_of(r.out)[1].find("\"status\": \"ok\""), std::string::npos) << r.out;
+}
+
+TEST_F(CliBatch, JsonIsValidForFileNamesThatAreNotUtf8) {
+  write_input("caf\xE9.ply");  // Latin-1: not UTF-8
+  write_input("ok.ply");
+  Result r = tsm("encode " + q("caf\xE9.ply") + " " + q("ok.ply") + " " + q("caf\xE9-missing.ply") + " -o " + q("out/") +
+                 " --json --quiet");
+  EXPECT_EQ(r.code, 4) << r.err;
+  ASSERT_TRUE(json_lines(r.out, 3));
+  const auto j = nlohmann::json::parse(lines_of(r.out)[0]);
+  // The odd byte shows as U+FFFD (the replacement character).
+  EXPECT_EQ(j["input"], file("caf\xEF\xBF\xBD.ply"));
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_GT(j["compression_ratio"].get<double>(), 1.0);
+  ASSERT_TRUE(fs::is_regular_file(file("out/caf\xE9.tsm")));
+  r = tsm("info " + q("out/caf\xE9.tsm") + " --json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(json_lines(r.out, 1));
+  // Text output shows the byte escaped.
+  r = tsm("encode " + q("caf\xE9.ply") + " -o " + q("text.tsm"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("caf\\xE9.ply"), std::string::npos) << r.out;
+  EXPECT_TRUE(clean_text(r.out + r.err));
+}
+
+TEST_F(Cli, InputThatIsNotAMeshIsBadInput) {
+  // A PNG named .obj: binary where OBJ text is expected; never echoed raw.
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x10\0\0\0\x10\x08\x06\0\0\0\x1f\xf3\xff" "a", 33);
+  png += std::string("\x1b[2J\x1b]0;pwned\x07", 13);
+  spit(file("picture.obj"), png);
+  Result r = tsm("encode " + q("picture.obj") + " -o " + q("picture.tsm"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("picture.obj: not a mesh"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("binary data"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\\x89PNG"), std::string::npos) << r.err;
+  EXPECT_TRUE(clean_text(r.out + r.err));
+  EXPECT_FALSE(fs::exists(file("picture.tsm")));
+
+  // Text that is no OBJ.
+  spit(file("hello.obj"), "hello world\n");
+  r = tsm("encode " + q("hello.obj") + " -o " + q("hello.tsm"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("line 1 (\"hello world\") is not an OBJ statement"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(file("hello.tsm")));
+
+  // A PLY read as OBJ because the command line says so: binary and ASCII PLY.
+  write_input("bin.ply");
+  tsm::WriteOptions ascii;
+  ascii.ascii = true;
+  ASSERT_TRUE(tsm::write_mesh(file("text.ply"), tsm_test::icosphere(1), ascii).ok());
+  for (const char* name : {"bin.ply", "text.ply"}) {
+    r = tsm("encode " + q(name) + " --input-format obj -o " + q("x.tsm"));
+    EXPECT_EQ(r.code, 3) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("looks like PLY: drop --input-format obj"), std::string::npos) << name << ": " << r.err;
+    EXPECT_TRUE(clean_text(r.err)) << name;
+    EXPECT_FALSE(fs::exists(file("x.tsm")));
+  }
+
+  // An empty OBJ, or one with comments and groups only, is an empty mesh: encoded, and said so.
+  spit(file("empty.obj"), "");
+  spit(file("comments.obj"), "# nothing here\n\no thing\ng group\n");
+  for (const char* name : {"empty.obj", "comments.obj"}) {
+    r = tsm("encode " + q(name) + " -o " + q(std::string(name) + ".tsm"));
+    EXPECT_EQ(r.code, 0) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("empty mesh"), std::string::npos) << name << ": " << r.err;
+    EXPECT_TRUE(fs::is_regular_file(file(std::string(name) + ".tsm")));
+  }
+}
+
+TEST_F(CliBatch, OutputNamesSayWhatTheyHold) {
+  write_three();
+  // A file name for several inputs: refused, nothing made.
+  Result r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("both.obj"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("give a folder"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(file("both.obj")));
+  r = tsm("decode " + q("a.ply") + " " + q("b.obj") + " -o " + q("both.tsm"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(file("both.tsm")));
+
+  // encode writes .tsm: a mesh name for it is refused, with the name to use.
+  for (const char* name : {"x.ply", "x.obj", "x.stl", "x.off"}) {
+    r = tsm("encode " + q("a.ply") + " -o " + q(name));
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(file("x.tsm")), std::string::npos) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("tsm decode"), std::string::npos) << name << ": " << r.err;
+    EXPECT_FALSE(fs::exists(file(name))) << name;
+  }
+  for (const char* name : {"x.glb", "x.gltf"}) {
+    r = tsm("encode " + q("a.ply") + " -o " + q(name));
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("glTF output of compressed meshes is not supported yet"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(file(name))) << name;
+  }
+  // Missing folders of a single output are created.
+  r = tsm("encode " + q("a.ply") + " -o " + q("nodir/x/y.tsm") + " --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(file("nodir/x/y.tsm")));
+  r = tsm("decode " + q("nodir/x/y.tsm") + " -o " + q("deep/er/a.obj") + " --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(file("deep/er/a.obj")));
+  EXPECT_EQ(temporaries_anywhere(), 0);
+}
+
+TEST_F(CliBatch, EveryHintLeadsSomewhere) {
+  write_input();
+  ASSERT_EQ(tsm("encode " + q("in.ply") + " -o " + q("in.tsm") + " --quiet").code, 0);
+
+  // An output name that does not say the format: both remedies offered work.
+  Result r = tsm("decode " + q("in.tsm") + " -o " + q("rt.xyz"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--format"), std::string::npos) << r.err;
+  EXPECT_EQ(tsm("decode " + q("in.tsm") + " -o " + q("rt.xyz") + " --format ply --quiet").code, 0);
+  EXPECT_EQ(tsm("decode " + q("in.tsm") + " -o " + q("rt.ply") + " --quiet").code, 0);
+  // An STL name: written, or refused with a hint that is not --format (which the name would contradict).
+  r = tsm("decode " + q("in.tsm") + " -o " + q("rt.stl") + " --quiet");
+  if (r.code != 0) {
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.find("--format"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("rt.ply"), std::string::npos) << r.err;
+  }
+
+  // --ascii is for PLY output.
+  r = tsm("decode " + q("in.tsm") + " -o " + q("rt.obj") + " --ascii");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("OBJ is text already: drop --ascii"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(file("rt.obj")));
+  EXPECT_EQ(tsm("decode " + q("in.tsm") + " -o " + q("rt2.ply") + " --ascii --quiet").code, 0);
+
+  // NaN coordinates: no hint toward --allow-nonfinite, which cannot help.
+  spit(file("nan.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  spit(file("nan.obj"), "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  for (const char* name : {"nan.ply", "nan.obj"}) {
+    for (const char* flag : {"", " --allow-nonfinite"}) {
+      r = tsm("encode " + q(name) + " -o " + q("nan.tsm") + flag);
+      EXPECT_EQ(r.code, 3) << name << flag << ": " << r.err;
+      EXPECT_EQ(r.err.find("--allow-nonfinite"), std::string::npos) << name << flag << ": " << r.err;
+      EXPECT_NE(r.err.find("fix or drop"), std::string::npos) << name << flag << ": " << r.err;
+    }
+  }
+
+  // A .gltf on stdin whose buffer is a file: what to do on the command line.
+  std::string bin;
+  for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&f), 4);
+  spit(file("tri.bin"), bin);
+  spit(file("tri.gltf"), R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "buffers": [{"byteLength": 36, "uri": "tri.bin"}], "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}]})");
+  r = sh("$TSM encode - -o " + q("tri.tsm") + " < " + q("tri.gltf"));
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("give the .gltf file's path instead of -"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("ReadOptions"), std::string::npos) << r.err;
+  r = tsm("encode " + q("tri.gltf") + " -o " + q("tri.tsm"));
+  EXPECT_EQ(r.code, 0) << r.err;
+
+  // Unknown options and commands: the nearest one is named.
+  r = tsm("encode " + q("in.ply") + " --qbits 12");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown option --qbits"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("did you mean -q/--quantization?"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("File does not exist"), std::string::npos) << r.err;
+  r = tsm("encode " + q("in.ply") + " --levle 3");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("did you mean -l/--level?"), std::string::npos) << r.err;
+  r = tsm("encode " + q("in.ply") + " --frobnicate");  // nothing near: no guess
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown option --frobnicate"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("did you mean"), std::string::npos) << r.err;
+  r = tsm("encdoe " + q("in.ply"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("did you mean 'tsm encode'?"), std::string::npos) << r.err;
+  r = tsm("");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("encode, decode, info or bench"), std::string::npos) << r.err;
+}
+
+TEST_F(CliBatch, ReportsSpeakPlainly) {
+  tsm::Mesh one;
+  one.add_vertex(0, 0, 0);
+  one.add_vertex(1, 0, 0);
+  one.add_vertex(0, 1, 0);
+  one.add_triangle(0, 1, 2);
+  ASSERT_TRUE(tsm::write_mesh(file("one.ply"), one).ok());
+  Result r = tsm("encode " + q("one.ply") + " -o " + q("one.tsm"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 vertices, 1 face -> "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" (ratio "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("1 faces"), std::string::npos) << r.out;
+  r = tsm("decode " + q("one.tsm") + " -o " + q("one-back.ply"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 vertices, 1 face, decode"), std::string::npos) << r.out;
+
+  // A short batch reports milliseconds, not "0.0 s".
+  write_three();
+  r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("out/"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("in 0.0 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" ms\n"), std::string::npos) << r.err;
+}
+
+// Draco's glTF reader runs in the same process as tsm's (bench): neither
+// copy of tinygltf may stand in for the other. Runs under ASan too.
+TEST_F(Cli, BenchReadsGltfAndGlb) {
+  ASSERT_TRUE(tsm::write_mesh(file("small.gltf"), tsm_test::icosphere(2)).ok());
+  ASSERT_TRUE(tsm::write_mesh(file("small.glb"), tsm_test::icosphere(1)).ok());
+  std::vector<std::string> meshes = {file("small.gltf"), file("small.glb")};
+  for (const char* rel : {"assets/VertexColorTest/VertexColorTest.gltf", "assets/Fox/Fox.gltf"})
+    if (fs::is_regular_file(tsm_test::corpus_file(rel))) meshes.push_back(tsm_test::corpus_file(rel));
+  for (const std::string& m : meshes) {
+    Result r = tsm("bench " + quote(m) + " --runs 1 -q 11 --quiet");
+    EXPECT_EQ(r.code, 0) << m << ":\n" << r.out << r.err;
+    EXPECT_NE(r.out.find("| " + fs::path(m).filename().string() + " |"), std::string::npos) << r.out;
+  }
 }
 
 }  // namespace

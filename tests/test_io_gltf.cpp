@@ -479,6 +479,88 @@ TEST(GltfRead, ExternalBufferFilesOnlyWhenAllowed) {
   expect_error(subst(kTriangleJson, "URI", "short.bin"), {"short.bin"}, ErrorCode::parse_error, o);
 }
 
+// A .gltf file's external buffers are read from its folder (and below)
+// only: every spelling that leads elsewhere is refused, with the file and
+// the URI named, and the "secret" outside is never read.
+TEST(GltfRead, ExternalBuffersOutsideTheFolderAreRefused) {
+  namespace fs = std::filesystem;
+  tsm_test::TempDir root;
+  const Bin b = triangle_bin();
+  // The secret is a valid buffer: if it were read, the file would load.
+  const std::string secret = root.file("secret.bin");
+  {
+    std::ofstream f(secret, std::ios::binary);
+    f << b.s;
+  }
+  const fs::path model = root.path / "model";
+  fs::create_directories(model / "sub");
+  for (const fs::path& p : {model / "tri.bin", model / "sub" / "tri.bin"}) {
+    std::ofstream f(p, std::ios::binary);
+    f << b.s;
+  }
+  fs::create_symlink(secret, model / "abs_link.bin");           // absolute link out
+  fs::create_symlink("../secret.bin", model / "rel_link.bin");  // relative link out
+  fs::create_directory_symlink(root.path, model / "up");        // a folder link out
+  fs::create_symlink("tri.bin", model / "inside_link.bin");     // a link that stays inside
+  auto gltf_with = [&](const std::string& uri) {
+    const std::string path = (model / "x.gltf").string();
+    std::ofstream f(path, std::ios::binary);
+    f << subst(kTriangleJson, "URI", uri);
+    return path;
+  };
+
+  struct Case {
+    std::string uri;   // as written in the JSON (JSON escapes included)
+    std::string says;  // part of the message
+  };
+  const std::vector<Case> refused = {
+      {"../secret.bin", "goes up a folder"},
+      {"sub/../../secret.bin", "goes up a folder"},
+      {"%2e%2e/secret.bin", "written as \"%2e%2e/secret.bin\""},
+      {"%2E%2E%2Fsecret.bin", "goes up a folder"},
+      {"..%2fsecret.bin", "goes up a folder"},
+      {"..\\\\secret.bin", "backslash"},
+      {secret, "absolute path"},
+      {"%2F" + secret.substr(1), "absolute path"},
+      {"file://" + secret, "file: URI"},
+      {"file:../secret.bin", "file: URI"},
+      {"FILE:secret.bin", "file: URI"},
+      {"http://example.org/secret.bin", "absolute URI"},
+      {"C:/secret.bin", "drive"},
+      {"abs_link.bin", "symbolic link"},
+      {"rel_link.bin", "symbolic link"},
+      {"up/secret.bin", "symbolic link"},
+  };
+  for (const Case& c : refused) {
+    Mesh m;
+    Status s = tsm::read_mesh(gltf_with(c.uri), m);
+    ASSERT_FALSE(s.ok()) << c.uri << ": the buffer outside the folder was read";
+    EXPECT_EQ(s.code(), ErrorCode::parse_error) << c.uri;
+    EXPECT_TRUE(contains(s.message(), "x.gltf: ")) << c.uri;
+    EXPECT_TRUE(contains(s.message(), c.says)) << c.uri;
+    EXPECT_TRUE(contains(s.message(), "refused")) << c.uri;
+    EXPECT_TRUE(contains(s.message(), "buffers[0]")) << c.uri;
+    EXPECT_EQ(m.vertex_count(), 0u) << c.uri;
+  }
+  // What stays inside is read: beside the file, in a subfolder (also
+  // percent-encoded), through "./", and through a link that stays inside.
+  for (const std::string uri : {"tri.bin", "sub/tri.bin", "sub%2Ftri.bin", "./tri.bin", "inside_link.bin"}) {
+    Mesh m;
+    Status s = tsm::read_mesh(gltf_with(uri), m);
+    ASSERT_TRUE(s.ok()) << uri << ": " << s.to_string();
+    EXPECT_EQ(m.face_count(), 1u) << uri;
+  }
+  // The same from memory, with the folder given.
+  {
+    Mesh m;
+    ReadOptions o;
+    o.external_files_dir = model.string();
+    Status s = read(subst(kTriangleJson, "URI", "../secret.bin"), m, nullptr, o);
+    ASSERT_FALSE(s.ok());
+    EXPECT_TRUE(contains(s.message(), "goes up a folder"));
+  }
+}
+
 TEST(GltfRead, DracoPrimitiveReadFromItsUncompressedCopyOnly) {
   std::string j = triangle_json();
   auto edit = [&](const std::string& from, const std::string& to) {

@@ -149,6 +149,13 @@
 // points; buffer views named only inside unknown extensions are not kept
 // (accessors are, by index); a mesh edited between reading and writing must
 // keep the tags and the per-group counts, or the writer refuses it.
+// Our copy of tinygltf lives in a namespace of its own. Draco's shared
+// library (linked into `tsm bench`) carries another tinygltf, of another
+// version, under the name `tinygltf`: with the same names, the dynamic linker
+// binds Draco's calls to our functions (the executable's definitions win),
+// and Draco's glTF reader frees our Model layout as its own (heap
+// corruption). With this name nothing of ours can stand in for Draco's.
+#define tinygltf tsm_tinygltf
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -157,7 +164,16 @@
 #include <fstream>      // tinygltf 2.7's file writers need it even without its file system
 #include <tiny_gltf.h>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
+#if defined(__linux__) && __has_include(<linux/openat2.h>)
+#include <linux/openat2.h>  // openat2 and RESOLVE_BENEATH: external buffers stay inside their folder
+#include <sys/syscall.h>
+#if defined(SYS_openat2)
+#define TSM_HAVE_OPENAT2 1
+#endif
+#endif
 
 #include <algorithm>
 #include <cerrno>
@@ -402,53 +418,239 @@ std::string clean_message(const std::string& s) {
 
 // ---------------------------------------------------------------------------
 // External buffer files (tinygltf's file system callbacks)
+//
+// A .gltf file names its external buffers by relative URI. Only files in the
+// .gltf file's folder or below it are read, whatever the spelling: tinygltf
+// percent-decodes the URI before it reaches these callbacks (so "%2e%2e" is
+// seen as ".."), and the decoded reference must be a plain relative path
+// ('/' separated, no ".." component, no backslash, no scheme such as
+// "file:", not absolute). The file is then opened relative to the folder
+// with the kernel's RESOLVE_BENEATH (openat2), so a symbolic link that leads
+// out of the folder is refused too; where openat2 is not available, the
+// link-resolved path (realpath) must lie inside the link-resolved folder
+// and the last component must not be a link. Only regular files are read.
 
 struct FsContext {
   std::string dir;     // empty: external files are refused
   std::string prefix;  // dir + '/'
   std::string error;   // why a file was refused or could not be read
+  std::string refused_reference;  // the decoded URI that was refused (to find its spelling)
+  int dir_fd = -1;     // the folder, opened once (O_PATH)
+  ~FsContext() {
+    if (dir_fd >= 0) ::close(dir_fd);
+  }
 };
+
+// A URI or path for messages: quoted, control bytes and non-ASCII escaped
+// as \xNN, cut after 200 bytes.
+std::string shown_uri(std::string_view s) {
+  std::string r = "\"";
+  for (char c : s.substr(0, 200)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 32 || u >= 127 || c == '"') {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", u);
+      r += buf;
+    } else {
+      r += c;
+    }
+  }
+  if (s.size() > 200) r += "...";
+  return r + "\"";
+}
+
+// Why a decoded relative reference may not be opened, or "" when it may.
+std::string unsafe_reference(const std::string& rel) {
+  if (rel.empty()) return "is empty";
+  if (rel.find('\0') != std::string::npos) return "contains a NUL byte";
+  if (rel.find('\\') != std::string::npos)
+    return "contains a backslash (glTF URIs separate folders with '/'; a backslash is not read as a path)";
+  // RFC 3986: a scheme ("file:", "http:", a Windows drive "C:") is letters,
+  // digits, '+', '-', '.' before the first ':' that comes before any '/'.
+  const size_t colon = rel.find(':');
+  if (colon != std::string::npos && colon < rel.find('/')) {
+    const std::string scheme = rel.substr(0, colon);
+    if (scheme.size() == 4 && (scheme[0] | 0x20) == 'f' && (scheme[1] | 0x20) == 'i' && (scheme[2] | 0x20) == 'l' &&
+        (scheme[3] | 0x20) == 'e')
+      return "is a file: URI (only relative references to files beside the .gltf file are read)";
+    return "is an absolute URI or a drive path (scheme or drive " + shown_uri(scheme) +
+           "; only relative references to files beside the .gltf file are read)";
+  }
+  if (rel[0] == '/') return "is an absolute path";
+  size_t start = 0;
+  for (;;) {
+    const size_t end = rel.find('/', start);
+    const std::string_view part = std::string_view(rel).substr(start, end == std::string::npos ? std::string::npos : end - start);
+    if (part == "..") return "goes up a folder ('..')";
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return "";
+}
+
+// Opens `rel` for reading inside ctx->dir (see above). Returns the file
+// descriptor, or -1 with ctx->error set.
+int open_beneath(FsContext* ctx, const std::string& rel) {
+  auto fail = [&](const std::string& why) {
+    if (ctx->error.empty()) ctx->error = why;
+    return -1;
+  };
+  if (ctx->dir_fd < 0) {
+    ctx->dir_fd = ::open(ctx->dir.c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC);
+    if (ctx->dir_fd < 0) return fail("buffer folder " + ctx->dir + ": " + std::strerror(errno));
+  }
+  const std::string outside =
+      "buffer uri " + shown_uri(rel) +
+      " leads outside the .gltf file's folder through a symbolic link; refused: external buffers are read only "
+      "from that folder and its subfolders (copy the file there, or embed the buffer: a .glb or a data: URI)";
+  int fd = -1;
+#ifdef TSM_HAVE_OPENAT2
+  struct open_how how = {};
+  how.flags = O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK;  // O_NONBLOCK: a FIFO must not hang the open
+  how.resolve = RESOLVE_BENEATH | RESOLVE_NO_MAGICLINKS;
+  fd = static_cast<int>(::syscall(SYS_openat2, ctx->dir_fd, rel.c_str(), &how, sizeof how));
+  if (fd < 0 && errno == EXDEV) {
+    ctx->refused_reference = rel;
+    return fail(outside);
+  }
+  if (fd < 0 && errno != ENOSYS && errno != EPERM && errno != E2BIG && errno != EINVAL)
+    return fail("buffer file " + ctx->prefix + rel + ": " + std::strerror(errno));
+#endif
+  if (fd < 0) {
+    // No openat2 (old kernel, or a sandbox that filters it): compare the
+    // link-resolved paths instead.
+    char* real_dir = ::realpath(ctx->dir.c_str(), nullptr);
+    if (!real_dir) return fail("buffer folder " + ctx->dir + ": " + std::strerror(errno));
+    const std::string base = std::string(real_dir) == "/" ? std::string("/") : std::string(real_dir) + "/";
+    std::free(real_dir);
+    const std::string path = ctx->prefix + rel;
+    char* real = ::realpath(path.c_str(), nullptr);
+    if (!real) return fail("buffer file " + path + ": " + std::strerror(errno));
+    const std::string resolved = real;
+    std::free(real);
+    if (resolved.compare(0, base.size(), base) != 0) {
+      ctx->refused_reference = rel;
+      return fail(outside);
+    }
+    fd = ::open(resolved.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK | O_NOFOLLOW);
+    if (fd < 0) return fail("buffer file " + path + ": " + std::strerror(errno));
+  }
+  struct stat st = {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return fail("buffer file " + ctx->prefix + rel + " is not a regular file");
+  }
+  return fd;
+}
+
+// The part of a path tinygltf built (folder + '/' + decoded URI) after the
+// folder, or "" with false when the path is not in the folder (tinygltf
+// also tries the current directory: never that).
+bool reference_in_dir(const FsContext* ctx, const std::string& path, std::string& rel) {
+  if (path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
+  rel = path.substr(ctx->prefix.size());
+  return true;
+}
 
 bool fs_exists(const std::string& path, void* user) {
   auto* ctx = static_cast<FsContext*>(user);
-  const std::string rel = path.size() > ctx->prefix.size() ? path.substr(ctx->prefix.size()) : std::string();
   if (ctx->dir.empty()) {
     if (ctx->error.empty())
-      ctx->error = "buffer file " + shown_name(path) +
+      ctx->error = "buffer file " + shown_uri(path) +
                    ": external files are not read here (the glTF did not come from a file: give the .gltf file's "
                    "path, or set ReadOptions::external_files_dir)";
     return false;
   }
-  // tinygltf tries the folder, then the current directory: only the folder.
-  if (path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
-  if (rel.empty() || rel[0] == '/' || rel.find('\0') != std::string::npos || rel.find("://") != std::string::npos) {
-    if (ctx->error.empty()) ctx->error = "buffer uri " + shown_name(rel) + " is not a relative file name";
+  std::string rel;
+  if (!reference_in_dir(ctx, path, rel)) return false;
+  const std::string why = unsafe_reference(rel);
+  if (!why.empty()) {
+    if (ctx->error.empty()) {
+      ctx->refused_reference = rel;
+      ctx->error = "buffer uri " + shown_uri(rel) + " " + why +
+                   "; refused: external buffers are read only from the .gltf file's folder and its subfolders, by "
+                   "relative URI (copy the file there and name it relative to the .gltf file, or embed the buffer: "
+                   "a .glb or a data: URI)";
+    }
     return false;
   }
-  struct stat st = {};
-  if (::stat(path.c_str(), &st) != 0) {
-    if (ctx->error.empty()) ctx->error = "buffer file " + path + ": " + std::strerror(errno);
-    return false;
-  }
-  if (!S_ISREG(st.st_mode)) {
-    if (ctx->error.empty()) ctx->error = "buffer file " + path + " is not a regular file";
-    return false;
-  }
+  const int fd = open_beneath(ctx, rel);
+  if (fd < 0) return false;
+  ::close(fd);
   return true;
 }
 
 std::string fs_expand(const std::string& path, void*) { return path; }
 
+// tinygltf's URI decoding (dlib::urldecode): '+' is a space, "%XX" a byte.
+std::string uri_decoded(const std::string& s) {
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string r;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '+') {
+      r += ' ';
+    } else if (s[i] == '%' && s.size() > i + 2) {
+      r += static_cast<char>(hex(s[i + 1]) * 16 + hex(s[i + 2]));
+      i += 2;
+    } else {
+      r += s[i];
+    }
+  }
+  return r;
+}
+
+// Where a refused reference comes from, for the message: " (buffers[i],
+// written as URI)" when the JSON spells it differently (percent-encoded),
+// " (buffers[i])" otherwise, "" when it cannot be found.
+std::string reference_origin(std::string_view json, const std::string& decoded) {
+  try {
+    const ojson doc = ojson::parse(json.begin(), json.end());
+    const auto it = doc.find("buffers");
+    if (it == doc.end() || !it->is_array()) return "";
+    for (size_t i = 0; i < it->size(); ++i) {
+      const ojson& b = (*it)[i];
+      if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string()) continue;
+      const std::string uri = b["uri"].get<std::string>();
+      if (uri_decoded(uri) != decoded) continue;
+      if (uri == decoded) return " (buffers[" + std::to_string(i) + "])";
+      return " (buffers[" + std::to_string(i) + "], written as " + shown_uri(uri) + ")";
+    }
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
 bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   auto* ctx = static_cast<FsContext*>(user);
-  std::string bytes;
-  Status s = read_file(path, bytes);
-  if (!s.ok()) {
-    if (ctx->error.empty()) ctx->error = s.message();
-    if (err) *err += s.message();
+  std::string rel;
+  // fs_exists accepted this path; checked again, as the file is opened anew.
+  const int fd = reference_in_dir(ctx, path, rel) && unsafe_reference(rel).empty() ? open_beneath(ctx, rel) : -1;
+  if (fd < 0) {
+    if (ctx->error.empty()) ctx->error = "buffer file " + shown_uri(path) + " refused";
+    if (err) *err += ctx->error;
     return false;
   }
-  out->assign(bytes.begin(), bytes.end());
+  out->clear();
+  unsigned char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      if (ctx->error.empty()) ctx->error = "buffer file " + path + ": read failed: " + why;
+      if (err) *err += ctx->error;
+      return false;
+    }
+    if (n == 0) break;
+    out->insert(out->end(), buf, buf + n);
+  }
+  ::close(fd);
   return true;
 }
 
@@ -631,6 +833,15 @@ class GltfReader {
                                       fs.dir);
     }
     if (!ok) {
+      if (!fs.error.empty() && !fs.refused_reference.empty()) {
+        // Name the buffer and its spelling in the file ("%2e%2e/x.bin" is "../x.bin").
+        const std::string quoted = shown_uri(fs.refused_reference);
+        std::string why = fs.error;
+        const size_t at = why.find(quoted);
+        if (at != std::string::npos)
+          why.insert(at + quoted.size(), reference_origin(json, fs.refused_reference));
+        return error(why);
+      }
       if (!fs.error.empty()) return error(fs.error);
       return error("invalid glTF: " + clean_message(err));
     }
