@@ -227,21 +227,23 @@ Status read_mesh(const std::string& path, Mesh& out, const ReadOptions& options,
   return read_mesh_from_memory(bytes, path, out, options, info, format_from_extension(path));
 }
 
-Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
+Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options, WriteInfo* info) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, path + ": mesh to write is invalid: " + why);
   std::string bytes;
   MeshFormat format = format_from_extension(path);
   if (format == MeshFormat::ply) {
-    TSM_RETURN_IF_ERROR(write_ply(mesh, options, bytes));
+    TSM_RETURN_IF_ERROR(write_ply(mesh, options, bytes, info));
   } else if (format == MeshFormat::obj) {
-    TSM_RETURN_IF_ERROR(write_obj(mesh, bytes));
+    TSM_RETURN_IF_ERROR(write_obj(mesh, bytes, info));
+  } else if (format == MeshFormat::stl || format == MeshFormat::off) {
+    TSM_RETURN_IF_ERROR(format == MeshFormat::stl ? write_stl(mesh, options, bytes, info) : write_off(mesh, options, bytes, info));
   } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
     Status s = write_gltf(mesh, options, bytes, format == MeshFormat::glb);
     if (!s.ok()) return Status(s.code(), path + ": " + s.message());
   } else {
     return Status(ErrorCode::invalid_argument,
-                  path + ": cannot write this format; use a .ply, .obj, .gltf or .glb file name");
+                  path + ": cannot write this format; use a .ply, .obj, .stl, .off, .gltf or .glb file name");
   }
   return write_file_atomic(path, bytes);
 }
