@@ -303,9 +303,9 @@ TEST_F(Cli, CorruptInputExitThreeNamesTheFile) {
   EXPECT_NE(r.err.find("limit"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(file("out.obj")));
   // Decode refuses an output format it cannot write.
-  r = tsm("decode " + q("good.tsm") + " -o " + q("out.stl"));
+  r = tsm("decode " + q("good.tsm") + " -o " + q("out.xyz"));
   EXPECT_EQ(r.code, 3) << r.err;
-  EXPECT_FALSE(fs::exists(file("out.stl")));
+  EXPECT_FALSE(fs::exists(file("out.xyz")));
   // A malformed mesh file given to encode.
   spit(file("bad.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
   r = tsm("encode " + q("bad.ply") + " -o " + q("bad.tsm"));
