@@ -1097,9 +1097,9 @@ TEST(AttributeCorpus, ObjFiles) {
   for (const char* file : {"edge/sphere.obj", "edge/test_nm.obj", "edge/extra_vertex.obj"}) {
     SCOPED_TRACE(file);
     ASSERT_TRUE(read_corpus(file, m, &info).ok());
-    // sphere.obj has one o, g, usemtl and s record: four 'obj:*' face attributes after the normals.
-    ASSERT_EQ(m.attributes.size(), std::string(file) == "edge/sphere.obj" ? 5u : 1u);
-    for (size_t k = 1; k < m.attributes.size(); ++k) EXPECT_EQ(m.attributes[k].name.substr(0, 4), "obj:");
+    // sphere.obj has one o, g, usemtl and s record each: the "obj" metadata
+    // says them, no face attribute is needed.
+    ASSERT_EQ(m.attributes.size(), 1u);
     const Attribute& a = m.attributes[0];
     EXPECT_EQ(a.kind, AttributeKind::normal);
     EXPECT_EQ(a.value_count(), m.vertex_count());
@@ -1355,7 +1355,7 @@ TEST(ObjGroups, SurviveEncodeDecodeAndWriteRead) {
 
 TEST(ObjGroups, OtherWritersKeepTheNumbersOrSayWhatTheyDrop) {
   Mesh m;
-  ASSERT_TRUE(obj("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\ng g1\nusemtl m1\nf 1 2 3\n", m).ok());
+  ASSERT_TRUE(obj("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\ng g1\nusemtl m1\nf 1 2 3\ng g2\nusemtl m2\nf 1 3 2\n", m).ok());
   // PLY keeps the numbers as face properties, not the names.
   std::string out;
   tsm::WriteInfo info;
@@ -1366,7 +1366,19 @@ TEST(ObjGroups, OtherWritersKeepTheNumbersOrSayWhatTheyDrop) {
   ASSERT_NE(find(back, "obj:group"), nullptr);
   // From PLY (no names) to OBJ: the groups stay apart under made-up names.
   ASSERT_TRUE(tsm::write_obj(back, out).ok());
-  EXPECT_TRUE(contains(out, "g group0\nusemtl material0\nf 1 2 3\n")) << out;
+  EXPECT_TRUE(contains(out, "g group0\nusemtl material0\nf 1 2 3\ng group1\nusemtl material1\nf 1 3 2\n")) << out;
+}
+
+TEST(ObjGroups, OneTextForTheWholeFileNeedsNoAttribute) {
+  Mesh m;
+  ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\no only\nusemtl red\nf 1 2 3\nf 1 3 2\n", m).ok());
+  EXPECT_TRUE(m.attributes.empty());
+  const tsm::MetadataEntry* e = m.find_metadata("obj");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->value, "object only\nmaterial red\n");
+  std::string out;
+  ASSERT_TRUE(tsm::write_obj(m, out).ok());
+  EXPECT_TRUE(contains(out, "v 0 1 0\no only\nusemtl red\nf 1 2 3\nf 1 3 2\n")) << out;
 }
 
 TEST(WriteNotes, ObjWriterNamesWhatItDrops) {

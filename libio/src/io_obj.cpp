@@ -17,7 +17,7 @@
 // has gives a face attribute ('obj:object', 'obj:group', 'obj:material',
 // 'obj:smoothing', generic i32) numbering, per face, the text in force when
 // the face was read among the distinct texts of that kind, in order of first
-// appearance; the texts and the `mtllib` file names go into the metadata
+// appearance (left out when there is one text: every face has entry 0); the texts and the `mtllib` file names go into the metadata
 // entry "obj" (format in io.hpp). The codec codes face attributes exactly
 // and carries metadata through, so the faces' groups and materials survive
 // encoding, whatever order the decoder gives the faces.
@@ -476,7 +476,8 @@ void ObjReader::finish_labels(Mesh& mesh, std::vector<std::string>& notes) {
   for (FaceLabels& l : labels_) {
     if (!l.seen) continue;
     for (const std::string& t : l.texts) meta += std::string(l.list) + " " + t + "\n";
-    if (nf == 0) continue;
+    // One text: every face has entry 0, which the list alone says.
+    if (nf == 0 || l.texts.size() == 1) continue;
     // Entries are stored as floats: exact up to 2^24.
     if (l.texts.size() > (size_t{1} << 24)) {
       notes.push_back("dropped which '" + std::string(l.keyword) + "' record each face belongs to: " +
@@ -747,6 +748,7 @@ struct LabelsOut {
   static constexpr const char* kLists[4] = {"object", "group", "material", "smoothing"};
   static constexpr const char* kKeywords[4] = {"o", "g", "usemtl", "s"};
   const Attribute* attr[4] = {nullptr, nullptr, nullptr, nullptr};
+  bool single[4] = {false, false, false, false};  // no attribute, one text: every face has entry 0
   std::vector<std::string> texts[4];
   std::vector<std::string> mtllibs;
 
@@ -777,13 +779,20 @@ struct LabelsOut {
       for (int k = 0; k < 4; ++k)
         if (key == kLists[k]) texts[k].emplace_back(text);
     }
+    for (int k = 0; k < 4; ++k) single[k] = !attr[k] && texts[k].size() == 1;
   }
   // The text of entry n of list k; entries the metadata lacks get a made-up
   // name ("group7"), so faces stay apart.
   std::string text(int k, size_t n) const {
     std::string t = n < texts[k].size() ? texts[k][n] : std::string(k == 3 ? "" : kLists[k]) + std::to_string(n);
+    return one_line(std::move(t));
+  }
+  // A record's text as a line can hold it: line ends become blanks, and a
+  // backslash at the end (which would join the next line) is dropped.
+  static std::string one_line(std::string t) {
     for (char& c : t)
       if (c == '\n' || c == '\r') c = ' ';
+    while (!t.empty() && (t.back() == '\\' || t.back() == ' ' || t.back() == '\t')) t.pop_back();
     return t;
   }
 };
@@ -831,7 +840,8 @@ Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {
   }
   LabelsOut labels;
   labels.find(mesh);
-  const bool any_labels = labels.attr[0] || labels.attr[1] || labels.attr[2] || labels.attr[3];
+  bool any_labels = false;
+  for (int k = 0; k < 4; ++k) any_labels = any_labels || labels.attr[k] || labels.single[k];
   std::string dropped;
   for (size_t k = 0; k < mesh.attributes.size(); ++k) {
     const Attribute& a = mesh.attributes[k];
@@ -850,12 +860,7 @@ Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {
          " faces\n";
   // attribute_words keeps names on one line.
   if (!dropped.empty()) out += "# tsm: not written (OBJ cannot hold them): " + dropped + "\n";
-  for (const std::string& m : labels.mtllibs) {
-    std::string t = m;
-    for (char& c : t)
-      if (c == '\n' || c == '\r') c = ' ';
-    out += "mtllib " + t + "\n";
-  }
+  for (const std::string& m : labels.mtllibs) out += "mtllib " + LabelsOut::one_line(m) + "\n";
   char buf[256];
   char* const bend = buf + sizeof buf;
   const float* pos = mesh.positions.data();
@@ -913,8 +918,8 @@ Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     if (any_labels) {
       for (int k = 0; k < 4; ++k) {
-        if (!labels.attr[k]) continue;
-        const size_t entry = static_cast<size_t>(labels.attr[k]->values[f]);
+        if (!labels.attr[k] && !labels.single[k]) continue;
+        const size_t entry = labels.attr[k] ? static_cast<size_t>(labels.attr[k]->values[f]) : 0;
         if (entry == written[k]) continue;
         written[k] = entry;
         std::string t = labels.text(k, entry);

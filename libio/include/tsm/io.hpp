@@ -75,7 +75,9 @@ Status read_ply(std::string_view bytes, const std::string& name, Mesh& out,
 // TEXT is what follows the keyword in the file (blanks around it and a
 // trailing comment removed; a `g` with several names keeps them as one
 // text). Faces before the first record of a kind get the empty text, as
-// does a record with nothing after its keyword. write_obj writes them back.
+// does a record with nothing after its keyword. A kind with a single text
+// (one `usemtl` for the whole file, say) gets no attribute: its list alone
+// says that every face has entry 0. write_obj writes them back.
 Status read_obj(std::string_view bytes, const std::string& name, Mesh& out,
                 const ReadOptions& options, ReadInfo* info);
 Status read_stl(std::string_view bytes, const std::string& name, Mesh& out,
