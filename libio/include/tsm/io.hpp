@@ -145,9 +145,11 @@ Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info = nullptr);
 // holds no attributes, metadata or unreferenced vertices: `info` says what
 // was left out.
 Status write_stl(const Mesh& mesh, const WriteOptions& options, std::string& out, WriteInfo* info = nullptr);
-// OFF text: "OFF", or "COFF" with a vertex colour; a face colour follows
-// each face's indices. Positions and faces read back bit-identically;
-// other attributes are noted in `info`.
+// OFF text: "OFF" with the prefixes ST, C, N for a vertex texcoord, colour
+// and normal attribute ("COFF" for a coloured mesh); a face colour follows
+// each face's indices. Positions, faces and those attributes read back
+// bit-identically (u16 colours as f32 0..1); other attributes and metadata
+// are noted in `info`.
 Status write_off(const Mesh& mesh, const WriteOptions& options, std::string& out, WriteInfo* info = nullptr);
 // glTF 2.0: binary (.glb) or JSON with the buffer as a data URI (.gltf).
 // With a "gltf" metadata entry (from read_gltf), the document it holds with
