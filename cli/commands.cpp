@@ -387,20 +387,7 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
     // glTF has no face attributes: the OBJ groups and materials per face
     // ('obj:*', from an OBJ input) would make the writer refuse the mesh.
-    std::vector<std::string> dropped;
-    for (size_t k = mesh.attributes.size(); k-- > 0;) {
-      const Attribute& at = mesh.attributes[k];
-      if (at.domain == AttributeDomain::face && at.name.compare(0, 4, "obj:") == 0) {
-        dropped.insert(dropped.begin(), "'" + at.name + "'");
-        mesh.attributes.erase(mesh.attributes.begin() + static_cast<std::ptrdiff_t>(k));
-      }
-    }
-    if (!dropped.empty()) {
-      std::string list;
-      for (const std::string& name : dropped) list += (list.empty() ? "" : ", ") + name;
-      wi.add_note("glTF cannot hold the OBJ object, group, material and smoothing group of each face (face "
-                  "attributes " + list + "); not written (decode to .obj to keep them)");
-    }
+    drop_obj_face_labels(mesh, &wi);
     s = write_gltf(mesh, WriteOptions(), out, format == MeshFormat::glb);
   } else {
     s = write_ply(mesh, wo, out, &wi);

@@ -1369,6 +1369,30 @@ TEST(ObjGroups, OtherWritersKeepTheNumbersOrSayWhatTheyDrop) {
   EXPECT_TRUE(contains(out, "g group0\nusemtl material0\nf 1 2 3\ng group1\nusemtl material1\nf 1 3 2\n")) << out;
 }
 
+TEST(ObjGroups, WriteMeshToGltfLeavesThemOutWithANote) {
+  Mesh m;
+  ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 3 2\n", m).ok());
+  ASSERT_NE(find(m, "obj:group"), nullptr);
+  // write_gltf itself refuses face attributes ...
+  std::string bytes;
+  EXPECT_FALSE(tsm::write_gltf(m, WriteOptions{}, bytes, true).ok());
+  // ... write_mesh leaves the groups out and says so.
+  tsm_test::TempDir dir;
+  tsm::WriteInfo info;
+  Status st = tsm::write_mesh(dir.file("m.glb"), m, WriteOptions{}, &info);
+  ASSERT_TRUE(st.ok()) << st.to_string();
+  EXPECT_TRUE(contains(info.notes, "glTF cannot hold the OBJ object, group, material and smoothing group of each face "
+                                   "(face attributes 'obj:group')"))
+      << info.notes;
+  Mesh back;
+  ASSERT_TRUE(tsm::read_mesh(dir.file("m.glb"), back).ok());
+  EXPECT_EQ(back.face_count(), 2u);
+  Mesh copy = m;
+  EXPECT_TRUE(tsm::drop_obj_face_labels(copy, nullptr));
+  EXPECT_TRUE(copy.attributes.empty());
+  EXPECT_FALSE(tsm::drop_obj_face_labels(copy, nullptr));
+}
+
 TEST(ObjGroups, OneTextForTheWholeFileNeedsNoAttribute) {
   Mesh m;
   ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\no only\nusemtl red\nf 1 2 3\nf 1 3 2\n", m).ok());

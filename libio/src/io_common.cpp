@@ -239,7 +239,13 @@ Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions&
   } else if (format == MeshFormat::stl || format == MeshFormat::off) {
     TSM_RETURN_IF_ERROR(format == MeshFormat::stl ? write_stl(mesh, options, bytes, info) : write_off(mesh, options, bytes, info));
   } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
-    Status s = write_gltf(mesh, options, bytes, format == MeshFormat::glb);
+    // glTF has no face attributes: OBJ groups ('obj:*') are left out, noted.
+    Mesh without_labels;
+    const Mesh* m = &mesh;
+    for (const Attribute& a : mesh.attributes)
+      if (m == &mesh && a.domain == AttributeDomain::face && a.name.compare(0, 4, "obj:") == 0) m = &without_labels;
+    if (m == &without_labels) drop_obj_face_labels(without_labels = mesh, info);
+    Status s = write_gltf(*m, options, bytes, format == MeshFormat::glb);
     if (!s.ok()) return Status(s.code(), path + ": " + s.message());
   } else {
     return Status(ErrorCode::invalid_argument,

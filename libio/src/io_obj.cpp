@@ -72,6 +72,7 @@
 // without attributes gives the same bytes as before attributes existed.
 #include <array>
 #include <charconv>
+#include <cstddef>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -816,6 +817,26 @@ Status read_obj(std::string_view bytes, const std::string& name, Mesh& out, cons
   }
   out = std::move(mesh);
   return Status::Ok();
+}
+
+bool drop_obj_face_labels(Mesh& mesh, WriteInfo* info) {
+  std::string list;
+  auto& attrs = mesh.attributes;
+  for (size_t k = 0; k < attrs.size();) {
+    if (attrs[k].domain == AttributeDomain::face && attrs[k].name.compare(0, 4, "obj:") == 0) {
+      list += (list.empty() ? "'" : ", '") + attrs[k].name + "'";
+      attrs.erase(attrs.begin() + static_cast<std::ptrdiff_t>(k));
+    } else {
+      ++k;
+    }
+  }
+  if (list.empty()) return false;
+  for (char& c : list)
+    if (c == '\n' || c == '\r') c = ' ';
+  if (info)
+    info->add_note("glTF cannot hold the OBJ object, group, material and smoothing group of each face (face "
+                   "attributes " + list + "); not written (decode to .obj to keep them)");
+  return true;
 }
 
 Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {

@@ -23,6 +23,8 @@ MeshFormat format_from_extension(std::string_view path);
 // when nothing fits (OBJ has no signature).
 MeshFormat sniff_format(std::string_view bytes);
 
+struct WriteInfo;
+
 struct ReadOptions {
   // NaN or infinite coordinates are refused unless this is set.
   bool allow_nonfinite = false;
@@ -80,6 +82,10 @@ Status read_ply(std::string_view bytes, const std::string& name, Mesh& out,
 // says that every face has entry 0. write_obj writes them back.
 Status read_obj(std::string_view bytes, const std::string& name, Mesh& out,
                 const ReadOptions& options, ReadInfo* info);
+// Removes the 'obj:*' face attributes (for writers without face attributes,
+// glTF) and notes in `info` that they were left out; the "obj" entry stays.
+// Returns whether there were any.
+bool drop_obj_face_labels(Mesh& mesh, WriteInfo* info);
 Status read_stl(std::string_view bytes, const std::string& name, Mesh& out,
                 const ReadOptions& options, ReadInfo* info);
 // OFF and its Geomview variants: vertex normals (N), colours (C) and texture
