@@ -6,10 +6,13 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <string>
 #include <thread>
@@ -531,16 +534,25 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
   if (!mesh.valid(&why))
     return finish(Status(ErrorCode::internal, shown_input(j.input) + ": decoded mesh is invalid: " + why));
   std::string out;
+  WriteOptions wo;
+  wo.ascii = a.ascii;
+  WriteInfo wi;
   if (format == MeshFormat::obj) {
-    s = write_obj(mesh, out);
+    s = write_obj(mesh, out, &wi);
+  } else if (format == MeshFormat::stl) {
+    s = write_stl(mesh, wo, out, &wi);
+  } else if (format == MeshFormat::off) {
+    s = write_off(mesh, wo, out, &wi);
   } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
+    // glTF has no face attributes: the OBJ groups and materials per face
+    // ('obj:*', from an OBJ input) would make the writer refuse the mesh.
+    drop_obj_face_labels(mesh, &wi);
     s = write_gltf(mesh, WriteOptions(), out, format == MeshFormat::glb);
   } else {
-    WriteOptions wo;
-    wo.ascii = a.ascii;
-    s = write_ply(mesh, wo, out);
+    s = write_ply(mesh, wo, out, &wi);
   }
   if (!s.ok()) return finish(Status(s.code(), shown_output(j.output) + ": " + s.message()));
+  if (!wi.notes.empty()) r.note = shown_output(j.output) + ": " + wi.notes;
   s = write_output(j.output, out, a.force);
   if (!s.ok()) return finish(s);
   write_ms = sw.ms();
@@ -554,6 +566,77 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
 }
 
 // ---------------------------------------------------------------- info
+
+// What `tsm info` says about one attribute of the decoded mesh.
+struct AttributeSummary {
+  const char* kind;
+  const char* domain;
+  const char* type;
+  const char* coding;  // "exact" (integer types), "grid", "octahedral" (float normals)
+  int bits = 0;        // exact: the type's width; grid: as the values show it (0: cannot tell)
+};
+
+// The grid a float attribute's decoded values lie on. The encoder puts each
+// component c on origin[c] + k * step, step = the largest extent of the
+// components / (2^bits - 1) (FORMAT.md §8.12), and the decoder gives those
+// values back (to a few float ulps): the smallest bits whose grid holds
+// every value. A grid of b bits is not a subset of a coarser one, so this is
+// the encoder's bits unless the values happen to use only the points of a
+// coarser grid. 0 when all values are equal (or none fits up to 24 bits).
+int grid_bits_from_values(const Attribute& a) {
+  const uint32_t nc = a.components;
+  if (nc == 0 || a.values.empty()) return 0;
+  std::vector<double> lo(nc, 0), hi(nc, 0);
+  std::vector<bool> seen(nc, false);
+  for (size_t i = 0; i < a.values.size(); ++i) {
+    const double x = a.values[i];
+    if (!std::isfinite(x)) continue;
+    const size_t c = i % nc;
+    if (!seen[c] || x < lo[c]) lo[c] = x;
+    if (!seen[c] || x > hi[c]) hi[c] = x;
+    seen[c] = true;
+  }
+  double extent = 0, magnitude = 0;
+  for (uint32_t c = 0; c < nc; ++c) {
+    extent = std::max(extent, hi[c] - lo[c]);
+    magnitude = std::max({magnitude, std::fabs(lo[c]), std::fabs(hi[c])});
+  }
+  if (!(extent > 0)) return 0;
+  for (int bits = 1; bits <= 24; ++bits) {
+    const double step = extent / (std::ldexp(1.0, bits) - 1);
+    const double tolerance = std::max(step * 1e-3, 16 * static_cast<double>(FLT_EPSILON) * magnitude);
+    bool fits = true;
+    for (size_t i = 0; i < a.values.size() && fits; ++i) {
+      const double x = a.values[i];
+      if (!std::isfinite(x)) continue;
+      const double k = std::round((x - lo[i % nc]) / step);
+      fits = std::fabs(x - (lo[i % nc] + k * step)) <= tolerance;
+    }
+    if (fits) return bits;
+  }
+  return 0;
+}
+
+AttributeSummary summarize(const Attribute& a) {
+  static const char* const kKinds[4] = {"generic", "normal", "color", "texcoord"};
+  static const char* const kDomains[3] = {"vertex", "face", "corner"};
+  static const char* const kTypes[4] = {"f32", "u8", "u16", "i32"};
+  static const int kWidths[4] = {32, 8, 16, 32};
+  AttributeSummary s;
+  s.kind = kKinds[static_cast<size_t>(a.kind) % 4];
+  s.domain = kDomains[static_cast<size_t>(a.domain) % 3];
+  s.type = kTypes[static_cast<size_t>(a.type) % 4];
+  if (a.type != AttributeType::f32) {
+    s.coding = "exact";
+    s.bits = kWidths[static_cast<size_t>(a.type) % 4];
+  } else if (a.kind == AttributeKind::normal && a.components == 3) {
+    s.coding = "octahedral";
+  } else {
+    s.coding = "grid";
+    s.bits = grid_bits_from_values(a);
+  }
+  return s;
+}
 
 FileResult info_one(const std::string& input) {
   FileResult r;
@@ -571,6 +654,14 @@ FileResult info_one(const std::string& input) {
   if (!s.ok()) return failed(s);
   FileInfo fi;
   s = inspect(bytes, fi);
+  if (!s.ok()) return failed(Status(s.code(), name + ": " + s.message()));
+
+  // The attributes: the library's FileInfo does not list them, the decoded
+  // mesh does (their stored bytes are not known apart from the side data).
+  Mesh mesh;
+  DecodeOptions dopt;
+  dopt.threads = 1;
+  s = decode(bytes, mesh, dopt);
   if (!s.ok()) return failed(Status(s.code(), name + ": " + s.message()));
 
   const double v = fi.vertex_count ? static_cast<double>(fi.vertex_count) : 1.0;
@@ -601,6 +692,19 @@ FileResult info_one(const std::string& input) {
                    i ? ", " : "", si.id, json_escape(si.name).c_str(), json_escape(si.codec).c_str(),
                    static_cast<ull>(si.stored_bytes), static_cast<ull>(si.raw_bytes));
   }
+  r.json += "], \"attributes\": [";
+  for (size_t k = 0; k < mesh.attributes.size(); ++k) {
+    const Attribute& a = mesh.attributes[k];
+    const AttributeSummary as = summarize(a);
+    r.json += strf("%s{\"name\": \"%s\", \"kind\": \"%s\", \"domain\": \"%s\", \"type\": \"%s\", "
+                   "\"components\": %u, \"values\": %llu, \"coding\": \"%s\", \"bits\": %d}",
+                   k ? ", " : "", json_escape(a.name).c_str(), as.kind, as.domain, as.type, a.components,
+                   static_cast<ull>(a.value_count()), as.coding, as.bits);
+  }
+  r.json += "], \"metadata\": [";
+  for (size_t k = 0; k < mesh.metadata.size(); ++k)
+    r.json += strf("%s{\"key\": \"%s\", \"bytes\": %llu}", k ? ", " : "",
+                   json_escape(mesh.metadata[k].key).c_str(), static_cast<ull>(mesh.metadata[k].value.size()));
   r.json += "]}";
 
   std::string& t = r.text;
@@ -608,8 +712,9 @@ FileResult info_one(const std::string& input) {
   t += strf("  vertices %s, faces %s, corners %s, segments %u\n", thousands(fi.vertex_count).c_str(),
             thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
   t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
-  t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,
-            per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side));
+  t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header, %sside data\n", bpv,
+            per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side),
+            mesh.attributes.empty() ? "" : "attributes and ");
   t += strf("  topology: %s components, %s vertex runs, %s triangle runs, %s marching bits, %s jump edges,\n"
             "            %s stitches, %s virtual vertices, %s side faces\n",
             thousands(fi.components).c_str(), thousands(fi.vertex_runs).c_str(), thousands(fi.triangle_runs).c_str(),
@@ -625,6 +730,39 @@ FileResult info_one(const std::string& input) {
     t += strf(", lattice planes x %s, y %s, z %s", thousands(fi.lattice_planes[0]).c_str(),
               thousands(fi.lattice_planes[1]).c_str(), thousands(fi.lattice_planes[2]).c_str());
   t += "\n";
+  if (!mesh.attributes.empty()) {
+    // Names are the file's own: keep each on one line.
+    auto one_line = [](std::string n) {
+      for (char& c : n)
+        if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+      return n;
+    };
+    size_t width = 9;
+    for (const Attribute& a : mesh.attributes) width = std::max(width, std::min<size_t>(one_line(a.name).size(), 40));
+    t += strf("  %-*s %-8s %-6s %-6s %12s  %s\n", static_cast<int>(width), "attribute", "kind", "domain", "type",
+              "values", "coded as");
+    for (const Attribute& a : mesh.attributes) {
+      const AttributeSummary as = summarize(a);
+      std::string coded = as.coding;
+      if (as.bits > 0 && std::string(as.coding) == "grid")
+        coded += strf(", %d bits (from the values)", as.bits);
+      else if (as.bits > 0)
+        coded += strf(", %d bits", as.bits);
+      t += strf("  %-*s %-8s %-6s %-6s %12s  %s\n", static_cast<int>(width), one_line(a.name).c_str(), as.kind,
+                as.domain, strf("%sx%u", as.type, a.components).c_str(), thousands(a.value_count()).c_str(),
+                coded.c_str());
+    }
+  }
+  if (!mesh.metadata.empty()) {
+    t += "  metadata:";
+    for (size_t k = 0; k < mesh.metadata.size(); ++k) {
+      std::string key = mesh.metadata[k].key;
+      for (char& c : key)
+        if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+      t += strf("%s '%s' (%s bytes)", k ? "," : "", key.c_str(), thousands(mesh.metadata[k].value.size()).c_str());
+    }
+    t += "\n";
+  }
   t += strf("  %-18s %-6s %12s %12s", "section", "codec", "stored", "raw");
   for (const SectionInfo& si : fi.sections)
     t += strf("\n  %-18s %-6s %12s %12s", si.name.c_str(), si.codec.c_str(), thousands(si.stored_bytes).c_str(),
@@ -647,12 +785,46 @@ bool single_file_output(const std::vector<std::string>& inputs, const std::strin
   return inputs.size() == 1 && !o.empty() && o != "-" && o.back() != '/' && !fs::is_directory(o, ec);
 }
 
-// The formats decode writes, and how messages list them.
-bool writable_format(MeshFormat f) {
-  return f == MeshFormat::ply || f == MeshFormat::obj || f == MeshFormat::gltf || f == MeshFormat::glb;
+// The formats decode writes (kWritableFormats in tsm/io.hpp).
+const WritableFormat* writable_format(MeshFormat f) {
+  for (const WritableFormat& w : kWritableFormats)
+    if (w.format == f) return &w;
+  return nullptr;
 }
-const char* const kWritableNames = ".ply, .obj, .gltf or .glb";
-const char* const kWritableFormats = "ply|obj|gltf|glb";
+
+std::vector<std::string> output_format_names() {
+  std::vector<std::string> out;
+  for (const WritableFormat& w : kWritableFormats) out.push_back(w.name);
+  return out;
+}
+
+std::string output_formats_bar() {
+  std::string out;
+  for (const WritableFormat& w : kWritableFormats) out += (out.empty() ? "" : "|") + std::string(w.name);
+  return out;
+}
+
+namespace {
+// "a, b, c or d" from the formats' fields.
+template <typename Field>
+std::string listed(Field field) {
+  const size_t n = std::size(kWritableFormats);
+  std::string out;
+  for (size_t i = 0; i < n; ++i) {
+    if (i > 0) out += i + 1 == n ? " or " : ", ";
+    out += field(kWritableFormats[i]);
+  }
+  return out;
+}
+}  // namespace
+
+std::string output_extensions_text() {
+  return listed([](const WritableFormat& w) { return std::string(w.extension); });
+}
+
+std::string output_formats_text() {
+  return listed([](const WritableFormat& w) { return std::string(mesh_format_name(w.format)); });
+}
 
 int cmd_encode(const EncodeArgs& a) {
   install_signal_guard();
@@ -689,10 +861,8 @@ int cmd_encode(const EncodeArgs& a) {
 int cmd_decode(const DecodeArgs& a) {
   install_signal_guard();
   const MeshFormat wanted = parse_format(lower(a.format));
-  const std::string ext = wanted == MeshFormat::obj    ? ".obj"
-                          : wanted == MeshFormat::gltf ? ".gltf"
-                          : wanted == MeshFormat::glb  ? ".glb"
-                                                       : ".ply";
+  // Every writable format has one extension; PLY is the default.
+  const std::string ext = writable_format(wanted) ? writable_format(wanted)->extension : ".ply";
   // One output format for the run: --format, else the extension of a single
   // -o FILE, else PLY. A name is checked before anything is created.
   MeshFormat format = wanted == MeshFormat::unknown ? MeshFormat::ply : wanted;
@@ -700,23 +870,24 @@ int cmd_decode(const DecodeArgs& a) {
     const MeshFormat by_name = format_from_extension(a.output);
     if (by_name != MeshFormat::unknown && !writable_format(by_name))
       return usage_error(a.output + ": tsm does not write " + mesh_format_name(by_name) + " files; name the output " +
-                         with_extension(a.output, ".ply") + " (or end it in " + kWritableNames + ")");
+                         with_extension(a.output, ".ply") + " (or end it in " + output_extensions_text() + ")");
     if (wanted != MeshFormat::unknown && by_name != MeshFormat::unknown && by_name != wanted)
       return usage_error(a.output + ": the name says " + mesh_format_name(by_name) + " but --format says " +
                          mesh_format_name(wanted) + "; drop one of them");
     if (wanted == MeshFormat::unknown) {
       if (by_name == MeshFormat::unknown)
-        return usage_error(a.output + ": the name does not say which format to write; end it in " + kWritableNames +
-                           ", or pass --format " + kWritableFormats);
+        return usage_error(a.output + ": the name does not say which format to write; end it in " + output_extensions_text() +
+                           ", or pass --format " + output_formats_bar());
       format = by_name;
     }
   }
-  if (a.ascii && format != MeshFormat::ply) {
+  if (a.ascii && format != MeshFormat::ply && format != MeshFormat::stl) {
     const char* why = format == MeshFormat::glb ? "GLB is binary only: drop --ascii, or write .gltf for JSON text"
                       : format == MeshFormat::gltf ? ".gltf is JSON text already: drop --ascii"
+                      : format == MeshFormat::off  ? "OFF is text already: drop --ascii"
                       : format == MeshFormat::obj  ? "OBJ is text already: drop --ascii"
                                                    : nullptr;
-    if (why) return usage_error(std::string("--ascii chooses ASCII PLY output, but the output is ") +
+    if (why) return usage_error(std::string("--ascii chooses ASCII PLY or STL output, but the output is ") +
                                 mesh_format_name(format) + "; " + why);
   }
   std::vector<Job> jobs;
@@ -727,6 +898,9 @@ int cmd_decode(const DecodeArgs& a) {
   if (to_stdout && format == MeshFormat::ply && !a.ascii && is_terminal(stdout))
     return usage_error("refusing to write binary PLY to a terminal; redirect stdout (> out.ply), pipe it, or pass "
                        "--ascii or --format obj for text");
+  if (to_stdout && format == MeshFormat::stl && !a.ascii && is_terminal(stdout))
+    return usage_error("refusing to write binary STL to a terminal; redirect stdout (> out.stl), pipe it, or pass "
+                       "--ascii for text");
   if (to_stdout && format == MeshFormat::glb && is_terminal(stdout))
     return usage_error("refusing to write binary GLB to a terminal; redirect stdout (> out.glb), pipe it, or pass "
                        "--format gltf for text");

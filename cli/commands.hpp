@@ -28,12 +28,20 @@ struct EncodeArgs : BatchArgs {
 
 struct DecodeArgs : BatchArgs {
   std::string output;
-  std::string format;               // "", ply, obj
+  std::string format;               // "" or one of output_format_names()
   bool ascii = false, force = false;
   uint64_t max_vertices = 0, max_faces = 0, max_corners = 0;
 };
 
 struct InfoArgs : BatchArgs {};
+
+// The formats decode writes (tsm::kWritableFormats), as the help text and
+// the messages list them: {"ply", "obj", ...}; "ply|obj|..."; ".ply, .obj,
+// ... or .glb"; "PLY, OBJ, ... or GLB".
+std::vector<std::string> output_format_names();
+std::string output_formats_bar();
+std::string output_extensions_text();
+std::string output_formats_text();
 
 int cmd_encode(const EncodeArgs& a);
 int cmd_decode(const DecodeArgs& a);

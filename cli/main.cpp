@@ -211,14 +211,15 @@ int main(int argc, char** argv) {
       "the others; failures are listed at the end and the exit code is the worst one (3 bad input, 4 I/O).");
 
   DecodeArgs da;
-  CLI::App* dec = app.add_subcommand("decode", "Decompress .tsm files into PLY, OBJ or glTF/GLB");
+  CLI::App* dec = app.add_subcommand("decode", "Decompress .tsm files into " + output_formats_text());
   dec->add_option("inputs", da.inputs, ".tsm files; - reads one from stdin")->required();
   dec->add_option("-o,--output", da.output,
-                  "Output: a .ply/.obj file (one input), a folder (DIR/, or several inputs: DIR/NAME.ply), or - for "
+                  "Output: a " + output_extensions_text() + " file (one input), a folder (DIR/, or several inputs: DIR/NAME.ply), or - for "
                   "stdout (default: beside each input, NAME.ply; stdout for stdin)");
-  dec->add_option("--format", da.format, "Output format (default: the extension of -o FILE, else ply)")
-      ->check(CLI::IsMember({"ply", "obj", "gltf", "glb"}, CLI::ignore_case));
-  dec->add_flag("--ascii", da.ascii, "Write ASCII PLY instead of binary (PLY output only)");
+  dec->add_option("--format", da.format,
+                  "Output format, " + output_formats_bar() + " (default: the extension of -o FILE, else ply)")
+      ->check(CLI::IsMember(output_format_names(), CLI::ignore_case));
+  dec->add_flag("--ascii", da.ascii, "Write ASCII PLY or STL instead of binary");
   dec->add_flag("-f,--force", da.force, "Overwrite existing output files (never an input)");
   dec->add_option("--max-vertices", da.max_vertices, "Refuse files with more vertices (memory bound)")
       ->check(CLI::NonNegativeNumber);

@@ -689,7 +689,7 @@ TEST_F(CliBatch, BadBatchArgumentsExitTwo) {
   spit(file("plain"), "x");
   for (const std::string& args : std::vector<std::string>{
            "encode " + q("a.ply") + " -j -1", "encode " + q("a.ply") + " -j x", "encode " + q("a.ply") + " --input-format fbx",
-           "decode " + q("a.ply") + " --format stl", "decode " + q("a.ply") + " -o " + q("x.ply") + " --format obj",
+           "decode " + q("a.ply") + " --format fbx", "decode " + q("a.ply") + " -o " + q("x.ply") + " --format obj",
            "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("plain"),
            "encode " + q("a.ply") + " " + q("b.obj") + " -o " + q("out.tsm")}) {
     Result r = tsm(args);

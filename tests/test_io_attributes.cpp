@@ -8,13 +8,16 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "mesh_gen.hpp"
 #include "test_util.hpp"
 #include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
 
 namespace {
 
@@ -1038,11 +1041,15 @@ void expect_written_back(const Mesh& m) {
     SCOPED_TRACE(ascii ? "PLY ascii" : "PLY binary");
     const Mesh back = write_read_ply(m, ascii);
     ASSERT_EQ(back.attributes.size(), m.attributes.size());
-    for (size_t i = 0; i < m.attributes.size(); ++i) {
-      if (m.attributes[i].domain == AttributeDomain::corner) {
-        EXPECT_TRUE(same_bits(per_corner(back, back.attributes[i]), per_corner(m, m.attributes[i])));
+    // By name: PLY puts face properties before the corner lists, so the
+    // order can differ.
+    for (const Attribute& a : m.attributes) {
+      const Attribute* b = find(back, a.name);
+      ASSERT_NE(b, nullptr) << a.name;
+      if (a.domain == AttributeDomain::corner) {
+        EXPECT_TRUE(same_bits(per_corner(back, *b), per_corner(m, a))) << a.name;
       } else {
-        EXPECT_TRUE(same_attribute(back.attributes[i], m.attributes[i]));
+        EXPECT_TRUE(same_attribute(*b, a)) << a.name;
       }
     }
   }
@@ -1090,6 +1097,8 @@ TEST(AttributeCorpus, ObjFiles) {
   for (const char* file : {"edge/sphere.obj", "edge/test_nm.obj", "edge/extra_vertex.obj"}) {
     SCOPED_TRACE(file);
     ASSERT_TRUE(read_corpus(file, m, &info).ok());
+    // sphere.obj has one o, g, usemtl and s record each: the "obj" metadata
+    // says them, no face attribute is needed.
     ASSERT_EQ(m.attributes.size(), 1u);
     const Attribute& a = m.attributes[0];
     EXPECT_EQ(a.kind, AttributeKind::normal);
@@ -1100,6 +1109,9 @@ TEST(AttributeCorpus, ObjFiles) {
   ASSERT_TRUE(read_corpus("edge/sphere.obj", m).ok());
   EXPECT_EQ(m.attributes[0].values[0], 0.44254783f);
   EXPECT_EQ(m.attributes[0].values[2], -8.0352547e-17f);
+  const tsm::MetadataEntry* e = m.find_metadata("obj");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->value, "mtllib sphere.mtl\nobject sphere1\ngroup sphere1_default\nmaterial default\nsmoothing 1\n");
 }
 
 TEST(AttributeCorpus, PlyFiles) {
@@ -1168,6 +1180,247 @@ TEST(AttributeCorpus, PlyFiles) {
     ASSERT_TRUE(read_corpus(file, m).ok());
     EXPECT_TRUE(m.attributes.empty()) << file;
   }
+}
+
+// ===========================================================================
+// OBJ objects, groups, materials and smoothing groups ('obj:*' + "obj")
+
+// Each face's "o=..|g=..|m=..|s=.." from the 'obj:*' attributes and the
+// "obj" metadata entry, decoded here independently of the writer.
+std::vector<std::string> face_labels(const Mesh& m) {
+  std::map<std::string, std::vector<std::string>> lists;
+  if (const tsm::MetadataEntry* e = m.find_metadata("obj")) {
+    std::istringstream in(e->value);
+    std::string line;
+    while (std::getline(in, line)) {
+      const size_t sp = line.find(' ');
+      lists[line.substr(0, sp)].push_back(sp == std::string::npos ? std::string() : line.substr(sp + 1));
+    }
+  }
+  std::vector<std::string> out(m.face_count());
+  for (const char* list : {"object", "group", "material", "smoothing"}) {
+    const Attribute* a = find(m, std::string("obj:") + list);
+    for (size_t f = 0; f < m.face_count(); ++f) {
+      std::string text = "(none)";
+      if (a) {
+        const size_t k = static_cast<size_t>(a->values[f]);
+        text = k < lists[list].size() ? lists[list][k] : "(missing entry " + std::to_string(k) + ")";
+      }
+      out[f] += std::string(list) + "=" + text + "|";
+    }
+  }
+  return out;
+}
+
+TEST(ObjGroups, ReadIntoFaceAttributesAndMetadata) {
+  Mesh m;
+  ReadInfo info;
+  Status st = obj("mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+                  "f 1 2 3\n"                                 // before any record
+                  "o thing # a comment\ng left  side\nusemtl mat#2\ns 1\nf 2 4 3\n"
+                  "g\nf 1 2 4\n"                              // a bare g: the empty text again
+                  "g left  side\nusemtl red\ns off\nf 1 3 4\n",
+                  m, {}, &info);
+  ASSERT_TRUE(st.ok()) << st.to_string();
+  ASSERT_EQ(m.face_count(), 4u);
+  const tsm::MetadataEntry* e = m.find_metadata("obj");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->value,
+            "mtllib a.mtl b.mtl\nobject \nobject thing\ngroup \ngroup left  side\nmaterial \nmaterial mat#2\n"
+            "material red\nsmoothing \nsmoothing 1\nsmoothing off\n");
+  struct Want {
+    const char* name;
+    std::vector<float> values;
+  };
+  for (const Want& w : {Want{"obj:object", {0, 1, 1, 1}}, Want{"obj:group", {0, 1, 0, 1}},
+                        Want{"obj:material", {0, 1, 1, 2}}, Want{"obj:smoothing", {0, 1, 1, 2}}}) {
+    const Attribute* a = find(m, w.name);
+    ASSERT_NE(a, nullptr) << w.name;
+    EXPECT_EQ(a->domain, AttributeDomain::face);
+    EXPECT_EQ(a->kind, AttributeKind::generic);
+    EXPECT_EQ(a->type, AttributeType::i32);
+    EXPECT_EQ(a->values, w.values) << w.name;
+  }
+  // Files without these records get neither attributes nor metadata.
+  Mesh plain;
+  ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", plain).ok());
+  EXPECT_TRUE(plain.attributes.empty());
+  EXPECT_TRUE(plain.metadata.empty());
+}
+
+TEST(ObjGroups, WrittenBackAsRecords) {
+  const std::string text =
+      "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\no a\ng x y\nusemtl red\ns 2\nf 2 4 3\n"
+      "usemtl blue\nf 1 2 4\no b\nf 1 3 4\n";
+  Mesh m;
+  ASSERT_TRUE(obj(text, m).ok());
+  std::string out;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_obj(m, out, &info).ok());
+  EXPECT_EQ(info.notes, "");
+  EXPECT_TRUE(contains(out, "mtllib scene.mtl\nv 0 0 0\n")) << out;
+  EXPECT_TRUE(contains(out, "f 1 2 3\no a\ng x y\nusemtl red\ns 2\nf 2 4 3\nusemtl blue\nf 1 2 4\no b\nf 1 3 4\n"))
+      << out;
+  Mesh back;
+  ASSERT_TRUE(obj(out, back).ok());
+  EXPECT_EQ(face_labels(back), face_labels(m));
+  // Faces in another order (as the decoder gives them): an entry that comes
+  // back to the empty text is written as the bare keyword (s: "s off").
+  Mesh reordered = m;
+  std::vector<uint32_t> order{3, 0, 1, 2};
+  reordered.indices.clear();
+  reordered.face_offsets = {0};
+  for (tsm::Attribute& a : reordered.attributes) a.values.clear();
+  for (uint32_t f : order) {
+    reordered.add_face(m.face(f), m.face_size(f));
+    for (size_t k = 0; k < m.attributes.size(); ++k) reordered.attributes[k].values.push_back(m.attributes[k].values[f]);
+  }
+  ASSERT_TRUE(tsm::write_obj(reordered, out).ok());
+  EXPECT_TRUE(contains(out, "f 1 3 4\no\ng\nusemtl\ns off\nf 1 2 3\n")) << out;
+  ASSERT_TRUE(obj(out, back).ok());
+  std::vector<std::string> want = face_labels(m), got = face_labels(back);
+  // "s off" is how OBJ says "no smoothing group".
+  want[0].replace(want[0].find("smoothing=|"), 11, "smoothing=off|");
+  for (size_t i = 0; i < order.size(); ++i) EXPECT_EQ(got[i], want[order[i]]) << i;
+}
+
+// The round trip of the issue: an OBJ with two objects, three groups, two
+// materials and mtllib, through encode and decode (which reorder faces and
+// vertices) and write_obj / read_obj, keeps every face's object, group,
+// material and smoothing group.
+TEST(ObjGroups, SurviveEncodeDecodeAndWriteRead) {
+  const Mesh sphere = tsm_test::icosphere(2);
+  std::ostringstream text;
+  text << "# two objects, three groups, two materials\nmtllib scene.mtl\n";
+  for (size_t v = 0; v < sphere.vertex_count(); ++v)
+    text << "v " << sphere.positions[3 * v] << " " << sphere.positions[3 * v + 1] << " " << sphere.positions[3 * v + 2]
+         << "\n";
+  for (size_t f = 0; f < sphere.face_count(); ++f) {
+    if (f == 0) text << "o first\ng left\nusemtl red\ns 1\n";
+    if (f == 100) text << "g right side\nusemtl blue\n";
+    if (f == 170) text << "usemtl red\ns off\n";
+    if (f == 200) text << "o second\ng third\nusemtl blue\n";
+    const uint32_t* c = sphere.face(f);
+    text << "f " << c[0] + 1 << " " << c[1] + 1 << " " << c[2] + 1 << "\n";
+  }
+  Mesh m;
+  ASSERT_TRUE(obj(text.str(), m).ok());
+  ASSERT_EQ(m.face_count(), sphere.face_count());
+
+  std::string bytes;
+  Status st = tsm::encode(m, tsm::EncodeOptions{}, bytes);
+  ASSERT_TRUE(st.ok()) << st.to_string();
+  Mesh decoded;
+  st = tsm::decode(bytes, decoded);
+  ASSERT_TRUE(st.ok()) << st.to_string();
+  std::string written;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_obj(decoded, written, &info).ok());
+  EXPECT_EQ(info.notes, "");
+  Mesh back;
+  ASSERT_TRUE(obj(written, back).ok());
+  ASSERT_EQ(back.face_count(), m.face_count());
+  EXPECT_TRUE(contains(written, "mtllib scene.mtl\n"));
+
+  // Faces matched by their corners' positions (to the quantization's
+  // precision; the sphere's vertices are far apart).
+  auto key = [](const Mesh& mesh, size_t f) {
+    std::vector<long> k;
+    for (uint32_t i = 0; i < mesh.face_size(f); ++i)
+      for (int a = 0; a < 3; ++a) k.push_back(std::lround(mesh.positions[3 * size_t{mesh.face(f)[i]} + a] * 1000));
+    std::vector<std::vector<long>> corners;
+    for (size_t i = 0; i < k.size(); i += 3) corners.push_back({k[i], k[i + 1], k[i + 2]});
+    std::sort(corners.begin(), corners.end());
+    return corners;
+  };
+  std::map<std::vector<std::vector<long>>, std::string> original;
+  const std::vector<std::string> labels = face_labels(m);
+  for (size_t f = 0; f < m.face_count(); ++f) original[key(m, f)] = labels[f];
+  ASSERT_EQ(original.size(), m.face_count());
+  const std::vector<std::string> got = face_labels(back);
+  size_t moved = 0;
+  for (size_t f = 0; f < back.face_count(); ++f) {
+    auto it = original.find(key(back, f));
+    ASSERT_NE(it, original.end()) << "face " << f;
+    EXPECT_EQ(got[f], it->second) << "face " << f;
+    moved += got[f] != labels[f];
+  }
+  EXPECT_GT(moved, 0u) << "the codec kept the face order; the test would not see a reordering";
+  // The labels are what the file said.
+  EXPECT_TRUE(contains(labels[0], "object=first|group=left|material=red|smoothing=1|"));
+  EXPECT_TRUE(contains(labels[150], "object=first|group=right side|material=blue|smoothing=1|"));
+  EXPECT_TRUE(contains(labels[180], "object=first|group=right side|material=red|smoothing=off|"));
+  EXPECT_TRUE(contains(labels[300], "object=second|group=third|material=blue|smoothing=off|"));
+}
+
+TEST(ObjGroups, OtherWritersKeepTheNumbersOrSayWhatTheyDrop) {
+  Mesh m;
+  ASSERT_TRUE(obj("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\ng g1\nusemtl m1\nf 1 2 3\ng g2\nusemtl m2\nf 1 3 2\n", m).ok());
+  // PLY keeps the numbers as face properties, not the names.
+  std::string out;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_ply(m, WriteOptions{}, out, &info).ok());
+  EXPECT_TRUE(contains(info.notes, "PLY cannot hold the metadata 'obj'")) << info.notes;
+  Mesh back;
+  ASSERT_TRUE(tsm::read_ply(out, "g.ply", back, {}, nullptr).ok());
+  ASSERT_NE(find(back, "obj:group"), nullptr);
+  // From PLY (no names) to OBJ: the groups stay apart under made-up names.
+  ASSERT_TRUE(tsm::write_obj(back, out).ok());
+  EXPECT_TRUE(contains(out, "g group0\nusemtl material0\nf 1 2 3\ng group1\nusemtl material1\nf 1 3 2\n")) << out;
+}
+
+TEST(ObjGroups, WriteMeshToGltfLeavesThemOutWithANote) {
+  Mesh m;
+  ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\ng a\nf 1 2 3\ng b\nf 1 3 2\n", m).ok());
+  ASSERT_NE(find(m, "obj:group"), nullptr);
+  // write_gltf itself refuses face attributes ...
+  std::string bytes;
+  EXPECT_FALSE(tsm::write_gltf(m, WriteOptions{}, bytes, true).ok());
+  // ... write_mesh leaves the groups out and says so.
+  tsm_test::TempDir dir;
+  tsm::WriteInfo info;
+  Status st = tsm::write_mesh(dir.file("m.glb"), m, WriteOptions{}, &info);
+  ASSERT_TRUE(st.ok()) << st.to_string();
+  EXPECT_TRUE(contains(info.notes, "glTF cannot hold the OBJ object, group, material and smoothing group of each face "
+                                   "(face attributes 'obj:group')"))
+      << info.notes;
+  Mesh back;
+  ASSERT_TRUE(tsm::read_mesh(dir.file("m.glb"), back).ok());
+  EXPECT_EQ(back.face_count(), 2u);
+  Mesh copy = m;
+  EXPECT_TRUE(tsm::drop_obj_face_labels(copy, nullptr));
+  EXPECT_TRUE(copy.attributes.empty());
+  EXPECT_FALSE(tsm::drop_obj_face_labels(copy, nullptr));
+}
+
+TEST(ObjGroups, OneTextForTheWholeFileNeedsNoAttribute) {
+  Mesh m;
+  ASSERT_TRUE(obj("v 0 0 0\nv 1 0 0\nv 0 1 0\no only\nusemtl red\nf 1 2 3\nf 1 3 2\n", m).ok());
+  EXPECT_TRUE(m.attributes.empty());
+  const tsm::MetadataEntry* e = m.find_metadata("obj");
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->value, "object only\nmaterial red\n");
+  std::string out;
+  ASSERT_TRUE(tsm::write_obj(m, out).ok());
+  EXPECT_TRUE(contains(out, "v 0 1 0\no only\nusemtl red\nf 1 2 3\nf 1 3 2\n")) << out;
+}
+
+TEST(WriteNotes, ObjWriterNamesWhatItDrops) {
+  Mesh m = tsm_test::icosphere(0);
+  Attribute a;
+  a.name = "confidence";
+  a.values.assign(m.vertex_count(), 0.5f);
+  m.attributes.push_back(a);
+  m.metadata.push_back({"gltf", "{}"});
+  std::string out;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_obj(m, out, &info).ok());
+  EXPECT_TRUE(contains(info.notes, "OBJ cannot hold the vertex attribute 'confidence', metadata 'gltf'")) << info.notes;
+  EXPECT_TRUE(contains(out, "# tsm: not written (OBJ cannot hold them): vertex attribute 'confidence'\n")) << out;
+  // Nothing to say when everything fits.
+  tsm::WriteInfo none;
+  ASSERT_TRUE(tsm::write_obj(tsm_test::icosphere(0), out, &none).ok());
+  EXPECT_EQ(none.notes, "");
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Tests for the OBJ, STL and OFF readers and the OBJ writer.
+// Tests for the OBJ, STL and OFF readers and the OBJ, STL and OFF writers.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "mesh_gen.hpp"
 #include "test_util.hpp"
+#include "tsm/compare.hpp"
 #include "tsm/io.hpp"
 
 namespace {
@@ -684,6 +686,228 @@ TEST(CorpusEdge, SpecificShapes) {
   EXPECT_TRUE(bi.binary);
   EXPECT_FALSE(ai.binary);
   EXPECT_EQ(faces_of(bin), faces_of(ascii));  // same welding, same first-appearance order
+}
+
+// ===========================================================================
+// OFF attributes (N, C, ST prefixes, face colours) and the OFF writer
+
+const tsm::Attribute* attr(const Mesh& m, tsm::AttributeDomain d, tsm::AttributeKind k) {
+  for (const tsm::Attribute& a : m.attributes)
+    if (a.domain == d && a.kind == k) return &a;
+  return nullptr;
+}
+
+TEST(OffAttributes, CoffVertexColoursIntegerAndFloat) {
+  Mesh m;
+  ReadInfo info;
+  ASSERT_TRUE(off("COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 128\n0 1 0 0 0 255 0\n3 0 1 2\n", m, {}, &info).ok());
+  const tsm::Attribute* c = attr(m, tsm::AttributeDomain::vertex, tsm::AttributeKind::color);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->name, "color");
+  EXPECT_EQ(c->type, tsm::AttributeType::u8);
+  EXPECT_EQ(c->components, 4u);
+  EXPECT_EQ(c->values, (std::vector<float>{255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0}));
+  EXPECT_EQ(info.notes, "");
+  // Floats (Geomview's 0..1 RGBA, or RGB) stay f32 as written.
+  ASSERT_TRUE(off("COFF\n3 1 0\n0 0 0 1 0.5 0\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n", m).ok());
+  c = attr(m, tsm::AttributeDomain::vertex, tsm::AttributeKind::color);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->type, tsm::AttributeType::f32);
+  EXPECT_EQ(c->components, 3u);
+  EXPECT_EQ(c->values, (std::vector<float>{1, 0.5f, 0, 0, 1, 0, 0, 0, 1}));
+}
+
+TEST(OffAttributes, NormalsColoursTextureCoordinatesInGeomviewOrder) {
+  Mesh m;
+  ASSERT_TRUE(off("STCNOFF\n3 1 0\n0 0 0  0 0 1  10 20 30  0.25 0.75\n1 0 0  0 0 1  40 50 60  1 0\n"
+                  "0 1 0  0 0 1  70 80 90  0 1\n3 0 1 2 1 0 0\n",
+                  m)
+                  .ok());
+  EXPECT_EQ(positions_of(m), (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  const tsm::Attribute* n = attr(m, tsm::AttributeDomain::vertex, tsm::AttributeKind::normal);
+  const tsm::Attribute* c = attr(m, tsm::AttributeDomain::vertex, tsm::AttributeKind::color);
+  const tsm::Attribute* t = attr(m, tsm::AttributeDomain::vertex, tsm::AttributeKind::texcoord);
+  const tsm::Attribute* fc = attr(m, tsm::AttributeDomain::face, tsm::AttributeKind::color);
+  ASSERT_TRUE(n && c && t && fc);
+  EXPECT_EQ(n->values, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  EXPECT_EQ(c->values, (std::vector<float>{10, 20, 30, 40, 50, 60, 70, 80, 90}));
+  EXPECT_EQ(c->type, tsm::AttributeType::u8);
+  EXPECT_EQ(t->values, (std::vector<float>{0.25f, 0.75f, 1, 0, 0, 1}));
+  EXPECT_EQ(fc->values, (std::vector<float>{1, 0, 0}));
+}
+
+TEST(OffAttributes, LinesThatDisagreeDropTheValuesWithANote) {
+  Mesh m;
+  ReadInfo info;
+  // The second vertex has no colour: no colours, a note naming the lines.
+  ASSERT_TRUE(off("COFF\n3 2 0\n0 0 0 1 0 0\n1 0 0\n0 1 0 0 0 1\n3 0 1 2 255 0 0\n3 0 2 1\n", m, {}, &info).ok());
+  EXPECT_EQ(m.vertex_count(), 3u);
+  EXPECT_EQ(m.face_count(), 2u);
+  EXPECT_TRUE(m.attributes.empty());
+  EXPECT_NE(info.notes.find("ignored the vertex colours the header 'COFF' announces: line 4"), std::string::npos)
+      << info.notes;
+  EXPECT_NE(info.notes.find("ignored the face colours: line 6 has one but line 7"), std::string::npos) << info.notes;
+  // Numbers a plain OFF does not announce are named, not silently skipped.
+  ASSERT_TRUE(off("OFF\n3 1 0\n0 0 0 1 0 0\n1 0 0 1 0 0\n0 1 0\n3 0 1 2 7\n", m, {}, &info).ok());
+  EXPECT_TRUE(m.attributes.empty());
+  EXPECT_NE(info.notes.find("ignored the numbers after x y z on 2 vertex lines (first: line 3)"), std::string::npos)
+      << info.notes;
+  EXPECT_NE(info.notes.find("after the indices of 1 face"), std::string::npos) << info.notes;
+  // Non-finite colours need the option, like coordinates.
+  Status st = off("COFF\n1 0 0\n0 0 0 nan 0 0\n", m);
+  EXPECT_EQ(st.code(), ErrorCode::parse_error);
+  EXPECT_NE(st.message().find("test.off: line 3"), std::string::npos) << st.message();
+}
+
+TEST(OffWriter, RoundTripsPositionsFacesAndAttributes) {
+  Mesh m = tsm_test::cube_quads();
+  m.add_vertex(0.1f, 1e-30f, -3.25e7f);  // unreferenced, odd floats
+  const uint32_t tri[3] = {0, 1, 2};
+  m.add_face(tri, 3);
+  tsm::Attribute color, normal, tex, fcolor;
+  color.name = "color", color.kind = tsm::AttributeKind::color, color.type = tsm::AttributeType::u8;
+  color.components = 4;
+  normal.name = "normal", normal.kind = tsm::AttributeKind::normal, normal.components = 3;
+  tex.name = "texcoord", tex.kind = tsm::AttributeKind::texcoord, tex.components = 2;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    for (int k = 0; k < 4; ++k) color.values.push_back(static_cast<float>((v * 37 + k * 11) % 256));
+    normal.values.insert(normal.values.end(), {0.6f, 0.8f, 0.0f});
+    tex.values.insert(tex.values.end(), {0.1f * static_cast<float>(v), 1.0f});
+  }
+  fcolor.name = "color", fcolor.kind = tsm::AttributeKind::color, fcolor.domain = tsm::AttributeDomain::face;
+  fcolor.components = 3;
+  for (size_t f = 0; f < m.face_count(); ++f) fcolor.values.insert(fcolor.values.end(), {0.0f, 1.0f, 0.5f});
+  m.attributes = {color, normal, tex, fcolor};
+  std::string text;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_off(m, tsm::WriteOptions{}, text, &info).ok());
+  EXPECT_EQ(info.notes, "");
+  EXPECT_EQ(text.substr(0, 8), "STCNOFF\n") << text;
+  EXPECT_TRUE(tsm_test::contains(text, " 0.0 1.0 0.5\n")) << text;  // f32 colours marked as floats
+  Mesh back;
+  ReadInfo ri;
+  ASSERT_TRUE(off(text, back, {}, &ri).ok());
+  EXPECT_EQ(ri.notes, "");
+  EXPECT_TRUE(bit_identical(m, back));
+  ASSERT_EQ(back.attributes.size(), 4u);
+  for (const tsm::Attribute& a : m.attributes) {
+    const tsm::Attribute* b = attr(back, a.domain, a.kind);
+    ASSERT_NE(b, nullptr) << a.name;
+    EXPECT_EQ(b->type, a.type) << a.name;
+    EXPECT_EQ(b->components, a.components) << a.name;
+    EXPECT_EQ(b->values, a.values) << a.name;
+  }
+  // Colours only: COFF. No attributes: plain OFF, as the reader's own input.
+  m.attributes = {color};
+  ASSERT_TRUE(tsm::write_off(m, tsm::WriteOptions{}, text).ok());
+  EXPECT_EQ(text.substr(0, 5), "COFF\n");
+  m.attributes.clear();
+  ASSERT_TRUE(tsm::write_off(m, tsm::WriteOptions{}, text).ok());
+  EXPECT_EQ(text.substr(0, 4), "OFF\n");
+  ASSERT_TRUE(off(text, back).ok());
+  EXPECT_TRUE(bit_identical(m, back));
+}
+
+TEST(OffWriter, NotesWhatOffCannotHold) {
+  Mesh m = tsm_test::icosphere(0);
+  tsm::Attribute a;
+  a.name = "confidence";
+  a.values.assign(m.vertex_count(), 1.0f);
+  m.attributes.push_back(a);
+  m.metadata.push_back({"obj", "group g\n"});
+  std::string text;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_off(m, tsm::WriteOptions{}, text, &info).ok());
+  EXPECT_NE(info.notes.find("OFF cannot hold the vertex attribute 'confidence', metadata 'obj'"), std::string::npos)
+      << info.notes;
+  EXPECT_EQ(text.substr(0, 4), "OFF\n");
+}
+
+// ===========================================================================
+// STL writer
+
+TEST(StlWriter, BinaryAndAsciiRoundTripThroughTheReader) {
+  const Mesh m = tsm_test::icosphere(2);
+  for (bool ascii : {false, true}) {
+    SCOPED_TRACE(ascii ? "ascii" : "binary");
+    tsm::WriteOptions wo;
+    wo.ascii = ascii;
+    std::string bytes;
+    tsm::WriteInfo info;
+    ASSERT_TRUE(tsm::write_stl(m, wo, bytes, &info).ok());
+    EXPECT_EQ(info.notes, "");
+    if (ascii) {
+      EXPECT_EQ(bytes.substr(0, 10), "solid tsm\n");
+    } else {
+      EXPECT_EQ(bytes.size(), 84 + 50 * m.face_count());
+      EXPECT_NE(bytes.substr(0, 5), "solid");  // readers that look at the first word must not take it for ASCII
+    }
+    EXPECT_EQ(tsm::sniff_format(bytes), tsm::MeshFormat::stl);
+    Mesh back;
+    ReadInfo ri;
+    ASSERT_TRUE(stl(bytes, back, {}, &ri).ok());
+    EXPECT_EQ(ri.binary, !ascii);
+    // Bit-exact positions (bits = 0), same faces up to the vertex order.
+    const tsm::CompareResult cr = tsm::compare_meshes(m, back, 0);
+    EXPECT_TRUE(cr.equal) << cr.difference;
+  }
+}
+
+TEST(StlWriter, PolygonsBecomeFansAndWhatStlCannotHoldIsNoted) {
+  Mesh m = tsm_test::cube_quads();  // 6 quads
+  m.add_vertex(5, 5, 5);            // no face uses it
+  const uint32_t edge[2] = {0, 1};
+  m.add_face(edge, 2);
+  tsm::Attribute a;
+  a.name = "color";
+  a.kind = tsm::AttributeKind::color;
+  a.components = 3;
+  a.values.assign(3 * m.vertex_count(), 0.5f);
+  m.attributes.push_back(a);
+  std::string bytes;
+  tsm::WriteInfo info;
+  ASSERT_TRUE(tsm::write_stl(m, tsm::WriteOptions{}, bytes, &info).ok());
+  EXPECT_EQ(bytes.size(), 84u + 50u * 12u);
+  for (const char* part : {"split 6 polygons into triangle fans", "faces of 1 or 2 corners: left out 1",
+                           "vertices no face uses: left out 1", "STL cannot hold the vertex attribute 'color'"})
+    EXPECT_NE(info.notes.find(part), std::string::npos) << part << " in " << info.notes;
+  Mesh back;
+  ASSERT_TRUE(stl(bytes, back).ok());
+  EXPECT_EQ(back.vertex_count(), 8u);
+  EXPECT_EQ(back.face_count(), 12u);
+  // The fan of a quad (a b c d) is (a b c), (a c d): the cube's area and
+  // orientation are kept, which the triangulated cube of compare_meshes shows.
+  Mesh tri;
+  tri.positions = tsm_test::cube_quads().positions;
+  const Mesh cube = tsm_test::cube_quads();
+  for (size_t f = 0; f < cube.face_count(); ++f) {
+    const uint32_t* c = cube.face(f);
+    tri.add_triangle(c[0], c[1], c[2]);
+    tri.add_triangle(c[0], c[2], c[3]);
+  }
+  const tsm::CompareResult cr = tsm::compare_meshes(tri, back, 0);
+  EXPECT_TRUE(cr.equal) << cr.difference;
+}
+
+TEST(StlWriter, WriteMeshByExtension) {
+  tsm_test::TempDir dir;
+  const Mesh m = tsm_test::icosphere(1);
+  for (const char* name : {"a.stl", "a.off"}) {
+    SCOPED_TRACE(name);
+    tsm::WriteInfo info;
+    Status st = tsm::write_mesh(dir.file(name), m, tsm::WriteOptions{}, &info);
+    ASSERT_TRUE(st.ok()) << st.to_string();
+    Mesh back;
+    ReadInfo ri;
+    st = tsm::read_mesh(dir.file(name), back, {}, &ri);
+    ASSERT_TRUE(st.ok()) << st.to_string();
+    EXPECT_EQ(ri.format, std::string(name) == "a.stl" ? tsm::MeshFormat::stl : tsm::MeshFormat::off);
+    const tsm::CompareResult cr = tsm::compare_meshes(m, back, 0);
+    EXPECT_TRUE(cr.equal) << cr.difference;
+  }
+  Status st = tsm::write_mesh(dir.file("a.xyz"), m);
+  EXPECT_EQ(st.code(), ErrorCode::invalid_argument);
+  EXPECT_NE(st.message().find(".ply, .obj, .stl, .off, .gltf or .glb"), std::string::npos) << st.message();
 }
 
 }  // namespace

@@ -227,21 +227,29 @@ Status read_mesh(const std::string& path, Mesh& out, const ReadOptions& options,
   return read_mesh_from_memory(bytes, path, out, options, info, format_from_extension(path));
 }
 
-Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
+Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options, WriteInfo* info) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, path + ": mesh to write is invalid: " + why);
   std::string bytes;
   MeshFormat format = format_from_extension(path);
   if (format == MeshFormat::ply) {
-    TSM_RETURN_IF_ERROR(write_ply(mesh, options, bytes));
+    TSM_RETURN_IF_ERROR(write_ply(mesh, options, bytes, info));
   } else if (format == MeshFormat::obj) {
-    TSM_RETURN_IF_ERROR(write_obj(mesh, bytes));
+    TSM_RETURN_IF_ERROR(write_obj(mesh, bytes, info));
+  } else if (format == MeshFormat::stl || format == MeshFormat::off) {
+    TSM_RETURN_IF_ERROR(format == MeshFormat::stl ? write_stl(mesh, options, bytes, info) : write_off(mesh, options, bytes, info));
   } else if (format == MeshFormat::gltf || format == MeshFormat::glb) {
-    Status s = write_gltf(mesh, options, bytes, format == MeshFormat::glb);
+    // glTF has no face attributes: OBJ groups ('obj:*') are left out, noted.
+    Mesh without_labels;
+    const Mesh* m = &mesh;
+    for (const Attribute& a : mesh.attributes)
+      if (m == &mesh && a.domain == AttributeDomain::face && a.name.compare(0, 4, "obj:") == 0) m = &without_labels;
+    if (m == &without_labels) drop_obj_face_labels(without_labels = mesh, info);
+    Status s = write_gltf(*m, options, bytes, format == MeshFormat::glb);
     if (!s.ok()) return Status(s.code(), path + ": " + s.message());
   } else {
     return Status(ErrorCode::invalid_argument,
-                  path + ": cannot write this format; use a .ply, .obj, .gltf or .glb file name");
+                  path + ": cannot write this format; use a .ply, .obj, .stl, .off, .gltf or .glb file name");
   }
   return write_file_atomic(path, bytes);
 }

@@ -6,10 +6,21 @@
 // allocation per line. Positions are parsed straight to float (correctly
 // rounded, no double-to-float double rounding). Faces are kept exactly as
 // written: polygons of any size, faces of 1 or 2 corners, repeated corners.
-// Vertices no face references are kept. `vp`, grouping and material records
-// are ignored; `l` and `p` records (lines and points) are skipped and counted;
-// records with unknown keywords are skipped with a note. A backslash at the
-// end of a line joins it with the next (except in comments).
+// Vertices no face references are kept. `o`, `g`, `usemtl`, `s` and
+// `mtllib` records are kept (below); `l` and `p` records (lines and points)
+// are skipped and counted; `vp`, `mg`, map, level-of-detail and render
+// records and records with unknown keywords are skipped with a note naming
+// the keyword. A backslash at the end of a line joins it with the next
+// (except in comments).
+//
+// Objects, groups, materials, smoothing groups: each kind of record the file
+// has gives a face attribute ('obj:object', 'obj:group', 'obj:material',
+// 'obj:smoothing', generic i32) numbering, per face, the text in force when
+// the face was read among the distinct texts of that kind, in order of first
+// appearance (left out when there is one text: every face has entry 0); the texts and the `mtllib` file names go into the metadata
+// entry "obj" (format in io.hpp). The codec codes face attributes exactly
+// and carries metadata through, so the faces' groups and materials survive
+// encoding, whatever order the decoder gives the faces.
 //
 // Attributes (Mesh::attributes):
 //  - `vt u [v [w]]` and `vn x y z` lists, named by the `i/t`, `i//n` and
@@ -53,10 +64,15 @@
 // vertex-domain colour is written as `v x y z r g b`: f32 values as they are,
 // u8 / u16 ones scaled to 0..1 (v / 255, v / 65535; OBJ colours are 0..1),
 // alpha dropped. Whatever OBJ cannot hold (other attributes, alpha) is named
-// in a `# tsm: not written` comment line. A mesh without attributes gives
-// the same bytes as before attributes existed.
+// in a `# tsm: not written` comment line and in WriteInfo::notes, as are
+// metadata entries other than "obj". The 'obj:*' face attributes become `o`,
+// `g`, `usemtl` and `s` records written before each face whose entry differs
+// from the one in force (the empty text as the bare keyword, `s off` for
+// `s`), after `mtllib` lines at the top; faces keep the mesh's order. A mesh
+// without attributes gives the same bytes as before attributes existed.
 #include <array>
 #include <charconv>
+#include <cstddef>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -64,11 +80,13 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "text_scan.hpp"
 #include "tsm/io.hpp"
+#include "write_notes.hpp"
 
 namespace tsm {
 
@@ -79,6 +97,44 @@ constexpr size_t kMaxIndexableVertices = std::numeric_limits<uint32_t>::max();
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
 bool is_line_end(char c) { return c == '\n' || c == '\r'; }
+
+// One kind of OBJ state record (`o`, `g`, `usemtl` or `s`): the distinct
+// texts in order of first appearance and, once a record of the kind has been
+// seen, each face's entry. Faces before the first record have the empty
+// text, as does a record with nothing after its keyword.
+struct FaceLabels {
+  const char* keyword;    // "o", "g", "usemtl", "s"
+  const char* list;       // "object", "group", "material", "smoothing" (metadata lines, attribute names)
+  std::vector<std::string> texts;
+  std::unordered_map<std::string, uint32_t> index;
+  std::vector<uint32_t> per_face;  // filled once `seen`
+  uint32_t current = 0;            // entry of the state in force
+  bool seen = false;
+  bool current_set = false;        // false until a record (or a face) needs an entry
+
+  uint32_t entry(const std::string& text) {
+    auto it = index.find(text);
+    if (it != index.end()) return it->second;
+    const uint32_t k = static_cast<uint32_t>(texts.size());
+    texts.push_back(text);
+    index.emplace(text, k);
+    return k;
+  }
+  // A record of this kind with `text`; `faces` were read before it.
+  void record(const std::string& text, size_t faces) {
+    if (!seen) {
+      seen = true;
+      // Faces so far had no record: the empty text, entry 0.
+      if (faces > 0) per_face.assign(faces, entry(std::string()));
+    }
+    current = entry(text);
+    current_set = true;
+  }
+  void face() {
+    if (!seen) return;
+    per_face.push_back(current);
+  }
+};
 
 class ObjReader {
  public:
@@ -146,6 +202,11 @@ class ObjReader {
 
   Status parse_vertex(Mesh& mesh);
   Status parse_face(Mesh& mesh);
+  // The text of an `o`, `g`, `usemtl`, `s` or `mtllib` record: the rest of
+  // the line (joined lines with a blank between), blanks around it and a
+  // comment that follows a blank removed.
+  std::string record_text();
+  void finish_labels(Mesh& mesh, std::vector<std::string>& notes);
   Status parse_values(const char* record, int min, int max, float* out, int& got);
   Status parse_texcoord();
   Status parse_normal();
@@ -181,6 +242,14 @@ class ObjReader {
   size_t lines_ = 0, points_ = 0;
   std::vector<std::pair<std::string, size_t>> unknown_;  // first few unknown keywords
   size_t unknown_other_ = 0;
+  std::vector<std::pair<std::string, size_t>> ignored_;  // known keywords tsm does not keep
+
+  // Object, group, material and smoothing group of each face; mtllib texts.
+  FaceLabels labels_[4] = {{"o", "object", {}, {}, {}, 0, false, false},
+                           {"g", "group", {}, {}, {}, 0, false, false},
+                           {"usemtl", "material", {}, {}, {}, 0, false, false},
+                           {"s", "smoothing", {}, {}, {}, 0, false, false}};
+  std::vector<std::string> mtllibs_;
 
   std::vector<float> vt_;  // u, v, w of each vt
   bool vt_w_ = false;      // some w is not 0
@@ -373,6 +442,61 @@ void ObjReader::finish_attributes(Mesh& mesh, std::vector<std::string>& notes) {
   }
 }
 
+std::string ObjReader::record_text() {
+  std::string text;
+  for (;;) {
+    cur_.skip_blanks();
+    std::string_view rest = cur_.rest_of_line();
+    // A '#' after a blank (or at the start) begins a comment; inside a
+    // name ("mat#2") it is part of it.
+    bool comment = false;
+    for (size_t i = 0; i < rest.size() && !comment; ++i)
+      if (rest[i] == '#' && (i == 0 || is_blank(rest[i - 1]))) {
+        rest = rest.substr(0, i);
+        comment = true;
+      }
+    size_t n = rest.size();
+    while (n > 0 && is_blank(rest[n - 1])) --n;
+    const bool joined = !comment && n > 0 && rest[n - 1] == '\\';
+    if (joined) --n;
+    while (n > 0 && is_blank(rest[n - 1])) --n;
+    if (!text.empty() && n > 0) text += ' ';
+    text.append(rest.data(), n);
+    if (!cur_.consume_line_end() || !joined) break;
+  }
+  return text;
+}
+
+// Per-face integer attributes 'obj:object', 'obj:group', 'obj:material',
+// 'obj:smoothing' for the kinds of record the file has, and the texts they
+// index in the metadata entry "obj" (see io.hpp).
+void ObjReader::finish_labels(Mesh& mesh, std::vector<std::string>& notes) {
+  std::string meta;
+  for (const std::string& t : mtllibs_) meta += "mtllib " + t + "\n";
+  const size_t nf = mesh.face_count();
+  for (FaceLabels& l : labels_) {
+    if (!l.seen) continue;
+    for (const std::string& t : l.texts) meta += std::string(l.list) + " " + t + "\n";
+    // One text: every face has entry 0, which the list alone says.
+    if (nf == 0 || l.texts.size() == 1) continue;
+    // Entries are stored as floats: exact up to 2^24.
+    if (l.texts.size() > (size_t{1} << 24)) {
+      notes.push_back("dropped which '" + std::string(l.keyword) + "' record each face belongs to: " +
+                      std::to_string(l.texts.size()) + " distinct ones are more than tsm can number (2^24)");
+      continue;
+    }
+    Attribute a;
+    a.name = std::string("obj:") + l.list;
+    a.kind = AttributeKind::generic;
+    a.domain = AttributeDomain::face;
+    a.type = AttributeType::i32;
+    a.components = 1;
+    a.values.assign(l.per_face.begin(), l.per_face.end());
+    mesh.attributes.push_back(std::move(a));
+  }
+  if (!meta.empty()) mesh.metadata.push_back({"obj", std::move(meta)});
+}
+
 Status ObjReader::parse_vertex(Mesh& mesh) {
   static const char* const kAxis[3] = {"x", "y", "z"};
   float xyz[3];
@@ -504,6 +628,7 @@ Status ObjReader::parse_face(Mesh& mesh) {
   commit_refs(vt_refs_, face_t_, mesh.indices.size(), vt_.size() / 3);
   commit_refs(vn_refs_, face_n_, mesh.indices.size(), vn_.size() / 3);
   mesh.add_face(corners_.data(), corners_.size());
+  for (FaceLabels& l : labels_) l.face();
   skip_record();  // a trailing comment, the line end
   return Status::Ok();
 }
@@ -530,10 +655,22 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
       TSM_RETURN_IF_ERROR(parse_texcoord());
     } else if (key == "vn") {
       TSM_RETURN_IF_ERROR(parse_normal());
-    } else if (key == "vp" || key == "o" || key == "g" || key == "s" ||
-               key == "usemtl" || key == "mtllib" || key == "mg" || key == "usemap" || key == "maplib" ||
-               key == "lod" || key == "bevel" || key == "c_interp" || key == "d_interp" ||
-               key == "shadow_obj" || key == "trace_obj" || key == "ctech" || key == "stech") {
+    } else if (key == "o" || key == "g" || key == "usemtl" || key == "s") {
+      const size_t k = key == "o" ? 0 : key == "g" ? 1 : key == "usemtl" ? 2 : 3;
+      labels_[k].record(record_text(), mesh.face_count());
+    } else if (key == "mtllib") {
+      mtllibs_.push_back(record_text());
+    } else if (key == "vp" || key == "mg" || key == "usemap" || key == "maplib" || key == "lod" ||
+               key == "bevel" || key == "c_interp" || key == "d_interp" || key == "shadow_obj" ||
+               key == "trace_obj" || key == "ctech" || key == "stech") {
+      bool found = false;
+      for (auto& u : ignored_)
+        if (u.first == key) {
+          ++u.second;
+          found = true;
+          break;
+        }
+      if (!found) ignored_.emplace_back(std::string(key), 1);
       skip_record();
     } else if (key == "l") {
       ++lines_;
@@ -576,6 +713,7 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
   if (vn_refs_.state == CornerRefs::State::all) TSM_RETURN_IF_ERROR(check_refs(vn_refs_, vn_.size() / 3));
   std::vector<std::string> attribute_notes;
   finish_attributes(mesh, attribute_notes);
+  finish_labels(mesh, attribute_notes);
 
   if (info) {
     info->skipped_elements = lines_ + points_;
@@ -589,6 +727,9 @@ Status ObjReader::run(Mesh& mesh, ReadInfo* info) {
       if (points_) s += std::to_string(points_) + " 'p' records";
       add(s + " (lines and points are not faces)");
     }
+    for (const auto& u : ignored_)
+      add("skipped " + std::to_string(u.second) + " " + quote(u.first) + " record" + (u.second == 1 ? "" : "s") +
+          " (parameter-space vertices, merging, maps, display and render settings are not kept)");
     for (const auto& u : unknown_)
       add("skipped " + std::to_string(u.second) + " record" + (u.second == 1 ? "" : "s") +
           " with unknown keyword " + quote(u.first));
@@ -602,7 +743,63 @@ char* put_float(char* p, char* end, float x) {
   return r.ptr;
 }
 
+// The 'obj:*' face attributes and the texts of the "obj" metadata entry
+// (see io.hpp) that the writer turns back into records.
+struct LabelsOut {
+  static constexpr const char* kLists[4] = {"object", "group", "material", "smoothing"};
+  static constexpr const char* kKeywords[4] = {"o", "g", "usemtl", "s"};
+  const Attribute* attr[4] = {nullptr, nullptr, nullptr, nullptr};
+  bool single[4] = {false, false, false, false};  // no attribute, one text: every face has entry 0
+  std::vector<std::string> texts[4];
+  std::vector<std::string> mtllibs;
+
+  // The attribute a writer uses for list k: face domain, one component,
+  // entry numbers (integers 0..2^24).
+  static bool usable(const Attribute& a) {
+    if (a.domain != AttributeDomain::face || a.components != 1) return false;
+    for (float x : a.values)
+      if (!(x >= 0.0f && x <= 16777216.0f) || x != std::floor(x)) return false;
+    return true;
+  }
+  void find(const Mesh& mesh) {
+    for (const Attribute& a : mesh.attributes)
+      for (int k = 0; k < 4; ++k)
+        if (!attr[k] && a.name == std::string("obj:") + kLists[k] && usable(a)) attr[k] = &a;
+    const MetadataEntry* e = mesh.find_metadata("obj");
+    if (!e) return;
+    // Lines "LIST TEXT"; anything else is skipped (a newer writer's items).
+    std::string_view v = e->value;
+    while (!v.empty()) {
+      const size_t eol = v.find('\n');
+      std::string_view line = v.substr(0, eol);
+      v = eol == std::string_view::npos ? std::string_view() : v.substr(eol + 1);
+      const size_t sp = line.find(' ');
+      const std::string_view key = line.substr(0, sp);
+      const std::string_view text = sp == std::string_view::npos ? std::string_view() : line.substr(sp + 1);
+      if (key == "mtllib") mtllibs.emplace_back(text);
+      for (int k = 0; k < 4; ++k)
+        if (key == kLists[k]) texts[k].emplace_back(text);
+    }
+    for (int k = 0; k < 4; ++k) single[k] = !attr[k] && texts[k].size() == 1;
+  }
+  // The text of entry n of list k; entries the metadata lacks get a made-up
+  // name ("group7"), so faces stay apart.
+  std::string text(int k, size_t n) const {
+    std::string t = n < texts[k].size() ? texts[k][n] : std::string(k == 3 ? "" : kLists[k]) + std::to_string(n);
+    return one_line(std::move(t));
+  }
+  // A record's text as a line can hold it: line ends become blanks, and a
+  // backslash at the end (which would join the next line) is dropped.
+  static std::string one_line(std::string t) {
+    for (char& c : t)
+      if (c == '\n' || c == '\r') c = ' ';
+    while (!t.empty() && (t.back() == '\\' || t.back() == ' ' || t.back() == '\t')) t.pop_back();
+    return t;
+  }
+};
+
 }  // namespace
+
 
 Status read_obj(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options,
                 ReadInfo* info) {
@@ -622,14 +819,35 @@ Status read_obj(std::string_view bytes, const std::string& name, Mesh& out, cons
   return Status::Ok();
 }
 
-Status write_obj(const Mesh& mesh, std::string& out) {
+bool drop_obj_face_labels(Mesh& mesh, WriteInfo* info) {
+  std::string list;
+  auto& attrs = mesh.attributes;
+  for (size_t k = 0; k < attrs.size();) {
+    if (attrs[k].domain == AttributeDomain::face && attrs[k].name.compare(0, 4, "obj:") == 0) {
+      list += (list.empty() ? "'" : ", '") + attrs[k].name + "'";
+      attrs.erase(attrs.begin() + static_cast<std::ptrdiff_t>(k));
+    } else {
+      ++k;
+    }
+  }
+  if (list.empty()) return false;
+  for (char& c : list)
+    if (c == '\n' || c == '\r') c = ' ';
+  if (info)
+    info->add_note("glTF cannot hold the OBJ object, group, material and smoothing group of each face (face "
+                   "attributes " + list + "); not written (decode to .obj to keep them)");
+  return true;
+}
+
+Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write OBJ: invalid mesh: " + why);
   for (size_t f = 0; f < mesh.face_count(); ++f)
     if (mesh.face_size(f) == 0)
       return Status(ErrorCode::invalid_argument,
                     "cannot write OBJ: face " + std::to_string(f) + " has no corners (OBJ cannot express it)");
-  // What OBJ can hold: one vt list, one vn list, r g b per vertex.
+  // What OBJ can hold: one vt list, one vn list, r g b per vertex, and the
+  // object, group, material and smoothing group of each face.
   const Attribute* tex = nullptr;
   const Attribute* nrm = nullptr;
   const Attribute* col = nullptr;
@@ -641,27 +859,29 @@ Status write_obj(const Mesh& mesh, std::string& out) {
     if (!nrm && a.kind == AttributeKind::normal) nrm = &a;
     if (!col && a.kind == AttributeKind::color && a.domain == AttributeDomain::vertex) col = &a;
   }
+  LabelsOut labels;
+  labels.find(mesh);
+  bool any_labels = false;
+  for (int k = 0; k < 4; ++k) any_labels = any_labels || labels.attr[k] || labels.single[k];
   std::string dropped;
   for (size_t k = 0; k < mesh.attributes.size(); ++k) {
     const Attribute& a = mesh.attributes[k];
     if (&a == tex || &a == nrm || (&a == col && a.components == 3)) continue;
-    static const char* const kDomain[3] = {"vertex", "face", "corner"};
+    if (&a == labels.attr[0] || &a == labels.attr[1] || &a == labels.attr[2] || &a == labels.attr[3]) continue;
     dropped += dropped.empty() ? "" : ", ";
     dropped += &a == col ? "the alpha of " : "";
-    dropped += std::string(kDomain[static_cast<size_t>(a.domain) % 3]) + " attribute '" + a.name + "'";
+    dropped += attribute_words(a);
   }
+  note_not_written(mesh, "OBJ", dropped, "obj", info);
 
   out.clear();
   out.reserve(mesh.vertex_count() * (col ? 60 : 36) + mesh.corner_count() * (tex || nrm ? 20 : 8) +
               mesh.face_count() * 3 + 64);
   out += "# tsm: " + std::to_string(mesh.vertex_count()) + " vertices, " + std::to_string(mesh.face_count()) +
          " faces\n";
-  // Names can hold anything: keep the comment on one line.
-  if (!dropped.empty()) {
-    for (char& c : dropped)
-      if (c == '\n' || c == '\r') c = ' ';
-    out += "# tsm: not written (OBJ cannot hold them): " + dropped + "\n";
-  }
+  // attribute_words keeps names on one line.
+  if (!dropped.empty()) out += "# tsm: not written (OBJ cannot hold them): " + dropped + "\n";
+  for (const std::string& m : labels.mtllibs) out += "mtllib " + LabelsOut::one_line(m) + "\n";
   char buf[256];
   char* const bend = buf + sizeof buf;
   const float* pos = mesh.positions.data();
@@ -712,7 +932,30 @@ Status write_obj(const Mesh& mesh, std::string& out) {
     }
     return static_cast<uint64_t>(a->indices[c]) + 1;
   };
+  // The entry of each label list in force in the written file (none yet:
+  // the empty text, which is what faces before a first record have).
+  size_t written[4] = {SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX};
+  std::string written_text[4];
   for (size_t f = 0; f < mesh.face_count(); ++f) {
+    if (any_labels) {
+      for (int k = 0; k < 4; ++k) {
+        if (!labels.attr[k] && !labels.single[k]) continue;
+        const size_t entry = labels.attr[k] ? static_cast<size_t>(labels.attr[k]->values[f]) : 0;
+        if (entry == written[k]) continue;
+        written[k] = entry;
+        std::string t = labels.text(k, entry);
+        if (t == written_text[k]) continue;
+        written_text[k] = t;
+        out += LabelsOut::kKeywords[k];
+        if (!t.empty()) {
+          out += ' ';
+          out += t;
+        } else if (k == 3) {
+          out += " off";  // `s` needs a value; no smoothing group is what off means
+        }
+        out += '\n';
+      }
+    }
     const uint32_t* c = mesh.face(f);
     const uint32_t n = mesh.face_size(f);
     const size_t first = mesh.face_offsets[f];

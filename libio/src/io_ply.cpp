@@ -59,7 +59,8 @@
 // the same value at every corner, but repeated values are no longer shared
 // and values no corner uses are gone. Names that are not PLY tokens or that
 // two properties of an element would share, and integer-typed values that
-// are not integers of their type's range, make the writer fail.
+// are not integers of their type's range, make the writer fail. PLY has no
+// place for Mesh::metadata: WriteInfo::notes names the entries left out.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -73,6 +74,7 @@
 
 #include "text_scan.hpp"
 #include "tsm/io.hpp"
+#include "write_notes.hpp"
 
 namespace tsm {
 
@@ -1657,9 +1659,10 @@ Status read_ply(std::string_view bytes, const std::string& name, Mesh& out, cons
   return s;
 }
 
-Status write_ply(const Mesh& mesh, const WriteOptions& options, std::string& out) {
+Status write_ply(const Mesh& mesh, const WriteOptions& options, std::string& out, WriteInfo* info) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write PLY: the mesh is invalid: " + why);
+  note_not_written(mesh, "PLY", "", nullptr, info);
   if (!mesh.attributes.empty()) return write_ply_with_attributes(mesh, options, out);
   const size_t nv = mesh.vertex_count();
   const size_t nf = mesh.face_count();

@@ -13,6 +13,17 @@
 // Otherwise a file starting with "solid" is read as ASCII: keywords are
 // case-insensitive, any amount of whitespace is accepted, several solids in
 // one file are read in turn.
+//
+// Writing: binary (80-byte header that does not start with "solid", the
+// count, 50 bytes per triangle, attribute word 0) or, with
+// WriteOptions::ascii, "solid tsm" text with the shortest decimal text that
+// reads back to each float. Each face of n >= 3 corners becomes the fan
+// (c0, c[i], c[i+1]); faces of 1 or 2 corners cannot be STL facets and are
+// left out. Facet normals are the normalized cross product of the edges (0 0
+// 0 for a degenerate triangle). Read back with welding, the positions come
+// back bit-identical; vertices at the same position merge, and unreferenced
+// vertices, attributes and metadata are lost: WriteInfo::notes says which.
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -25,6 +36,7 @@
 #include "byte_io.hpp"
 #include "text_scan.hpp"
 #include "tsm/io.hpp"
+#include "write_notes.hpp"
 
 namespace tsm {
 
@@ -334,6 +346,113 @@ Status read_stl(std::string_view bytes, const std::string& name, Mesh& out, cons
                       "binary STL has " + std::to_string(bytes.size() - expected) +
                           " bytes after its last triangle (the header says " + std::to_string(count) +
                           " triangles, " + std::to_string(expected) + " bytes)");
+}
+
+namespace {
+
+// The unit normal of triangle (a, b, c) by the right-hand rule, computed in
+// double; zeros when the triangle has no area (or a non-finite corner).
+void facet_normal(const float* a, const float* b, const float* c, float n[3]) {
+  const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+  const double v[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+  const double x[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double len = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  for (int k = 0; k < 3; ++k) n[k] = len > 0 && std::isfinite(len) ? static_cast<float>(x[k] / len) : 0.0f;
+}
+
+void put_f32_le(std::string& out, float x) {
+  uint32_t b;
+  std::memcpy(&b, &x, 4);
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>(b >> (8 * i)));
+}
+
+void put_text(std::string& out, const char* lead, const float p[3]) {
+  char buf[96];
+  char* w = buf;
+  for (const char* k = lead; *k; ++k) *w++ = *k;
+  for (int a = 0; a < 3; ++a) {
+    *w++ = ' ';
+    w = std::to_chars(w, buf + sizeof buf, p[a]).ptr;  // shortest text that reads back to p[a]
+  }
+  *w++ = '\n';
+  out.append(buf, static_cast<size_t>(w - buf));
+}
+
+}  // namespace
+
+Status write_stl(const Mesh& mesh, const WriteOptions& options, std::string& out, WriteInfo* info) {
+  std::string why;
+  if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write STL: invalid mesh: " + why);
+  uint64_t triangles = 0, short_faces = 0, polygons = 0;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    const uint32_t n = mesh.face_size(f);
+    if (n < 3) {
+      ++short_faces;
+    } else {
+      triangles += n - 2;
+      if (n > 3) ++polygons;
+    }
+  }
+  if (triangles > std::numeric_limits<uint32_t>::max())
+    return Status(ErrorCode::limit_exceeded, "cannot write STL: " + std::to_string(triangles) +
+                                                 " triangles are more than an STL file can count (4294967295); "
+                                                 "write PLY or OBJ instead");
+  if (info) {
+    if (polygons > 0)
+      info->add_note("STL holds triangles only: split " + std::to_string(polygons) + " polygon" +
+                     (polygons == 1 ? "" : "s") + " into triangle fans");
+    if (short_faces > 0)
+      info->add_note("STL cannot hold faces of 1 or 2 corners: left out " + std::to_string(short_faces));
+    const size_t loose = mesh.unreferenced_vertex_count();
+    if (loose > 0)
+      info->add_note("STL cannot hold vertices no face uses: left out " + std::to_string(loose));
+    std::string dropped;
+    for (const Attribute& a : mesh.attributes) dropped += (dropped.empty() ? "" : ", ") + attribute_words(a);
+    note_not_written(mesh, "STL", dropped, nullptr, info);
+  }
+
+  out.clear();
+  const float* pos = mesh.positions.data();
+  auto for_each_triangle = [&](auto&& emit) {
+    for (size_t f = 0; f < mesh.face_count(); ++f) {
+      const uint32_t n = mesh.face_size(f);
+      const uint32_t* c = mesh.face(f);
+      for (uint32_t i = 1; i + 1 < n; ++i) emit(pos + 3 * size_t{c[0]}, pos + 3 * size_t{c[i]}, pos + 3 * size_t{c[i + 1]});
+    }
+  };
+  if (!options.ascii) {
+    // The header must not begin with "solid", or readers that look only at
+    // the first word would take the file for ASCII.
+    std::string header = "binary STL written by tsm";
+    header.resize(80, ' ');
+    out.reserve(84 + 50 * static_cast<size_t>(triangles));
+    out += header;
+    const uint32_t count = static_cast<uint32_t>(triangles);
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>(count >> (8 * i)));
+    for_each_triangle([&](const float* a, const float* b, const float* c) {
+      float n[3];
+      facet_normal(a, b, c, n);
+      for (const float* p : {static_cast<const float*>(n), a, b, c})
+        for (int k = 0; k < 3; ++k) put_f32_le(out, p[k]);
+      out.push_back('\0');
+      out.push_back('\0');
+    });
+    return Status::Ok();
+  }
+  out.reserve(30 + 250 * static_cast<size_t>(triangles));
+  out += "solid tsm\n";
+  for_each_triangle([&](const float* a, const float* b, const float* c) {
+    float n[3];
+    facet_normal(a, b, c, n);
+    put_text(out, "facet normal", n);
+    out += "outer loop\n";
+    put_text(out, "vertex", a);
+    put_text(out, "vertex", b);
+    put_text(out, "vertex", c);
+    out += "endloop\nendfacet\n";
+  });
+  out += "endsolid tsm\n";
+  return Status::Ok();
 }
 
 }  // namespace tsm
