@@ -547,7 +547,7 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
     // glTF has no face attributes: the OBJ groups and materials per face
     // ('obj:*', from an OBJ input) would make the writer refuse the mesh.
     drop_obj_face_labels(mesh, &wi);
-    s = write_gltf(mesh, WriteOptions(), out, format == MeshFormat::glb);
+    s = write_gltf(mesh, WriteOptions(), out, format == MeshFormat::glb, &wi);
   } else {
     s = write_ply(mesh, wo, out, &wi);
   }

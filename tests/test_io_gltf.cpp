@@ -752,6 +752,30 @@ TEST(GltfMalformed, RandomDamageNeverCrashes) {
 // ---------------------------------------------------------------------------
 // What the writer refuses
 
+// A document that names its images by relative URI needs those files beside
+// the written output: the writer says so, and says nothing for data URIs.
+TEST(GltfWrite, NotesImagesNamedByRelativeUri) {
+  std::string json = triangle_json();
+  json.insert(json.rfind('}'), R"(, "images": [{"uri": "tex.png"}, {"uri": "data:image/png;base64,AAAA"}])");
+  Mesh m;
+  Status s = tsm::read_mesh_from_memory(json, "tri.gltf", m, {}, nullptr);
+  ASSERT_TRUE(s.ok()) << s.to_string();
+  for (bool binary : {false, true}) {
+    std::string out;
+    tsm::WriteInfo info;
+    s = tsm::write_gltf(m, WriteOptions(), out, binary, &info);
+    ASSERT_TRUE(s.ok()) << s.to_string();
+    EXPECT_TRUE(contains(info.notes, "1 image file")) << info.notes;
+    EXPECT_TRUE(contains(info.notes, "tex.png")) << info.notes;
+  }
+  Mesh no_images;
+  ASSERT_TRUE(tsm::read_mesh_from_memory(triangle_json(), "tri.gltf", no_images, {}, nullptr).ok());
+  std::string out;
+  tsm::WriteInfo none;
+  ASSERT_TRUE(tsm::write_gltf(no_images, WriteOptions(), out, false, &none).ok());
+  EXPECT_TRUE(none.notes.empty()) << none.notes;
+}
+
 TEST(GltfWrite, RefusesPolygonsAndFaceOrCornerAttributes) {
   std::string out;
   Mesh quad = grid(3, 1);

@@ -245,7 +245,7 @@ Status write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions&
     for (const Attribute& a : mesh.attributes)
       if (m == &mesh && a.domain == AttributeDomain::face && a.name.compare(0, 4, "obj:") == 0) m = &without_labels;
     if (m == &without_labels) drop_obj_face_labels(without_labels = mesh, info);
-    Status s = write_gltf(*m, options, bytes, format == MeshFormat::glb);
+    Status s = write_gltf(*m, options, bytes, format == MeshFormat::glb, info);
     if (!s.ok()) return Status(s.code(), path + ": " + s.message());
   } else {
     return Status(ErrorCode::invalid_argument,

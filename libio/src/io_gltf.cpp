@@ -2149,6 +2149,22 @@ class PassThroughWriter {
     return serialize(binary, out);
   }
 
+  // The image URIs of the document that name files (not data: URIs): a
+  // written .gltf/.glb refers to them relative to its own folder.
+  std::vector<std::string> image_files() const {
+    std::vector<std::string> files;
+    const ojson& doc = wrapper_["document"];
+    auto images = doc.find("images");
+    if (images == doc.end() || !images->is_array()) return files;
+    for (const ojson& image : *images) {
+      if (!image.is_object()) continue;
+      auto uri = image.find("uri");
+      if (uri != image.end() && uri->is_string() && uri->get<std::string>().rfind("data:", 0) != 0)
+        files.push_back(uri->get<std::string>());
+    }
+    return files;
+  }
+
  private:
   static Status damaged(const std::string& what) {
     return Status(ErrorCode::corrupt_data,
@@ -2503,13 +2519,23 @@ Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out, con
   return GltfReader(bytes, name, out, options, info).run();
 }
 
-Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary) {
+Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary, WriteInfo* info) {
   (void)options;
   out.clear();
   try {
     if (const MetadataEntry* pass = mesh.find_metadata(kPassKey)) {
-      Status s = PassThroughWriter(mesh, pass->value).run(binary, out);
-      if (!s.ok()) out.clear();
+      PassThroughWriter writer(mesh, pass->value);
+      Status s = writer.run(binary, out);
+      if (!s.ok()) {
+        out.clear();
+      } else if (info) {
+        const std::vector<std::string> files = writer.image_files();
+        if (!files.empty())
+          info->add_note("the document names " + std::to_string(files.size()) +
+                         (files.size() == 1 ? " image file" : " image files") + " by relative URI (first: \"" +
+                         clean_message(files[0]) + "\"): copy " + (files.size() == 1 ? "it" : "them") +
+                         " beside the output, or viewers show the mesh without it");
+      }
       return s;
     }
     return GltfWriter(mesh).run(binary, out);

@@ -166,8 +166,10 @@ Status write_off(const Mesh& mesh, const WriteOptions& options, std::string& out
 // unsigned byte / short) and other vertex attributes as "_name". Refuses
 // (ErrorCode::unsupported) faces that are not triangles, face and corner
 // attributes (glTF would need split vertices: write PLY or OBJ) and
-// non-finite positions.
-Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary);
+// non-finite positions. `info` notes the image files the document names by
+// relative URI, which the output needs beside it.
+Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary,
+                  WriteInfo* info = nullptr);
 
 // Whole-file helpers used by readers, writers and the CLI.
 Status read_file(const std::string& path, std::string& out);
