@@ -761,7 +761,7 @@ TEST_F(CliBatch, ProgressBarOnlyOnATerminalAndNotWhenQuiet) {
   EXPECT_EQ(pty.drain(), "");
   // Work shorter than the delay shows no bar. A delay of ten minutes, not the
   // default second: under a sanitizer on a loaded machine three encodes can
-  // take longer than a second (the test failed so once, in session 18).
+  // take longer than a second (the test once failed that way).
   r = sh("TSM_PROGRESS_AFTER_MS=600000 $TSM encode " + inputs + " -o " + q("o4") + " </dev/null 2>" + quote(pty.slave));
   ASSERT_EQ(r.code, 0) << r.err;
   seen = pty.drain();

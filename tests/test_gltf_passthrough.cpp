@@ -831,7 +831,7 @@ TEST(GltfPassThrough, WithoutTheEntryTheWriterIsUnchanged) {
 
 namespace {
 
-// fuzz_read_mesh (session 5, crash-3cc75120, after 142k executions): a mesh
+// fuzz_read_mesh (crash-3cc75120, after 142k executions): a mesh
 // without "primitives" (glTF requires them; tinygltf reads none) was kept,
 // but building the pass-through entry looked its primitives up with JSON
 // operator[], which added "primitives": null to the stored document, and
