@@ -1,0 +1,67 @@
+// The decoder library on its own (CMake target tsm_decoder): this program
+// links only tsm_decoder, none of the encoder, and decodes FORMAT.md §11's
+// triangle through the C++ API, the stream decoder and the C API, then every
+// file named on the command line (the golden files). Exit 0 when all decode
+// as expected. ctest: decoder.links_alone.
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "tsm/tsm.h"
+#include "tsm/tsm.hpp"
+
+namespace {
+
+// FORMAT.md §11: (0, 0, 0), (2, 0, 0), (0, 1, 0.5), one face, at 8 bits, level 0.
+const unsigned char kTriangle[] = {
+    0x54, 0x53, 0x4d, 0x1a, 0x0c, 0x00, 0x00, 0x00, 0x1a, 0x03, 0x01, 0x03, 0x08, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x40, 0x01, 0xd6, 0x8b, 0xfe,
+    0x4a, 0x0a, 0x00, 0x00, 0x18, 0x18, 0x20, 0x10, 0x56, 0x1b, 0x03, 0x02, 0x05, 0x0a, 0x00, 0x0a, 0x4e, 0x04, 0x07,
+    0x00, 0x04, 0x04, 0xaf, 0x70, 0x04, 0x00, 0x00, 0x00, 0x53, 0xab, 0x90, 0x70, 0x2a, 0x15, 0x00, 0x00};
+
+int failures = 0;
+
+void check(bool ok, const std::string& what) {
+  if (!ok) {
+    std::fprintf(stderr, "decoder_only: FAILED: %s\n", what.c_str());
+    ++failures;
+  }
+}
+
+bool is_triangle(const tsm::Mesh& m) {
+  return m.vertex_count() == 3 && m.face_count() == 1 && m.indices == std::vector<uint32_t>{0, 1, 2} &&
+         m.positions[3] == 2.0f && m.positions[7] == 128.0f * 2.0f / 255.0f;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string_view bytes(reinterpret_cast<const char*>(kTriangle), sizeof kTriangle);
+  tsm::Mesh m;
+  tsm::Status s = tsm::decode(bytes, m);
+  check(s.ok() && is_triangle(m), "tsm::decode of the worked example: " + s.to_string());
+  tsm::StreamDecoder sd;
+  for (char c : bytes) s = sd.feed(std::string_view(&c, 1));
+  check(s.ok() && sd.finish().ok() && is_triangle(sd.mesh()), "StreamDecoder, a byte at a time");
+  tsm::FileInfo fi;
+  check(tsm::inspect(bytes, fi).ok() && fi.format_version == 12 && fi.geometry_predictor == "raw",
+        "tsm::inspect: format version 12, predictor raw");
+  tsm_mesh* cm = nullptr;
+  char err[256];
+  check(tsm_decode(kTriangle, sizeof kTriangle, nullptr, &cm, err, sizeof err) == TSM_OK &&
+            tsm_mesh_vertex_count(cm) == 3 && tsm_mesh_face_count(cm) == 1,
+        "tsm_decode");
+  tsm_mesh_free(cm);
+  for (int i = 1; i < argc; ++i) {
+    std::ifstream in(argv[i], std::ios::binary);
+    const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    tsm::Mesh g;
+    s = tsm::decode(file, g);
+    check(in.good() || in.eof(), std::string(argv[i]) + ": cannot read");
+    check(s.ok() && g.valid(), std::string(argv[i]) + ": " + s.to_string());
+    if (s.ok()) std::printf("%s: %zu vertices, %zu faces\n", argv[i], g.vertex_count(), g.face_count());
+  }
+  std::printf("decoder_only: %s (tsm %s)\n", failures ? "FAILED" : "ok", tsm::version_string());
+  return failures ? 1 : 0;
+}
