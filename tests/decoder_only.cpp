@@ -1,13 +1,16 @@
 // The decoder library on its own (CMake target tsm_decoder): this program
 // links only tsm_decoder, none of the encoder, and decodes FORMAT.md §11's
-// triangle through the C++ API, the stream decoder and the C API, then every
-// file named on the command line (the golden files). Exit 0 when all decode
+// triangle through the C++ API, the stream decoder and the C API; then,
+// given `--manifest tests/golden/MANIFEST.txt`, every golden file it lists,
+// checked against the hash of its decoded mesh there. Exit 0 when all decode
 // as expected. ctest: decoder.links_alone.
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
+#include "golden_hash.hpp"
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
 
@@ -53,14 +56,29 @@ int main(int argc, char** argv) {
             tsm_mesh_vertex_count(cm) == 3 && tsm_mesh_face_count(cm) == 1,
         "tsm_decode");
   tsm_mesh_free(cm);
-  for (int i = 1; i < argc; ++i) {
-    std::ifstream in(argv[i], std::ios::binary);
-    const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    tsm::Mesh g;
-    s = tsm::decode(file, g);
-    check(in.good() || in.eof(), std::string(argv[i]) + ": cannot read");
-    check(s.ok() && g.valid(), std::string(argv[i]) + ": " + s.to_string());
-    if (s.ok()) std::printf("%s: %zu vertices, %zu faces\n", argv[i], g.vertex_count(), g.face_count());
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (std::string(argv[i]) != "--manifest") break;
+    const std::string manifest = argv[i + 1];
+    const std::string dir = manifest.substr(0, manifest.find_last_of('/') + 1);
+    std::ifstream list(manifest);
+    check(list.good(), manifest + ": cannot read");
+    int files = 0;
+    for (std::string line; std::getline(list, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream f(line);
+      std::string file, mesh, q, level, seg, hash;
+      if (!(f >> file >> mesh >> q >> level >> seg >> hash)) continue;
+      std::ifstream in(dir + file, std::ios::binary);
+      const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      tsm::Mesh g;
+      s = tsm::decode(data, g);
+      check(s.ok() && g.valid(), file + ": " + s.to_string());
+      check(tsm_golden::hex(tsm_golden::mesh_hash(g)) == hash, file + ": decoded mesh hash is not the manifest's");
+      std::printf("%s: %zu vertices, %zu faces, hash %s\n", file.c_str(), g.vertex_count(), g.face_count(),
+                  tsm_golden::hex(tsm_golden::mesh_hash(g)).c_str());
+      ++files;
+    }
+    check(files > 0, manifest + ": no golden files listed");
   }
   std::printf("decoder_only: %s (tsm %s)\n", failures ? "FAILED" : "ok", tsm::version_string());
   return failures ? 1 : 0;
