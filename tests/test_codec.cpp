@@ -623,9 +623,9 @@ TEST(Codec, ForgedHeaderFieldsRefused) {
     h.version = static_cast<uint16_t>(version);
     const tsm::Status s = tsm::decode(build(h), back);
     EXPECT_EQ(s.code(), ErrorCode::unsupported) << version;
-    EXPECT_NE(s.message().find("format version " + std::to_string(version) + ": this decoder reads only format version 12"),
-              std::string::npos)
-        << s.to_string();
+    const std::string expected =
+        "format version " + std::to_string(version) + ": this decoder reads only format version 12";
+    EXPECT_NE(s.message().find(expected), std::string::npos) << s.to_string();
     tsm::StreamDecoder sd;
     EXPECT_EQ(sd.feed(build(h)).code(), ErrorCode::unsupported) << version;
   }

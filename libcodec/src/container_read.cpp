@@ -24,11 +24,11 @@ const char* section_name(uint16_t id) {
   switch (id) {
     case kSectionEnd: return "end";
     case kSectionSegment: return "segment";
-    case kSectionRetiredAttributes: return "retired";
+    case kSectionReserved8: return "reserved";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
   }
-  return id >= kSectionRetiredFirst && id <= kSectionRetiredLast ? "retired" : "unknown";
+  return id >= kSectionReservedFirst && id <= kSectionReservedLast ? "reserved" : "unknown";
 }
 
 uint32_t checksum32(std::string_view bytes) { return XXH32(bytes.data(), bytes.size(), 0); }
@@ -173,8 +173,8 @@ Status SectionRules::admit(const Section& s, const Header& h) {
       return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
     return Status::Ok();
   }
-  if ((s.id >= kSectionRetiredFirst && s.id <= kSectionRetiredLast) || s.id == kSectionRetiredAttributes)
-    return corrupt_at(at, s.id, "retired section id " + std::to_string(s.id) +
+  if ((s.id >= kSectionReservedFirst && s.id <= kSectionReservedLast) || s.id == kSectionReserved8)
+    return corrupt_at(at, s.id, "reserved section id " + std::to_string(s.id) +
                                     " (a mesh's streams belong in the mesh or segment sections)");
   if (segment_count > 1 && s.id == kSectionMesh)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");

@@ -589,7 +589,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
   uint32_t next = 0;
   for (size_t k = 0; k < S; ++k) {
     EncodedPart& p = parts[k];
-    if (!p.status.ok()) return Status(p.status.code(), "segment " + std::to_string(k) + ": " + p.status.message());
+    if (!p.status.ok())
+      return Status(p.status.code(), "segment " + std::to_string(k) + ": " + p.status.message());
     std::vector<uint32_t> global(p.order.size(), kNone);
     uint64_t refs = 0;
     for (size_t v = 0; v < p.order.size(); ++v) {
