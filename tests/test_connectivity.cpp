@@ -86,7 +86,7 @@ TEST(Connectivity, SpheresWithOneToFiftyHoles) {
 TEST(Connectivity, MoebiusStripAndInconsistentOrientation) {
   // The Moebius strip is canonical too. The coder's vertex order on its
   // decoded self is a symmetry of the faces (the mirror image), which used
-  // to permute the positions on each re-encoding; codec.cpp
+  // to permute the positions on each re-encoding; encode.cpp
   // canonical_connectivity now keeps the decoded ids (expect_round_trip
   // encodes the decoded mesh again and compares the bytes).
   for (int n : {3, 4, 5, 6, 7, 8, 10, 12, 17, 24, 31, 64})
@@ -325,7 +325,7 @@ TEST(Connectivity, PropertyThousandsOfRandomMeshes) {
 // 16 vertices, found by a review's random meshes). With the rounds capped at
 // 16 the encoder kept round 15's coding, and the decoded mesh, further along
 // the same sequence, re-encoded to other bytes. Small parts now get up to
-// 256 rounds (codec.cpp, canonical_rounds).
+// 256 rounds (encode.cpp, canonical_rounds).
 TEST(Connectivity, TangleSettlingAfterManyRoundsReencodesCanonically) {
   Mesh m;
   ASSERT_TRUE(read_mesh(std::string(TSM_REGRESSIONS_DIR) + "/canonical-after-20-rounds.obj", m).ok());

@@ -147,7 +147,7 @@ TEST(Format, OnlyVersion12IsRead) {
 }
 
 // FORMAT.md §4.3: the mesh section is required in a file of one segment and
-// refused in a file of several; the retired ids 3-6 and 8 are refused; ids
+// refused in a file of several; the reserved ids 3-6 and 8 are refused; ids
 // 1 and 2 and unassigned ids are ignored; stream lengths past the section's
 // end are refused.
 TEST(Format, SectionRules) {
@@ -156,10 +156,11 @@ TEST(Format, SectionRules) {
   (void)mesh_payload(good, storage);
   const std::string mesh = storage;
   const Mesh expected = decode_ok(good);
-  for (int retired : {3, 4, 5, 6, 8}) {
-    SCOPED_TRACE(retired);
-    EXPECT_EQ(decode_code(rebuild(good, {{tsm::kSectionMesh, mesh}, {static_cast<uint16_t>(retired), "x"}})), tsm::ErrorCode::corrupt_data);
-    EXPECT_EQ(decode_code(rebuild(good, {{static_cast<uint16_t>(retired), "x"}, {tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
+  for (int reserved : {3, 4, 5, 6, 8}) {
+    SCOPED_TRACE(reserved);
+    const uint16_t id = static_cast<uint16_t>(reserved);
+    EXPECT_EQ(decode_code(rebuild(good, {{tsm::kSectionMesh, mesh}, {id, "x"}})), tsm::ErrorCode::corrupt_data);
+    EXPECT_EQ(decode_code(rebuild(good, {{id, "x"}, {tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
   }
   for (int ignored : {1, 2, 11, 200, 0xFFFF}) {
     SCOPED_TRACE(ignored);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the tsm decoder for the browser: build/web/tsm_decoder.{js,wasm}
-# (emscripten glue + WebAssembly), from the same libcodec sources as the
-# native library, with emcc directly (no CMake).
+# (emscripten glue + WebAssembly), from the sources of the native decoder
+# library (libcodec/decoder_sources.txt, CMake's tsm_decoder), with emcc
+# directly (no CMake).
 #
 #   web/build.sh            # needs emcc (Debian: apt-get install emscripten node-acorn)
 #   TSM_WEB_DEBUG=1 web/build.sh   # -O1 -g, assertions on
@@ -80,19 +81,24 @@ else
   ZSTD_FILES=("$ROOT/web/zstd_stub.c")
   ZSTD_INC=()
   ZSTD_MODE=stub
-  # zstd.h for container.cpp: Debian's libzstd-dev header, through the one-header dir below
+  # zstd.h for container_read.cpp: Debian's libzstd-dev header, through the one-header dir below
   ZSTD_H=/usr/include/zstd.h
 fi
-# The encoder path of container.cpp names ZSTD_compress; the decoder never
-# reaches it, and this keeps the link whole without the compressor.
-ZSTD_FILES+=("$ROOT/web/zstd_compress_stub.c")
-
-# ---- library sources: libcodec/src minus file I/O and mesh comparison --------
+# ---- library sources: the decoder library's list ---------------------------------
+# libcodec/decoder_sources.txt, the list CMake builds tsm_decoder from: every
+# source decoding needs, none of the encoder's entry points nor zstd's
+# compressor (so no stub stands in for it). One path per line, relative to
+# libcodec/; '#' starts a comment.
+SOURCE_LIST="$LIBCODEC/decoder_sources.txt"
+[ -f "$SOURCE_LIST" ] || { echo "web/build.sh: $SOURCE_LIST not found" >&2; exit 1; }
 LIB_FILES=()
-for f in "$LIBCODEC"/src/*.cpp; do
-  case "$(basename "$f")" in io_*.cpp|compare.cpp) continue ;; esac
-  LIB_FILES+=("$f")
-done
+while IFS= read -r line || [ -n "$line" ]; do
+  line="${line%%#*}"
+  line="${line//[[:space:]]/}"
+  [ -z "$line" ] && continue
+  [ -f "$LIBCODEC/$line" ] || { echo "web/build.sh: $SOURCE_LIST lists $line, which is missing" >&2; exit 1; }
+  LIB_FILES+=("$LIBCODEC/$line")
+done < "$SOURCE_LIST"
 
 CXXFLAGS=("${OPT[@]}" -std=c++17 -DTSM_VERSION="\"$VERSION\"" -DTSM_NO_THREADS -DXXH_INLINE_ALL
           -DEIGEN_DONT_PARALLELIZE -DEIGEN_MPL2_ONLY

@@ -1,20 +1,18 @@
-// The C API (tsm.h) over the C++ API, for bindings and the WebAssembly build.
-// No exception or C++ type crosses it.
+// The C API (tsm.h) over the C++ API, for bindings and the WebAssembly
+// build: decoding (whole and streamed), meshes built and read, attributes
+// and metadata; tsm_encode is in c_api_encode.cpp (the encoder's half). No
+// exception or C++ type crosses it.
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <new>
 #include <string>
 
+#include "c_api_internal.hpp"
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
 
-// A mesh the caller owns, or a view of the stream decoder's growing mesh.
-struct tsm_mesh {
-  tsm::Mesh mesh;
-  const tsm::Mesh* view = nullptr;
-  const tsm::Mesh& get() const { return view ? *view : mesh; }
-};
+using tsm::capi::guarded;
 
 struct tsm_stream {
   explicit tsm_stream(const tsm::DecodeOptions& o) : decoder(o) { mesh.view = &decoder.mesh(); }
@@ -23,27 +21,6 @@ struct tsm_stream {
 };
 
 namespace {
-
-int report(const tsm::Status& s, char* err, size_t err_size) {
-  if (err && err_size > 0) {
-    std::string m = s.ok() ? "" : s.message();
-    size_t n = std::min(m.size(), err_size - 1);
-    std::memcpy(err, m.data(), n);
-    err[n] = '\0';
-  }
-  return static_cast<int>(s.code());
-}
-
-template <typename F>
-int guarded(char* err, size_t err_size, F&& f) {
-  try {
-    return report(f(), err, err_size);
-  } catch (const std::bad_alloc&) {
-    return report(tsm::Status(tsm::ErrorCode::limit_exceeded, "out of memory"), err, err_size);
-  } catch (const std::exception& e) {
-    return report(tsm::Status(tsm::ErrorCode::internal, e.what()), err, err_size);
-  }
-}
 
 // Attribute number i of a mesh, or null.
 const tsm::Attribute* attribute(const tsm_mesh* m, size_t i) {
@@ -111,35 +88,6 @@ int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t*
     }
     *out = m;
     return tsm::Status::Ok();
-  });
-}
-
-int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
-               size_t err_size) {
-  return guarded(err, err_size, [&] {
-    if (!mesh || !out || !out_size) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
-    *out = nullptr;
-    *out_size = 0;
-    tsm::EncodeOptions o;
-    if (options) {
-      if (options->quantization_bits) o.quantization_bits = options->quantization_bits;
-      if (options->level >= 0) o.level = options->level;
-      o.segment_faces = options->segment_faces;
-      o.threads = options->threads;
-      if (options->normal_bits) o.attribute_bits.normal = options->normal_bits;
-      if (options->texcoord_bits) o.attribute_bits.texcoord = options->texcoord_bits;
-      if (options->color_bits) o.attribute_bits.color = options->color_bits;
-      if (options->generic_bits) o.attribute_bits.generic = options->generic_bits;
-    }
-    std::string bytes;
-    tsm::Status s = tsm::encode(mesh->get(), o, bytes);
-    if (!s.ok()) return s;
-    auto* buf = static_cast<uint8_t*>(std::malloc(bytes.size() ? bytes.size() : 1));
-    if (!buf) return tsm::Status(tsm::ErrorCode::limit_exceeded, "out of memory");
-    std::memcpy(buf, bytes.data(), bytes.size());
-    *out = buf;
-    *out_size = bytes.size();
-    return s;
   });
 }
 

@@ -4,7 +4,9 @@
 //   vertex_tree.cpp    the vertex spanning tree (layered spiral) and its runs
 //   bounding_loop.cpp  jump edges, rotation system and the bounding loop walk
 //   triangle_tree.cpp  triangle tree runs and marching pattern
-//   connectivity.cpp   the coded streams and the decoder's reassembly
+//   connectivity_encode.cpp  the coded streams (connectivity_coding.hpp:
+//                      the models and stitch candidates both sides share)
+//   connectivity_decode.cpp  the decoder: the streams read, the faces reassembled
 //
 // Half-edge h = 3*t + i of triangle t runs from corner i to corner (i+1)%3;
 // the triangle lies on its left. Faces are counter-clockwise seen from
@@ -300,7 +302,7 @@ struct ConnectivityEncoding {
   // With stitches: the topology stream as it would be with every stitch
   // target coded as a distance after its position instead of by candidates
   // (empty without stitches). Not a stream of the file: the canonical rounds
-  // (codec.cpp) order the codings of a cycle by it.
+  // (encode.cpp) order the codings of a cycle by it.
   std::string distance_topology;
   bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
 };

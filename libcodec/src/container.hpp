@@ -23,12 +23,12 @@ constexpr uint64_t kMaxExpansion = 1024;
 
 enum SectionId : uint16_t {
   kSectionEnd = 0,
-  // Ids 1-6 and 8 are retired and never reused: 1 and 2 are ignored like
-  // any unknown id, 3-6 and 8 refused (SectionRules).
-  kSectionRetiredFirst = 3,   // 3-6: retired
-  kSectionRetiredLast = 6,
+  // Ids 3-6 and 8 are reserved: a file that has one is refused
+  // (SectionRules); 1, 2 and 11 and up are unassigned: ignored.
+  kSectionReservedFirst = 3,  // 3-6: reserved
+  kSectionReservedLast = 6,
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
-  kSectionRetiredAttributes = 8,  // retired
+  kSectionReserved8 = 8,      // reserved
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
 };
@@ -80,7 +80,7 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
 
 // Which ids may follow which (FORMAT.md §4.3): segment sections only in a
 // file of several segments, at most segment_count of them; the mesh section
-// only in a file of one; the retired ids 3-6 and 8 never; any other id at
+// only in a file of one; the reserved ids 3-6 and 8 never; any other id at
 // most once.
 struct SectionRules {
   std::vector<uint16_t> seen;

@@ -1,324 +1,30 @@
-// Encoder and decoder entry points: validate the mesh, run the connectivity
-// stages (seed 004 §3-4), quantize positions on the Draco grid (design notes
-// §6) and code them in decoded vertex order, and lay the streams out as
-// container sections.
+// Encoding (seed 004 §3-4; FORMAT.md): the encoder's entry point: validate
+// the mesh, quantize positions on the Draco grid (design notes §6), cut it
+// into segments (the segments of a file coded in parallel), run the
+// connectivity stages on each part, code positions in decoded vertex order
+// and attributes in the decoder's order, keep the codings that re-encode
+// to their own bytes (canonical rounds) and the smallest of those tried,
+// and lay the streams out as container sections.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <limits>
 #include <numeric>
 #include <tuple>
 #include <unordered_map>
-#ifndef TSM_NO_THREADS
-#include <thread>
-#endif
 
 #include "attributes.hpp"
+#include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
+#include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
+#include "tsm/quantization.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm {
 
-const char* version_string() { return TSM_VERSION; }
-
 namespace {
-
-Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
-
-double grid_step(const Header& h) {
-  return h.extent > 0 ? h.extent / (std::ldexp(1.0, h.quantization_bits) - 1.0) : 0.0;
-}
-
-const Section* find_section(const std::vector<Section>& sections, uint16_t id) {
-  for (const Section& s : sections)
-    if (s.id == id) return &s;
-  return nullptr;
-}
-
-// One part of a file: the whole mesh (the mesh section, §4.7) or one
-// segment (§4.5).
-struct PartCounts {
-  uint64_t vertex_count = 0, face_count = 0, corner_count = 0, reference_count = 0;
-};
-struct PartStreams {
-  std::string_view vertex_tree, triangle_tree, topology, references, geometry;
-  bool segmented = false;  // has a references stream
-  std::string_view attributes;  // empty: none
-};
-
-// A modelled binary decision costs at least 0.0028146 bits (range_coder.hpp:
-// probabilities stay within 64/32768 of certainty), so a stream of n bytes
-// (plus the 8 zero bytes a decoder may read past its end) holds at most
-// max_decisions(n) = 2843 (n + 8) decisions. Every own vertex costs at least
-// 3 in the geometry stream, every vertex of a segment 1 in its references
-// stream, every triangle of the cut surface at least 1 in the triangle-tree
-// stream (a marching bit or a run's end), every side-face corner at least 6
-// in the topology stream: counts beyond that are forged, refused before
-// allocating.
-uint64_t decisions(std::string_view stream) { return max_decisions(stream.size()); }
-
-Status check_budget(const PartCounts& c, const PartStreams& s) {
-  if (c.vertex_count >= 0x3FFFFFFFu || c.corner_count >= 0x3FFFFFFFu || c.face_count > c.corner_count)
-    return corrupt("vertex, face or corner count out of range");
-  if (c.reference_count > c.vertex_count) return corrupt("more references than vertices");
-  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3)
-    return corrupt("the header's " + std::to_string(c.vertex_count - c.reference_count) +
-                   " vertices cannot be coded in a geometry section of this size");
-  if (s.segmented && c.vertex_count > decisions(s.references))
-    return corrupt("the segment's " + std::to_string(c.vertex_count) +
-                   " vertices cannot be flagged in a references stream of this size");
-  if (c.corner_count > 3 * decisions(s.triangle_tree) + decisions(s.topology) / 6)
-    return corrupt("the header's " + std::to_string(c.corner_count) +
-                   " corners cannot be coded in connectivity sections of this size");
-  return Status::Ok();
-}
-
-Status check_user_limits(const Header& h, const DecodeOptions& options) {
-  if (options.max_vertices && h.vertex_count > options.max_vertices)
-    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.vertex_count) +
-                                                 " vertices, above the caller's limit of " +
-                                                 std::to_string(options.max_vertices));
-  if (options.max_faces && h.face_count > options.max_faces)
-    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.face_count) +
-                                                 " faces, above the caller's limit of " +
-                                                 std::to_string(options.max_faces));
-  const uint64_t max_corners = options.max_corners ? options.max_corners : 16 * options.max_faces;
-  if (max_corners && h.corner_count > max_corners)
-    return Status(ErrorCode::limit_exceeded, "file has " + std::to_string(h.corner_count) +
-                                                 " face corners, above the caller's limit of " +
-                                                 std::to_string(max_corners));
-  if (h.vertex_count >= 0x3FFFFFFFu || h.corner_count >= 0x3FFFFFFFu || h.face_count > h.corner_count)
-    return corrupt("vertex, face or corner count out of range");
-  return Status::Ok();
-}
-
-// What a decoded part holds before it joins the mesh.
-struct DecodedPart {
-  PartCounts counts;
-  Mesh faces;                    // corners are the part's output vertex ids
-  std::vector<uint32_t> q;       // grid indices, 3 per own vertex
-  std::vector<uint32_t> global;  // per part vertex: the earlier segment's vertex it is, kNone if own
-  std::vector<std::vector<uint32_t>> alias;  // per attribute, per corner value: an earlier segment's value, or kNone
-  ConnectivityStats cstats;
-  GeometryStats gstats;
-  uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
-  Status status;
-};
-
-Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, DecodedPart& out) {
-  TSM_RETURN_IF_ERROR(check_budget(out.counts, s));
-  ConnectivityStreams cs;
-  cs.vertex_tree.assign(s.vertex_tree);
-  cs.triangle_tree.assign(s.triangle_tree);
-  cs.topology.assign(s.topology);
-  GeometryLayout layout;
-  const PartCounts& c = out.counts;
-  TSM_RETURN_IF_ERROR(
-      decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
-  if (!s.segmented) {
-    if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
-    TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
-  } else {
-    TSM_RETURN_IF_ERROR(
-        decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
-    TSM_RETURN_IF_ERROR(
-        decode_geometry(s.geometry, own_layout(layout, out.global), bits, out.q, &out.gstats));
-  }
-  AttributePart ap;
-  ap.faces = &out.faces;
-  ap.global = &out.global;
-  ap.q = &out.q;
-  ap.segmented = s.segmented;
-  ap.table_coded = &out.table_coded_attributes;
-  return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
-}
-
-// Runs f(0..n-1) on up to `threads` threads (0 = one per core); each index
-// once. Serial where threads are not available.
-template <class F>
-void parallel_for(size_t n, int threads, F&& f) {
-#ifndef TSM_NO_THREADS
-  size_t t = threads > 0 ? static_cast<size_t>(threads) : std::max(1u, std::thread::hardware_concurrency());
-  t = std::min(t, n);
-  if (t > 1) {
-    std::atomic<size_t> next{0};
-    auto work = [&] {
-      for (size_t i; (i = next.fetch_add(1)) < n;) f(i);
-    };
-    std::vector<std::thread> pool;
-    for (size_t k = 1; k < t; ++k) pool.emplace_back(work);
-    work();
-    for (std::thread& th : pool) th.join();
-    return;
-  }
-#else
-  (void)threads;
-#endif
-  for (size_t i = 0; i < n; ++i) f(i);
-}
-
-// A segment section as a part: its streams (views into the section) and counts.
-Status read_part(const Section& sec, PartStreams& s, PartCounts& c) {
-  SegmentPayload p;
-  TSM_RETURN_IF_ERROR(read_segment(sec.data, p));
-  s = PartStreams{p.vertex_tree, p.triangle_tree, p.topology, p.references, p.geometry, true, p.attributes};
-  c = PartCounts{p.vertex_count, p.face_count, p.corner_count, p.reference_count};
-  return Status::Ok();
-}
-
-// The file's parts, from its parsed sections.
-Status collect_parts(const Header& h, const std::vector<Section>& sections, std::vector<PartStreams>& streams,
-                     std::vector<DecodedPart>& parts) {
-  if (h.segment_count == 1) {
-    PartStreams s;
-    const Section* sec = find_section(sections, kSectionMesh);
-    if (!sec) return corrupt("the mesh section is missing");
-    MeshPayload p;
-    TSM_RETURN_IF_ERROR(read_mesh_payload(sec->data, p));
-    s.vertex_tree = p.vertex_tree;
-    s.triangle_tree = p.triangle_tree;
-    s.topology = p.topology;
-    s.geometry = p.geometry;
-    s.attributes = p.attributes;
-    streams.assign(1, s);
-    parts.resize(1);
-    parts[0].counts = PartCounts{h.vertex_count, h.face_count, h.corner_count, 0};
-    return Status::Ok();
-  }
-  PartCounts sum;
-  for (const Section& sec : sections) {
-    if (sec.id != kSectionSegment) continue;
-    PartStreams s;
-    PartCounts c;
-    TSM_RETURN_IF_ERROR(read_part(sec, s, c));
-    streams.push_back(s);
-    parts.emplace_back();
-    parts.back().counts = c;
-    sum.vertex_count += c.vertex_count - c.reference_count;
-    sum.face_count += c.face_count;
-    sum.corner_count += c.corner_count;
-  }
-  if (parts.size() != h.segment_count)
-    return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
-                   std::to_string(parts.size()));
-  if (sum.vertex_count != h.vertex_count || sum.face_count != h.face_count || sum.corner_count != h.corner_count)
-    return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
-  return Status::Ok();
-}
-
-// A grid index as a coordinate (FORMAT.md §5).
-float grid_value(const Header& h, double step, int axis, uint32_t q) {
-  constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
-  const double o = static_cast<double>(h.origin[axis]);
-  double x = o + static_cast<double>(q) * step;
-  // A grid point may lie up to half a step past the largest input
-  // coordinate; near the float limit, clamp (the input was within range).
-  x = x > kFloatMax ? kFloatMax : x < -kFloatMax ? -kFloatMax : x;
-  float c = static_cast<float>(x);
-  // On an axis shorter than the extent, the float nearest a grid point may
-  // lie just past origin + extent; then the float below it, so that the
-  // decoded mesh has the extent it was coded with and coding it again
-  // takes the same grid (canonical re-encoding).
-  while (static_cast<double>(c) - o > h.extent) c = std::nextafter(c, -std::numeric_limits<float>::infinity());
-  return c;
-}
-
-// The parts of a file carry the same attributes (names, kinds, domains,
-// types, components), each with its own values.
-Status check_same_attributes(const Mesh& out, bool first, const std::vector<Attribute>& part) {
-  if (first) return Status::Ok();
-  bool same = part.size() == out.attributes.size();
-  for (size_t i = 0; same && i < part.size(); ++i) same = same_description(part[i], out.attributes[i]);
-  return same ? Status::Ok() : corrupt("the segments disagree on the attributes they carry");
-}
-
-// Appends a decoded part to the mesh: its own vertices get the next ids,
-// its faces follow the faces so far, its attribute values follow theirs.
-// Frees the part's buffers.
-Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
-  TSM_RETURN_IF_ERROR(check_same_attributes(out, first, part.faces.attributes));
-  const double step = grid_step(h);
-  const uint32_t base = static_cast<uint32_t>(out.vertex_count());
-  if (first) {
-    out.attributes = std::move(part.faces.attributes);
-  } else {
-    for (size_t i = 0; i < out.attributes.size(); ++i) {
-      Attribute &o = out.attributes[i], &p = part.faces.attributes[i];
-      const uint32_t value_base = static_cast<uint32_t>(o.value_count());
-      const std::vector<uint32_t>* alias = i < part.alias.size() && !part.alias[i].empty() ? &part.alias[i] : nullptr;
-      if (!alias) {
-        o.values.insert(o.values.end(), p.values.begin(), p.values.end());
-        for (uint32_t x : p.indices) o.indices.push_back(value_base + x);
-        continue;
-      }
-      // Values of earlier segments are not added again: their corners use the earlier ones.
-      std::vector<uint32_t> id(alias->size());
-      uint32_t next = value_base;
-      for (size_t j = 0; j < id.size(); ++j) {
-        const uint32_t a = (*alias)[j];
-        if (a == kNone) {
-          id[j] = next++;
-          o.values.insert(o.values.end(), p.values.begin() + static_cast<std::ptrdiff_t>(p.components * j),
-                          p.values.begin() + static_cast<std::ptrdiff_t>(p.components * (j + 1)));
-        } else if (a < value_base) {
-          id[j] = a;
-        } else {
-          return corrupt("attribute '" + p.name + "': a value names value " + std::to_string(a) +
-                         " of the segments before, which hold " + std::to_string(value_base));
-        }
-      }
-      for (uint32_t x : p.indices) o.indices.push_back(id[x]);
-    }
-  }
-  if (first)
-    for (const std::vector<uint32_t>& alias : part.alias)
-      for (uint32_t a : alias)
-        if (a != kNone) return corrupt("the first segment names values of segments before it");
-  out.positions.resize(out.positions.size() + part.q.size());
-  float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
-  const uint32_t* q = part.q.data();
-  for (size_t v = 0, nv = part.q.size() / 3; v < nv; ++v, q += 3, pos += 3)
-    for (int axis = 0; axis < 3; ++axis) pos[axis] = grid_value(h, step, axis, q[axis]);
-  if (first) {  // the first part has no references: its faces as they are, no copy
-    out.face_offsets = std::move(part.faces.face_offsets);
-    out.indices = std::move(part.faces.indices);
-  } else {
-    std::vector<uint32_t> id(part.global.size());
-    uint32_t own = 0;
-    for (size_t v = 0; v < id.size(); ++v) id[v] = part.global[v] != kNone ? part.global[v] : base + own++;
-    const uint32_t corner_base = static_cast<uint32_t>(out.indices.size());
-    out.indices.reserve(out.indices.size() + part.faces.indices.size());
-    for (uint32_t x : part.faces.indices) out.indices.push_back(id[x]);
-    out.face_offsets.reserve(out.face_offsets.size() + part.faces.face_count());
-    for (size_t f = 1; f < part.faces.face_offsets.size(); ++f)
-      out.face_offsets.push_back(corner_base + part.faces.face_offsets[f]);
-  }
-  part.faces.clear();
-  part.q = std::vector<uint32_t>();
-  part.global = std::vector<uint32_t>();
-  return Status::Ok();
-}
-
-Status decode_parts(const Header& h, std::vector<Section>& sections, int threads, std::vector<DecodedPart>& parts,
-                    std::vector<PartStreams>& streams) {
-  TSM_RETURN_IF_ERROR(collect_parts(h, sections, streams, parts));
-  std::vector<uint64_t> earlier(parts.size(), 0);
-  for (size_t k = 1; k < parts.size(); ++k)
-    earlier[k] = earlier[k - 1] + parts[k - 1].counts.vertex_count - parts[k - 1].counts.reference_count;
-  parallel_for(parts.size(), threads, [&](size_t k) {
-    parts[k].status = decode_part(streams[k], earlier[k], h.quantization_bits, parts[k]);
-  });
-  for (size_t k = 0; k < parts.size(); ++k)
-    if (!parts[k].status.ok())
-      return parts.size() == 1 ? parts[k].status
-                               : Status(parts[k].status.code(),
-                                        "segment " + std::to_string(k) + ": " + parts[k].status.message());
-  return Status::Ok();
-}
 
 // FORMAT.md §8.12.1: the fast levels' attribute residuals through tables
 // where they pay.
@@ -837,7 +543,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
       }
   std::vector<std::vector<uint32_t>> inputs(S);  // per segment: its vertices (input ids)
   std::vector<EncodedPart> parts(S);
-  parallel_for(S, options.threads, [&](size_t k) {
+  size_t failed = 0;
+  const Status threw = parallel_for(S, options.threads, [&](size_t k) {
     std::vector<uint32_t>& in = inputs[k];
     for (uint32_t f : segments[k])
       for (uint32_t i = 0; i < mesh.face_size(f); ++i) in.push_back(mesh.face(f)[i]);
@@ -870,7 +577,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     part.attributes = segment_attributes(mesh, in, faces, rot, k + 1 == S, parts[k].value_origin);
     parts[k].status = encode_part(part, q, is_ref, headers, options, parts[k]);
     parts[k].part = std::move(part);
-  });
+  }, &failed);
+  if (!threw.ok()) parts[failed].status = threw;
   // Per corner attribute, per value of the mesh: its id in the file's value
   // list once a segment has added it.
   std::vector<std::vector<uint32_t>> value_id(mesh.attributes.size());
@@ -881,7 +589,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
   uint32_t next = 0;
   for (size_t k = 0; k < S; ++k) {
     EncodedPart& p = parts[k];
-    TSM_RETURN_IF_ERROR(p.status);
+    if (!p.status.ok())
+      return Status(p.status.code(), "segment " + std::to_string(k) + ": " + p.status.message());
     std::vector<uint32_t> global(p.order.size(), kNone);
     uint64_t refs = 0;
     for (size_t v = 0; v < p.order.size(); ++v) {
@@ -995,218 +704,5 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   out = cw.finish();
   return Status::Ok();
 }
-
-Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
-  out.clear();
-  Header h;
-  std::vector<Section> sections;
-  TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  TSM_RETURN_IF_ERROR(check_user_limits(h, options));
-  std::vector<DecodedPart> parts;
-  std::vector<PartStreams> streams;
-  TSM_RETURN_IF_ERROR(decode_parts(h, sections, options.threads, parts, streams));
-  if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
-  for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
-  if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
-  return Status::Ok();
-}
-
-Status inspect(std::string_view bytes, FileInfo& info) {
-  info = FileInfo();
-  Header h;
-  std::vector<Section> sections;
-  TSM_RETURN_IF_ERROR(read_container(bytes, h, sections));
-  info.format_version = h.version;
-  info.vertex_count = h.vertex_count;
-  info.face_count = h.face_count;
-  info.corner_count = h.corner_count;
-  info.quantization_bits = h.quantization_bits;
-  info.level = h.level;
-  info.segment_count = h.segment_count;
-  for (int a = 0; a < 3; ++a) info.bbox_min[a] = h.origin[a];
-  info.step = grid_step(h);
-  info.file_bytes = bytes.size();
-  for (const Section& s : sections) {
-    SectionInfo si;
-    si.id = s.id;
-    si.name = section_name(s.id);
-    si.codec = s.codec == SectionCodec::zstd ? "zstd" : "raw";
-    si.stored_bytes = s.stored_bytes;
-    si.raw_bytes = s.raw_bytes;
-    info.sections.push_back(si);
-  }
-  std::vector<DecodedPart> parts;
-  std::vector<PartStreams> streams;
-  TSM_RETURN_IF_ERROR(decode_parts(h, sections, 1, parts, streams));
-  for (size_t k = 0; k < parts.size(); ++k) {
-    const PartStreams& s = streams[k];
-    info.connectivity_bytes += s.vertex_tree.size() + s.triangle_tree.size() + s.topology.size();
-    info.geometry_bytes += s.geometry.size();
-    info.reference_bytes += s.references.size();
-    const ConnectivityStats& st = parts[k].cstats;
-    info.components += st.components;
-    info.vertex_runs += st.vertex_runs;
-    info.triangle_runs += st.triangle_runs;
-    info.jump_edges += st.jump_edges;
-    info.stitches += st.stitches;
-    info.virtual_vertices += st.virtual_vertices;
-    info.side_faces += st.side_faces;
-    info.marching_bits += st.marching_bits;
-    info.run_table_parts += st.run_tables;
-    info.table_coded_attributes += parts[k].table_coded_attributes;
-    info.references += parts[k].counts.reference_count;
-    SegmentSummary sum;
-    sum.vertices = parts[k].counts.vertex_count;
-    sum.references = parts[k].counts.reference_count;
-    sum.faces = parts[k].counts.face_count;
-    info.segments.push_back(sum);
-  }
-  info.other_bytes = bytes.size() - info.connectivity_bytes - info.geometry_bytes;
-  // The first segment's predictor stands for the file (each segment chooses its own).
-  const GeometryStats& gs = parts[0].gstats;
-  info.geometry_predictor = gs.predictor == Predictor::ancestors ? "ancestors"
-                            : gs.predictor == Predictor::gate    ? "gate"
-                            : gs.predictor == Predictor::spread  ? "spread"
-                            : gs.predictor == Predictor::fan     ? "fan"
-                            : gs.predictor == Predictor::raw     ? "raw"
-                                                                 : "parallelograms";
-  if (gs.tangent) info.geometry_predictor += "+tangent";
-  if (gs.mix) info.geometry_predictor += "+mix";
-  if (gs.top) info.geometry_predictor += "+top";
-  if (gs.tables) info.geometry_predictor += "+tables";
-  info.ancestors = gs.ancestors;
-  for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
-  return Status::Ok();
-}
-
-// Streaming: sections are read as their bytes arrive; a segment is decoded
-// as soon as its section is complete (a file of one segment at its end).
-struct StreamDecoder::Impl {
-  DecodeOptions options;
-  std::string buf;      // bytes received and not yet consumed
-  size_t base = 0;      // file offset of buf[0]
-  bool have_header = false, ended = false;
-  Header h;
-  SectionRules rules;
-  std::vector<Section> whole;  // a one-segment file's sections, until the end marker
-  Mesh mesh;
-  uint32_t done = 0;
-  uint64_t faces = 0, corners = 0;
-  Status failed;
-
-  Status part_done(DecodedPart& part, const PartStreams& s) {
-    TSM_RETURN_IF_ERROR(decode_part(s, mesh.vertex_count(), h.quantization_bits, part));
-    TSM_RETURN_IF_ERROR(append_part(h, part, mesh, done == 0));
-    ++done;
-    return Status::Ok();
-  }
-
-  Status segment(const Section& sec) {
-    PartStreams s;
-    DecodedPart part;
-    TSM_RETURN_IF_ERROR(read_part(sec, s, part.counts));
-    const PartCounts& p = part.counts;
-    // Against the header before anything is allocated: the header's counts
-    // passed the caller's limits.
-    const uint64_t own = p.vertex_count - std::min(p.reference_count, p.vertex_count);
-    if (mesh.vertex_count() + own > h.vertex_count || faces + p.face_count > h.face_count ||
-        corners + p.corner_count > h.corner_count)
-      return corrupt("segment " + std::to_string(done) + " holds more vertices, faces or corners than the header");
-    faces += p.face_count;
-    corners += p.corner_count;
-    Status st = part_done(part, s);
-    if (!st.ok()) return Status(st.code(), "segment " + std::to_string(done) + ": " + st.message());
-    return Status::Ok();
-  }
-
-  Status end() {
-    ended = true;
-    if (h.segment_count == 1) {
-      std::vector<DecodedPart> parts;
-      std::vector<PartStreams> streams;
-      TSM_RETURN_IF_ERROR(collect_parts(h, whole, streams, parts));
-      TSM_RETURN_IF_ERROR(part_done(parts[0], streams[0]));
-      whole.clear();
-      return Status::Ok();
-    }
-    if (done != h.segment_count)
-      return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
-                     std::to_string(done));
-    if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
-      return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
-    return Status::Ok();
-  }
-
-  Status feed(std::string_view bytes) {
-    if (ended && !bytes.empty())
-      return corrupt(std::to_string(bytes.size()) + " unexpected bytes after the end marker");
-    buf.append(bytes.data(), bytes.size());
-    size_t pos = 0;
-    std::string missing;
-    if (!have_header) {
-      TSM_RETURN_IF_ERROR(read_header(buf, pos, h, missing));
-      if (!missing.empty()) return Status::Ok();
-      TSM_RETURN_IF_ERROR(check_user_limits(h, options));
-      have_header = true;
-    }
-    while (!ended) {
-      Section s;
-      TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base));
-      if (!missing.empty()) break;
-      if (s.id == kSectionEnd) {
-        if (pos != buf.size())
-          return corrupt(std::to_string(buf.size() - pos) + " unexpected bytes after the end marker");
-        TSM_RETURN_IF_ERROR(end());
-        break;
-      }
-      TSM_RETURN_IF_ERROR(rules.admit(s, h));
-      if (s.id == kSectionMetadata)
-        TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
-      else if (s.id == kSectionSegment)
-        TSM_RETURN_IF_ERROR(segment(s));
-      else if (h.segment_count == 1)
-        whole.push_back(std::move(s));
-    }
-    buf.erase(0, pos);
-    base += pos;
-    return Status::Ok();
-  }
-};
-
-StreamDecoder::StreamDecoder(const DecodeOptions& options) : impl_(std::make_unique<Impl>()) {
-  impl_->options = options;
-}
-StreamDecoder::~StreamDecoder() = default;
-
-Status StreamDecoder::feed(std::string_view bytes) {
-  if (!impl_->failed.ok()) return impl_->failed;
-  Status s = impl_->feed(bytes);
-  if (!s.ok()) impl_->failed = s;
-  return s;
-}
-
-Status StreamDecoder::finish() {
-  if (!impl_->failed.ok()) return impl_->failed;
-  if (impl_->ended) return Status::Ok();
-  std::string missing;
-  if (!impl_->have_header) {
-    size_t pos = 0;
-    Header h;
-    Status s = read_header(impl_->buf, pos, h, missing);
-    impl_->failed = s.ok() ? corrupt(missing.empty() ? "file ends inside the header" : missing) : s;
-  } else {
-    size_t pos = 0;
-    Section s;
-    Status st = read_section(impl_->buf, pos, s, false, missing, impl_->base);
-    impl_->failed = st.ok() ? corrupt(missing.empty() ? "file ends before the end marker" : missing) : st;
-  }
-  return impl_->failed;
-}
-
-uint32_t StreamDecoder::segment_count() const { return impl_->have_header ? impl_->h.segment_count : 0; }
-uint32_t StreamDecoder::segments_done() const { return impl_->done; }
-bool StreamDecoder::done() const { return impl_->ended && impl_->failed.ok(); }
-const Mesh& StreamDecoder::mesh() const { return impl_->mesh; }
-Mesh StreamDecoder::take_mesh() { return std::move(impl_->mesh); }
 
 }  // namespace tsm

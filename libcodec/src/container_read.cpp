@@ -1,10 +1,9 @@
-// The .tsm container (format-spec/FORMAT.md §2-3): magic, version, header,
-// then self-delimiting sections, each with an id, a codec (raw or zstd), its
-// lengths and an XXH32 checksum, ended by an end marker. The method's streams
-// (seed 004 §3-4: vertex tree, triangle tree, marching pattern, geometry) go
-// in one section per segment (a mesh of one segment: the mesh section);
-// side data is zstd-compressed where that wins. Sections are read in order,
-// so a decoder can start on a section as soon as its bytes are in.
+// Reading the .tsm container (format-spec/FORMAT.md §2-4; the decoder's
+// first step): magic, version, header, then self-delimiting sections, each
+// with an id, a codec (raw or zstd), its lengths and an XXH32 checksum,
+// ended by an end marker; the mesh section's streams and the metadata.
+// Sections are read in order, so a decoder can start on a section as soon
+// as its bytes are in. (Writing: container_write.cpp.)
 //
 // Every length is checked against the bytes that remain before anything is
 // allocated, and every section's checksum is verified before it is used.
@@ -25,27 +24,16 @@ const char* section_name(uint16_t id) {
   switch (id) {
     case kSectionEnd: return "end";
     case kSectionSegment: return "segment";
-    case kSectionRetiredAttributes: return "retired";
+    case kSectionReserved8: return "reserved";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
   }
-  return id >= kSectionRetiredFirst && id <= kSectionRetiredLast ? "retired" : "unknown";
+  return id >= kSectionReservedFirst && id <= kSectionReservedLast ? "reserved" : "unknown";
 }
 
 uint32_t checksum32(std::string_view bytes) { return XXH32(bytes.data(), bytes.size(), 0); }
 
 namespace {
-
-void write_header_fields(ByteWriter& w, const Header& h) {
-  w.varint(h.vertex_count);
-  w.varint(h.face_count);
-  w.varint(h.corner_count);
-  w.u8(h.quantization_bits);
-  w.u8(h.level);
-  for (float o : h.origin) w.f32(o);
-  w.f64(h.extent);
-  w.varint(h.segment_count);
-}
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
 
@@ -54,46 +42,6 @@ Status corrupt_at(size_t at, uint16_t id, const std::string& what) {
 }
 
 }  // namespace
-
-ContainerWriter::ContainerWriter(const Header& header) {
-  ByteWriter w(out_);
-  w.bytes(std::string_view(kMagic, 4));
-  w.u16(header.version);
-  w.u16(0);  // flags
-  std::string fields;
-  ByteWriter fw(fields);
-  write_header_fields(fw, header);
-  w.varint(fields.size());
-  w.bytes(fields);
-  w.u32(checksum32(std::string_view(out_)));
-}
-
-void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zstd_level) {
-  std::string stored;
-  SectionCodec codec = SectionCodec::raw;
-  if (zstd_level > 0 && payload.size() > 64) {
-    stored.resize(ZSTD_compressBound(payload.size()));
-    size_t n = ZSTD_compress(stored.data(), stored.size(), payload.data(), payload.size(), zstd_level);
-    if (!ZSTD_isError(n) && n < payload.size() && payload.size() <= n * kMaxExpansion) {
-      stored.resize(n);
-      codec = SectionCodec::zstd;
-    }
-  }
-  if (codec == SectionCodec::raw) stored.assign(payload.data(), payload.size());
-  ByteWriter w(out_);
-  w.u16(id);
-  w.u8(static_cast<uint8_t>(codec));
-  w.varint(stored.size());
-  w.varint(payload.size());
-  w.u32(checksum32(stored));
-  w.bytes(stored);
-}
-
-std::string ContainerWriter::finish() {
-  ByteWriter w(out_);
-  w.u16(kSectionEnd);
-  return std::move(out_);
-}
 
 Status read_header(std::string_view bytes, size_t& offset, Header& header, std::string& missing) {
   missing.clear();
@@ -225,8 +173,8 @@ Status SectionRules::admit(const Section& s, const Header& h) {
       return corrupt_at(at, s.id, "more segment sections than the header's " + std::to_string(segment_count));
     return Status::Ok();
   }
-  if ((s.id >= kSectionRetiredFirst && s.id <= kSectionRetiredLast) || s.id == kSectionRetiredAttributes)
-    return corrupt_at(at, s.id, "retired section id " + std::to_string(s.id) +
+  if ((s.id >= kSectionReservedFirst && s.id <= kSectionReservedLast) || s.id == kSectionReserved8)
+    return corrupt_at(at, s.id, "reserved section id " + std::to_string(s.id) +
                                     " (a mesh's streams belong in the mesh or segment sections)");
   if (segment_count > 1 && s.id == kSectionMesh)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
@@ -235,13 +183,6 @@ Status SectionRules::admit(const Section& s, const Header& h) {
   seen.push_back(s.id);
   if (seen.size() > 4096) return corrupt("too many sections");
   return Status::Ok();
-}
-
-std::string write_mesh_payload(const MeshPayload& p) {
-  std::string out;
-  ByteWriter w(out);
-  write_streams(w, {p.vertex_tree, p.triangle_tree, p.topology, p.geometry}, p.attributes);
-  return out;
 }
 
 Status read_mesh_payload(std::string_view bytes, MeshPayload& p) {
@@ -274,19 +215,6 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
   if (offset != bytes.size())
     return corrupt(std::to_string(bytes.size() - offset) + " unexpected bytes after the end marker");
   return Status::Ok();
-}
-
-std::string write_metadata(const std::vector<MetadataEntry>& entries) {
-  std::string out;
-  ByteWriter w(out);
-  w.varint(entries.size());
-  for (const MetadataEntry& e : entries) {
-    w.u8(static_cast<uint8_t>(e.key.size()));
-    w.bytes(e.key);
-    w.varint(e.value.size());
-    w.bytes(e.value);
-  }
-  return out;
 }
 
 Status read_metadata(std::string_view payload, std::vector<MetadataEntry>& entries) {
