@@ -146,10 +146,11 @@ TEST_F(ToolOutput, HelpAndErrorsListTheSameOutputFormats) {
   r = tsm("encode " + q("in.ply") + " -o " + q("a.tsm"));
   ASSERT_EQ(r.code, 0) << r.err;
   r = tsm("decode " + q("a.tsm") + " -o " + q("a.xyz"));
-  EXPECT_EQ(r.code, 3);
-  EXPECT_TRUE(contains(r.err, "output must end in .ply, .obj, .stl, .off, .gltf or .glb (or pass --format "
-                              "ply|obj|stl|off|gltf|glb)"))
+  EXPECT_EQ(r.code, 2);  // a usage error, found before anything is decoded
+  EXPECT_TRUE(contains(r.err, "end it in .ply, .obj, .stl, .off, .gltf or .glb, or pass --format "
+                              "ply|obj|stl|off|gltf|glb"))
       << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("a.xyz")));
 }
 
 TEST_F(ToolOutput, ObjGroupsSurviveTheTool) {
