@@ -256,7 +256,7 @@ TEST(Attributes, EncoderRefusesBadAttributes) {
   EXPECT_EQ(encode(m, EncodeOptions{}, bytes).code(), ErrorCode::invalid_argument);
 }
 
-// fuzz_read_mesh (session 5, crash-2b31933c): a PLY property name of 1,118
+// fuzz_read_mesh (crash-2b31933c): a PLY property name of 1,118
 // bytes became an attribute the encoder wrote and the decoder refused
 // ("truncated attribute header": names are at most 1024 bytes). Now the
 // limit is the mesh's (Mesh::valid, so encode refuses it with the reason)

@@ -753,8 +753,8 @@ std::string spec_example_bytes() {
 }  // namespace
 
 // The spec's worked example is what the encoder writes for its triangle and
-// decodes to that triangle (the session-5 review found it stale: nothing
-// checked it).
+// decodes to that triangle (it once went stale because nothing checked
+// it).
 TEST(Codec, FormatSpecWorkedExampleIsCurrent) {
   const std::string example = spec_example_bytes();
   ASSERT_EQ(example.size(), 74u) << "could not read the example from " << TSM_FORMAT_SPEC;

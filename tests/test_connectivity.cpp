@@ -345,7 +345,8 @@ TEST(Connectivity, TangleSettlingAfterManyRoundsReencodesCanonically) {
 // Canonical re-encoding of damaged meshes: faces dropped, flipped, given
 // twice, given also reversed, in shuffled order. Such tangles can send the
 // encoder's canonical rounds round a cycle (one in six of these did before
-// session 23, about one in a thousand without the reversed faces).
+// the rounds learnt to detect cycles, about one in a thousand without the
+// reversed faces).
 TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
   std::mt19937 rng(777);
   int checked = 0;
@@ -564,7 +565,7 @@ TEST(Connectivity, VirtualVertexNeverInsideTheVertexTree) {
 
 namespace {
 
-// The decoder's bounding loop as first written (sessions 1-11): explicit
+// The decoder's bounding loop as first written: explicit
 // slot lists per vertex (tree slots, each followed by the jump ends of its
 // corner), walked by "arrive by a slot's reverse, leave by the next slot
 // clockwise". Kept here as the oracle for decoder_loop, which now derives

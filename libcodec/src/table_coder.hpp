@@ -4,7 +4,7 @@
 // canonical prefix code per residual context, stored in the file, instead
 // of the adaptive binary models of range_coder.hpp: one table lookup per
 // value instead of about ten adaptive decisions (6-9x faster to decode,
-// 1-2% larger; README, session 16). The
+// 1-2% larger). The
 // contexts are the adaptive coder's (seed 004 §3.2 predicts, the contexts
 // of design notes §6 say how much was known); only the coder changes.
 //
