@@ -567,74 +567,26 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
 
 // ---------------------------------------------------------------- info
 
-// What `tsm info` says about one attribute of the decoded mesh.
+// What `tsm info` says about one attribute: the file's description of it
+// (FileInfo::attributes) and, from the decoded mesh, how many values it has.
 struct AttributeSummary {
   const char* kind;
   const char* domain;
   const char* type;
-  const char* coding;  // "exact" (integer types), "grid", "octahedral" (float normals)
-  int bits = 0;        // exact: the type's width; grid: as the values show it (0: cannot tell)
+  std::string coding;  // "exact", "grid, 12 bits", "octahedral, 10 bits" (+ ", tables")
 };
 
-// The grid a float attribute's decoded values lie on. The encoder puts each
-// component c on origin[c] + k * step, step = the largest extent of the
-// components / (2^bits - 1) (FORMAT.md §8.12), and the decoder gives those
-// values back (to a few float ulps): the smallest bits whose grid holds
-// every value. A grid of b bits is not a subset of a coarser one, so this is
-// the encoder's bits unless the values happen to use only the points of a
-// coarser grid. 0 when all values are equal (or none fits up to 24 bits).
-int grid_bits_from_values(const Attribute& a) {
-  const uint32_t nc = a.components;
-  if (nc == 0 || a.values.empty()) return 0;
-  std::vector<double> lo(nc, 0), hi(nc, 0);
-  std::vector<bool> seen(nc, false);
-  for (size_t i = 0; i < a.values.size(); ++i) {
-    const double x = a.values[i];
-    if (!std::isfinite(x)) continue;
-    const size_t c = i % nc;
-    if (!seen[c] || x < lo[c]) lo[c] = x;
-    if (!seen[c] || x > hi[c]) hi[c] = x;
-    seen[c] = true;
-  }
-  double extent = 0, magnitude = 0;
-  for (uint32_t c = 0; c < nc; ++c) {
-    extent = std::max(extent, hi[c] - lo[c]);
-    magnitude = std::max({magnitude, std::fabs(lo[c]), std::fabs(hi[c])});
-  }
-  if (!(extent > 0)) return 0;
-  for (int bits = 1; bits <= 24; ++bits) {
-    const double step = extent / (std::ldexp(1.0, bits) - 1);
-    const double tolerance = std::max(step * 1e-3, 16 * static_cast<double>(FLT_EPSILON) * magnitude);
-    bool fits = true;
-    for (size_t i = 0; i < a.values.size() && fits; ++i) {
-      const double x = a.values[i];
-      if (!std::isfinite(x)) continue;
-      const double k = std::round((x - lo[i % nc]) / step);
-      fits = std::fabs(x - (lo[i % nc] + k * step)) <= tolerance;
-    }
-    if (fits) return bits;
-  }
-  return 0;
-}
-
-AttributeSummary summarize(const Attribute& a) {
+AttributeSummary summarize(const AttributeInfo& a) {
   static const char* const kKinds[4] = {"generic", "normal", "color", "texcoord"};
   static const char* const kDomains[3] = {"vertex", "face", "corner"};
   static const char* const kTypes[4] = {"f32", "u8", "u16", "i32"};
-  static const int kWidths[4] = {32, 8, 16, 32};
   AttributeSummary s;
   s.kind = kKinds[static_cast<size_t>(a.kind) % 4];
   s.domain = kDomains[static_cast<size_t>(a.domain) % 3];
   s.type = kTypes[static_cast<size_t>(a.type) % 4];
-  if (a.type != AttributeType::f32) {
-    s.coding = "exact";
-    s.bits = kWidths[static_cast<size_t>(a.type) % 4];
-  } else if (a.kind == AttributeKind::normal && a.components == 3) {
-    s.coding = "octahedral";
-  } else {
-    s.coding = "grid";
-    s.bits = grid_bits_from_values(a);
-  }
+  s.coding = a.coding;
+  if (a.bits > 0) s.coding += strf(", %d bits", a.bits);
+  if (a.tables) s.coding += ", tables";
   return s;
 }
 
@@ -656,8 +608,8 @@ FileResult info_one(const std::string& input) {
   s = inspect(bytes, fi);
   if (!s.ok()) return failed(Status(s.code(), name + ": " + s.message()));
 
-  // The attributes: the library's FileInfo does not list them, the decoded
-  // mesh does (their stored bytes are not known apart from the side data).
+  // The number of values of each attribute and the metadata entries come
+  // from the decoded mesh.
   Mesh mesh;
   DecodeOptions dopt;
   dopt.threads = 1;
@@ -667,20 +619,25 @@ FileResult info_one(const std::string& input) {
   const double v = fi.vertex_count ? static_cast<double>(fi.vertex_count) : 1.0;
   auto per_vertex = [v](uint64_t n) { return 8.0 * static_cast<double>(n) / v; };
   const double bpv = per_vertex(fi.file_bytes);
-  const uint64_t side = fi.file_bytes - fi.connectivity_bytes - fi.geometry_bytes;  // header, framing, side sections
+  // Header, framing, references, metadata and the attribute streams' headers and tables.
+  uint64_t attribute_values = 0;
+  for (const AttributeInfo& a : fi.attributes) attribute_values += a.coded_bytes;
+  attribute_values = std::min(attribute_values, fi.attribute_bytes);
+  const uint64_t side = fi.file_bytes - fi.connectivity_bytes - fi.geometry_bytes - attribute_values;
   using ull = unsigned long long;
   r.json = strf("{\"file\": \"%s\", \"status\": \"ok\", \"format_version\": %u, \"bytes\": %llu, \"vertices\": %llu, "
                 "\"faces\": %llu, \"corners\": %llu, \"quantization_bits\": %d, \"level\": %d, \"segments\": %u, "
                 "\"bbox_min\": [%.9g, %.9g, %.9g], \"step\": %.9g, \"bits_per_vertex\": %.4f, "
                 "\"connectivity_bits_per_vertex\": %.4f, \"geometry_bits_per_vertex\": %.4f, "
-                "\"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
+                "\"attribute_bits_per_vertex\": %.4f, \"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
                 "\"triangle_runs\": %llu, \"marching_bits\": %llu, \"jump_edges\": %llu, \"stitches\": %llu, "
                 "\"virtual_vertices\": %llu, \"side_faces\": %llu, \"run_table_parts\": %llu, \"table_coded_attributes\": %llu, \"geometry_predictor\": \"%s\", "
                 "\"ancestors\": %d, \"lattice_planes\": [%u, %u, %u], \"sections\": [",
                 json_escape(input).c_str(), fi.format_version, static_cast<ull>(fi.file_bytes),
                 static_cast<ull>(fi.vertex_count), static_cast<ull>(fi.face_count), static_cast<ull>(fi.corner_count),
                 fi.quantization_bits, fi.level, fi.segment_count, fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2],
-                fi.step, bpv, per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side),
+                fi.step, bpv, per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(attribute_values),
+                per_vertex(side),
                 static_cast<ull>(fi.components), static_cast<ull>(fi.vertex_runs), static_cast<ull>(fi.triangle_runs),
                 static_cast<ull>(fi.marching_bits), static_cast<ull>(fi.jump_edges), static_cast<ull>(fi.stitches),
                 static_cast<ull>(fi.virtual_vertices), static_cast<ull>(fi.side_faces), static_cast<ull>(fi.run_table_parts),
@@ -693,13 +650,16 @@ FileResult info_one(const std::string& input) {
                    static_cast<ull>(si.stored_bytes), static_cast<ull>(si.raw_bytes));
   }
   r.json += "], \"attributes\": [";
-  for (size_t k = 0; k < mesh.attributes.size(); ++k) {
-    const Attribute& a = mesh.attributes[k];
+  for (size_t k = 0; k < fi.attributes.size(); ++k) {
+    const AttributeInfo& a = fi.attributes[k];
     const AttributeSummary as = summarize(a);
+    const uint64_t values = k < mesh.attributes.size() ? mesh.attributes[k].value_count() : 0;
     r.json += strf("%s{\"name\": \"%s\", \"kind\": \"%s\", \"domain\": \"%s\", \"type\": \"%s\", "
-                   "\"components\": %u, \"values\": %llu, \"coding\": \"%s\", \"bits\": %d}",
+                   "\"components\": %u, \"values\": %llu, \"coding\": \"%s\", \"bits\": %d, \"tables\": %s, "
+                   "\"bytes\": %llu, \"bits_per_vertex\": %.4f}",
                    k ? ", " : "", json_escape(a.name).c_str(), as.kind, as.domain, as.type, a.components,
-                   static_cast<ull>(a.value_count()), as.coding, as.bits);
+                   static_cast<ull>(values), a.coding.c_str(), a.bits, a.tables ? "true" : "false",
+                   static_cast<ull>(a.coded_bytes), per_vertex(a.coded_bytes));
   }
   r.json += "], \"metadata\": [";
   for (size_t k = 0; k < mesh.metadata.size(); ++k)
@@ -712,9 +672,14 @@ FileResult info_one(const std::string& input) {
   t += strf("  vertices %s, faces %s, corners %s, segments %u\n", thousands(fi.vertex_count).c_str(),
             thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
   t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
-  t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header, %sside data\n", bpv,
-            per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side),
-            mesh.attributes.empty() ? "" : "attributes and ");
+  if (fi.attributes.empty())
+    t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,
+              per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side));
+  else
+    t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f attributes + %.3f header and "
+              "side data\n",
+              bpv, per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(attribute_values),
+              per_vertex(side));
   t += strf("  topology: %s components, %s vertex runs, %s triangle runs, %s marching bits, %s jump edges,\n"
             "            %s stitches, %s virtual vertices, %s side faces\n",
             thousands(fi.components).c_str(), thousands(fi.vertex_runs).c_str(), thousands(fi.triangle_runs).c_str(),
@@ -730,7 +695,7 @@ FileResult info_one(const std::string& input) {
     t += strf(", lattice planes x %s, y %s, z %s", thousands(fi.lattice_planes[0]).c_str(),
               thousands(fi.lattice_planes[1]).c_str(), thousands(fi.lattice_planes[2]).c_str());
   t += "\n";
-  if (!mesh.attributes.empty()) {
+  if (!fi.attributes.empty()) {
     // Names are the file's own: keep each on one line.
     auto one_line = [](std::string n) {
       for (char& c : n)
@@ -738,19 +703,16 @@ FileResult info_one(const std::string& input) {
       return n;
     };
     size_t width = 9;
-    for (const Attribute& a : mesh.attributes) width = std::max(width, std::min<size_t>(one_line(a.name).size(), 40));
-    t += strf("  %-*s %-8s %-6s %-6s %12s  %s\n", static_cast<int>(width), "attribute", "kind", "domain", "type",
-              "values", "coded as");
-    for (const Attribute& a : mesh.attributes) {
+    for (const AttributeInfo& a : fi.attributes) width = std::max(width, std::min<size_t>(one_line(a.name).size(), 40));
+    t += strf("  %-*s %-8s %-6s %-6s %12s %12s %8s  %s\n", static_cast<int>(width), "attribute", "kind", "domain",
+              "type", "values", "bytes", "bits/v", "coded as");
+    for (size_t k = 0; k < fi.attributes.size(); ++k) {
+      const AttributeInfo& a = fi.attributes[k];
       const AttributeSummary as = summarize(a);
-      std::string coded = as.coding;
-      if (as.bits > 0 && std::string(as.coding) == "grid")
-        coded += strf(", %d bits (from the values)", as.bits);
-      else if (as.bits > 0)
-        coded += strf(", %d bits", as.bits);
-      t += strf("  %-*s %-8s %-6s %-6s %12s  %s\n", static_cast<int>(width), one_line(a.name).c_str(), as.kind,
-                as.domain, strf("%sx%u", as.type, a.components).c_str(), thousands(a.value_count()).c_str(),
-                coded.c_str());
+      const uint64_t values = k < mesh.attributes.size() ? mesh.attributes[k].value_count() : 0;
+      t += strf("  %-*s %-8s %-6s %-6s %12s %12s %8.3f  %s\n", static_cast<int>(width), one_line(a.name).c_str(),
+                as.kind, as.domain, strf("%sx%u", as.type, a.components).c_str(), thousands(values).c_str(),
+                thousands(a.coded_bytes).c_str(), per_vertex(a.coded_bytes), as.coding.c_str());
     }
   }
   if (!mesh.metadata.empty()) {

@@ -78,30 +78,67 @@ TEST_F(ToolOutput, InfoListsTheAttributes) {
   ASSERT_EQ(r.code, 0) << r.err;
   r = tsm("info " + q("a.tsm"));
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_TRUE(contains(r.out, "header, attributes and side data")) << r.out;
+  EXPECT_TRUE(contains(r.out, " attributes + ")) << r.out;
   EXPECT_TRUE(contains(r.out, "attribute  kind     domain type ")) << r.out;
+  EXPECT_TRUE(contains(r.out, "bits/v  coded as")) << r.out;
   EXPECT_TRUE(contains(r.out, "confidence generic  vertex f32x1")) << r.out;
-  EXPECT_TRUE(contains(r.out, "grid, 16 bits (from the values)")) << r.out;  // the default --generic-bits
+  EXPECT_TRUE(contains(r.out, "grid, 16 bits")) << r.out;  // the default --generic-bits, as the file says
   EXPECT_TRUE(contains(r.out, "label      generic  vertex u8x1")) << r.out;
-  EXPECT_TRUE(contains(r.out, "exact, 8 bits")) << r.out;
+  EXPECT_TRUE(contains(r.out, "  exact")) << r.out;
   r = tsm("info --json " + q("a.tsm"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.out, "\"attributes\": [{\"name\": \"confidence\", \"kind\": \"generic\", \"domain\": "
                               "\"vertex\", \"type\": \"f32\", \"components\": 1, \"values\": 642, \"coding\": "
-                              "\"grid\", \"bits\": 16}, {\"name\": \"label\""))
+                              "\"grid\", \"bits\": 16, \"tables\": false, \"bytes\": "))
       << r.out;
-  // Other bits are seen in the values.
+  // Other bits are what the file says.
   r = tsm("encode " + q("in.ply") + " -o " + q("b.tsm") + " --generic-bits 11");
   ASSERT_EQ(r.code, 0) << r.err;
   r = tsm("info " + q("b.tsm"));
-  EXPECT_TRUE(contains(r.out, "grid, 11 bits (from the values)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "grid, 11 bits")) << r.out;
   // A mesh without attributes says nothing about them.
   ASSERT_TRUE(tsm::write_mesh(dir.file("plain.ply"), tsm_test::icosphere(1)).ok());
   r = tsm("encode " + q("plain.ply") + " -o " + q("plain.tsm"));
   ASSERT_EQ(r.code, 0) << r.err;
   r = tsm("info " + q("plain.tsm"));
-  EXPECT_TRUE(contains(r.out, "+ 0.000 header, side data") || contains(r.out, " header, side data")) << r.out;
+  EXPECT_TRUE(contains(r.out, " geometry + ")) << r.out;
+  EXPECT_FALSE(contains(r.out, "attributes +")) << r.out;
   EXPECT_FALSE(contains(r.out, "attribute ")) << r.out;
+}
+
+// inspect() tells what each attribute's values cost: the costs add up to
+// the attribute streams less their headers and tables, and a noisy
+// attribute costs more than a constant one.
+TEST(Inspect, AttributeBytesAddUp) {
+  tsm::Mesh m = tsm_test::icosphere(4);
+  tsm::Attribute noisy, constant;
+  noisy.name = "noisy";
+  constant.name = "constant";
+  uint32_t x = 12345;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    x = x * 1664525u + 1013904223u;
+    noisy.values.push_back(static_cast<float>(x >> 8) / 16777216.0f);
+    constant.values.push_back(0.5f);
+  }
+  m.attributes = {noisy, constant};
+  for (int segment_faces : {0, 1000}) {
+    tsm::EncodeOptions o;
+    o.segment_faces = static_cast<uint32_t>(segment_faces);
+    std::string bytes;
+    ASSERT_TRUE(tsm::encode(m, o, bytes).ok());
+    tsm::FileInfo fi;
+    ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+    ASSERT_EQ(fi.attributes.size(), 2u);
+    EXPECT_EQ(fi.attributes[0].name, "noisy");
+    EXPECT_EQ(fi.attributes[0].coding, "grid");
+    EXPECT_EQ(fi.attributes[0].bits, 16);
+    const uint64_t sum = fi.attributes[0].coded_bytes + fi.attributes[1].coded_bytes;
+    EXPECT_LE(sum, fi.attribute_bytes + 8 * fi.segments.size());
+    EXPECT_GE(sum + 200 * fi.segments.size(), fi.attribute_bytes) << "headers cost more than expected";
+    // 16 random bits per vertex cannot be coded in fewer than ~15.
+    EXPECT_GT(fi.attributes[0].coded_bytes, 15 * m.vertex_count() / 8);
+    EXPECT_LT(fi.attributes[1].coded_bytes, m.vertex_count() / 8);
+  }
 }
 
 TEST_F(ToolOutput, DecodeWritesStlAndOffAndSaysWhatTheyDrop) {

@@ -988,6 +988,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     dec.tables = &tables;
   }
   if (in.table_coded) *in.table_coded = static_cast<uint32_t>(std::count(tabled.begin(), tabled.end(), 1));
+  if (in.header_bytes) *in.header_bytes = bytes.size() - r.remaining() - table_bytes;
+  if (in.costs) in.costs->clear();
   std::string_view coded;
   r.bytes(r.remaining(), coded);
   const size_t V = global.size();
@@ -1002,6 +1004,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (size_t i = 0; i < headers.size(); ++i) {
     const AttributeHeader& h = headers[i];
     dec.base = tabled[i] ? kAttributeTableContexts * static_cast<int>(i) : -1;
+    const uint64_t bits_before = 8 * dec.d.bytes_read() + dec.bits.bits_read();
     const uint32_t n = int_components(h);
     std::vector<int32_t> gn;
     std::vector<uint8_t> gh;
@@ -1038,6 +1041,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (dec.d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("stream is truncated");
     if (dec.bad_code) return corrupt("a residual of '" + h.name + "' is a code word no table has");
     if (dec.bits.overrun()) return corrupt("the table-coded bit stream is truncated");
+    if (in.costs) in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));
     for (size_t j = 0; j < x.size() / n; ++j) from_ints(h, &x[n * j], &a.values[h.components * j]);
     out.push_back(std::move(a));

@@ -70,12 +70,23 @@ uint32_t smallest_rotation(const uint32_t* corners, uint32_t n);
 // Decoder, one part: the attributes of its own vertices (output order), its
 // faces and corners (output order), each corner attribute with the part's own
 // value list.
+// What one attribute of a part cost (tsm info): its header and the bits its
+// values took in the coded stream (range-coded bytes read while decoding
+// it, exact to a few bytes, plus its table-coded bits).
+struct AttributeCost {
+  AttributeHeader header;
+  bool tables = false;
+  uint64_t coded_bits = 0;
+};
+
 struct AttributePart {
   const Mesh* faces = nullptr;                     // the part's decoded faces (part output ids)
   const std::vector<uint32_t>* global = nullptr;   // per part vertex: kNone own, else a reference
   const std::vector<uint32_t>* q = nullptr;        // own vertices' grid indices
   bool segmented = false;                          // a segment's payload (may name earlier values)
   uint32_t* table_coded = nullptr;                 // out (optional): attributes with table-coded residuals
+  std::vector<AttributeCost>* costs = nullptr;     // out (optional): what each attribute cost, in file order
+  uint64_t* header_bytes = nullptr;                // out (optional): bytes before the coded values
 };
 // `alias` (optional) gets per attribute, per value of the part's value list,
 // the id in the file's value list of an earlier segment's value it stands

@@ -99,6 +99,8 @@ struct DecodedPart {
   ConnectivityStats cstats;
   GeometryStats gstats;
   uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
+  std::vector<AttributeCost> attribute_costs;  // filled for inspect() only
+  bool want_costs = false;
   Status status;
 };
 
@@ -127,6 +129,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.q = &out.q;
   ap.segmented = s.segmented;
   ap.table_coded = &out.table_coded_attributes;
+  if (out.want_costs) ap.costs = &out.attribute_costs;
   return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
 }
 
@@ -273,8 +276,9 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
 }
 
 Status decode_parts(const Header& h, std::vector<Section>& sections, int threads, std::vector<DecodedPart>& parts,
-                    std::vector<PartStreams>& streams) {
+                    std::vector<PartStreams>& streams, bool attribute_costs = false) {
   TSM_RETURN_IF_ERROR(collect_parts(h, sections, streams, parts));
+  for (DecodedPart& p : parts) p.want_costs = attribute_costs;
   std::vector<uint64_t> earlier(parts.size(), 0);
   for (size_t k = 1; k < parts.size(); ++k)
     earlier[k] = earlier[k - 1] + parts[k - 1].counts.vertex_count - parts[k - 1].counts.reference_count;
@@ -309,6 +313,32 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   return Status::Ok();
 }
 
+namespace {
+
+// Sums one part's attribute costs into the file's list (every part codes the
+// same attributes in the same order; a part without attributes adds none).
+void add_attribute_costs(const std::vector<AttributeCost>& costs, std::vector<AttributeInfo>& out) {
+  static const char* const kCodings[3] = {"exact", "grid", "octahedral"};
+  for (size_t i = 0; i < costs.size(); ++i) {
+    const AttributeHeader& h = costs[i].header;
+    if (i == out.size()) {
+      AttributeInfo a;
+      a.name = h.name;
+      a.kind = h.kind;
+      a.domain = h.domain;
+      a.type = h.type;
+      a.components = h.components;
+      a.coding = kCodings[static_cast<size_t>(h.quant) % 3];
+      a.bits = h.quant == AttributeQuant::exact ? 0 : h.bits;
+      out.push_back(a);
+    }
+    out[i].tables = out[i].tables || costs[i].tables;
+    out[i].coded_bytes += (costs[i].coded_bits + 7) / 8;
+  }
+}
+
+}  // namespace
+
 Status inspect(std::string_view bytes, FileInfo& info) {
   info = FileInfo();
   Header h;
@@ -335,9 +365,11 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   }
   std::vector<DecodedPart> parts;
   std::vector<PartStreams> streams;
-  TSM_RETURN_IF_ERROR(decode_parts(h, sections, 1, parts, streams));
+  TSM_RETURN_IF_ERROR(decode_parts(h, sections, 1, parts, streams, true));
   for (size_t k = 0; k < parts.size(); ++k) {
     const PartStreams& s = streams[k];
+    info.attribute_bytes += s.attributes.size();
+    add_attribute_costs(parts[k].attribute_costs, info.attributes);
     info.connectivity_bytes += s.vertex_tree.size() + s.triangle_tree.size() + s.topology.size();
     info.geometry_bytes += s.geometry.size();
     info.reference_bytes += s.references.size();

@@ -42,7 +42,7 @@ std::string RangeEncoder::finish() {
 }
 
 void RangeDecoder::init(std::string_view data) {
-  p_ = reinterpret_cast<const uint8_t*>(data.data());
+  begin_ = p_ = reinterpret_cast<const uint8_t*>(data.data());
   end_ = p_ + data.size();
   range_ = 0xFFFFFFFFu;
   code_ = 0;

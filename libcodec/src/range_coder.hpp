@@ -162,6 +162,9 @@ class RangeDecoder {
   // end of a stream; callers compare against kMaxOverrun).
   uint64_t overrun() const { return overrun_; }
   static constexpr uint64_t kMaxOverrun = 8;
+  // Bytes taken from the data so far (past its end too): the coder reads 4
+  // ahead, so differences between two points are exact to a few bytes.
+  uint64_t bytes_read() const { return static_cast<uint64_t>(p_ - begin_) + overrun_; }
 
  private:
   uint32_t next_byte() {
@@ -169,6 +172,7 @@ class RangeDecoder {
     ++overrun_;
     return 0;
   }
+  const uint8_t* begin_ = nullptr;
   const uint8_t* p_ = nullptr;
   const uint8_t* end_ = nullptr;
   uint32_t range_ = 0xFFFFFFFFu;

@@ -158,6 +158,7 @@ class BitReader {
     consumed_ += static_cast<uint64_t>(n);
   }
   bool overrun() const { return consumed_ > limit_; }
+  uint64_t bits_read() const { return consumed_; }
 
  private:
   const uint8_t* p_ = nullptr;

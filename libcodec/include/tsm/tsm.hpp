@@ -89,6 +89,18 @@ struct SegmentSummary {
   uint64_t references = 0;  // vertices of earlier segments it uses
   uint64_t faces = 0;
 };
+// One attribute as the file codes it (tsm info), summed over the parts.
+struct AttributeInfo {
+  std::string name;
+  AttributeKind kind = AttributeKind::generic;
+  AttributeDomain domain = AttributeDomain::vertex;
+  AttributeType type = AttributeType::f32;
+  uint32_t components = 1;
+  std::string coding;      // "exact" (integers), "grid" or "octahedral" (normals)
+  int bits = 0;            // grid and octahedral: bits per component; exact: 0
+  bool tables = false;     // residuals through static prefix codes in some part
+  uint64_t coded_bytes = 0;  // its values in the coded stream (to a few bytes per part)
+};
 struct FileInfo {
   uint32_t format_version = 0;  // the header's (a file this library reads says 12)
   uint64_t vertex_count = 0;
@@ -113,6 +125,8 @@ struct FileInfo {
   // Stored bytes by kind; other = header, framing, references, side data.
   uint64_t connectivity_bytes = 0, geometry_bytes = 0, other_bytes = 0;
   uint64_t reference_bytes = 0;  // part of other: the segments' references streams
+  uint64_t attribute_bytes = 0;  // part of other: the attribute streams (headers, tables, values)
+  std::vector<AttributeInfo> attributes;
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
