@@ -1,7 +1,7 @@
 /* Stand-in for zstd's decompressor in the WebAssembly build, used only when
  * web/build.sh cannot get zstd's sources from Debian's source package. The
  * tsm encoder never writes zstd-coded sections; a file that has one is refused
- * (container.cpp reports the section as not decodable). */
+ * (container_read.cpp reports the section as not decodable). */
 #include <stddef.h>
 
 #define TSM_ZSTD_STUB_ERROR ((size_t)-1)
