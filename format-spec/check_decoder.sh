@@ -5,7 +5,8 @@
 # Usage: check_decoder.sh [TSM_BINARY] [WORK_DIR]
 #   TSM_BINARY: the tsm CLI (default: $TSM, else ../build/release/cli/tsm)
 #   CORPUS=DIR: the corpus folder (default: ../../shared/corpus); missing corpus
-#               files are skipped with a note
+#               files are skipped with a note, or fail the check when CI is set
+#               (to anything but empty, 0 or false)
 #
 # How the outputs are compared (one line per case, IDENTICAL or DIFFERENT):
 # * every case: `tsm decode X.tsm -o X.ply` (binary PLY) against the PLY that
@@ -91,9 +92,12 @@ forged() {  # name command...: runs a forging command; its failure is a failed c
   if "$@"; then return 0; fi
   echo "$name: forging failed"; result "$name" 1; return 1
 }
+in_ci() { case "${CI:-}" in ""|0|false) return 1 ;; *) return 0 ;; esac; }
 corpus_case() {  # check-function name file q level [segment_faces]
   fn=$1; shift
-  if [ -f "$2" ]; then "$fn" "$@"; else echo "$1: skipped, $2 not found"; fi
+  if [ -f "$2" ]; then "$fn" "$@"
+  elif in_ci; then echo "$1: FAILED, $2 not found (in CI the corpus must be there)"; result "$1" 1
+  else echo "$1: skipped, $2 not found"; fi
 }
 
 # ---- connectivity and geometry
@@ -154,6 +158,8 @@ forged metadata_none $meta "$work/triangle.tsm" "$work/metadata_none.tsm" --raw 
 if command -v zstd > /dev/null; then  # codec 1: checked if python3 has the zstandard module, else skipped
   forged metadata_zstd $meta "$work/mixed_l6.tsm" "$work/metadata_zstd.tsm" --zstd \
     "gltf=$(head -c 3000 "$work/mixed.obj")" && compare_file metadata_zstd
+elif in_ci; then
+  echo "metadata_zstd: FAILED, no zstd command (scripts/setup.sh installs it)"; result metadata_zstd 1
 else
   echo "metadata_zstd: skipped, no zstd command"
 fi

@@ -15,7 +15,7 @@ PACKAGES=(
   libcli11-dev
   # tests (and the sanitizer build's runtime comes with gcc); python3 runs the
   # format spec's independent reference decoder (format-spec/check_decoder.sh)
-  libgtest-dev python3 python3-zstandard
+  libgtest-dev python3 python3-zstandard zstd
   # comparison (optional at build time; the bench shows its columns when present)
   libdraco-dev draco
   # fuzzers (clang's libFuzzer)
