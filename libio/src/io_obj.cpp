@@ -840,12 +840,7 @@ bool drop_obj_face_labels(Mesh& mesh, WriteInfo* info) {
 }
 
 Status write_obj(const Mesh& mesh, std::string& out, WriteInfo* info) {
-  std::string why;
-  if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write OBJ: invalid mesh: " + why);
-  for (size_t f = 0; f < mesh.face_count(); ++f)
-    if (mesh.face_size(f) == 0)
-      return Status(ErrorCode::invalid_argument,
-                    "cannot write OBJ: face " + std::to_string(f) + " has no corners (OBJ cannot express it)");
+  TSM_RETURN_IF_ERROR(check_faces_writable(mesh, "OBJ"));
   // What OBJ can hold: one vt list, one vn list, r g b per vertex, and the
   // object, group, material and smoothing group of each face.
   const Attribute* tex = nullptr;

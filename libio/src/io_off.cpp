@@ -446,12 +446,7 @@ char* put_number(char* p, char* end, float x, bool mark_float) {
 }  // namespace
 
 Status write_off(const Mesh& mesh, const WriteOptions& /*options*/, std::string& out, WriteInfo* info) {
-  std::string why;
-  if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "cannot write OFF: invalid mesh: " + why);
-  for (size_t f = 0; f < mesh.face_count(); ++f)
-    if (mesh.face_size(f) == 0)
-      return Status(ErrorCode::invalid_argument,
-                    "cannot write OFF: face " + std::to_string(f) + " has no corners (OFF cannot express it)");
+  TSM_RETURN_IF_ERROR(check_faces_writable(mesh, "OFF"));
   // What OFF holds: one vertex normal, colour and texture coordinate pair,
   // and a face colour.
   const Attribute* nrm = nullptr;

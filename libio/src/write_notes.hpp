@@ -16,6 +16,19 @@ inline const char* domain_word(AttributeDomain d) {
   return "unknown";
 }
 
+// The check every text writer starts with: a valid mesh whose every face
+// has a corner (a face of none has no line to be written as).
+inline Status check_faces_writable(const Mesh& mesh, const char* format) {
+  std::string why;
+  if (!mesh.valid(&why))
+    return Status(ErrorCode::invalid_argument, std::string("cannot write ") + format + ": invalid mesh: " + why);
+  for (size_t f = 0; f < mesh.face_count(); ++f)
+    if (mesh.face_size(f) == 0)
+      return Status(ErrorCode::invalid_argument, std::string("cannot write ") + format + ": face " + std::to_string(f) +
+                                                     " has no corners (" + format + " cannot express it)");
+  return Status::Ok();
+}
+
 // "vertex attribute 'confidence'", with line ends shown as blanks so that a
 // note stays on one line.
 inline std::string attribute_words(const Attribute& a) {
