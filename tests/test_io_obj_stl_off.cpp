@@ -911,3 +911,23 @@ TEST(StlWriter, WriteMeshByExtension) {
 }
 
 }  // namespace
+
+// A face without corners cannot be written as an OBJ or OFF line: both
+// writers refuse the mesh, naming the face, instead of writing an empty line
+// that would read back as another mesh.
+TEST(TextWriters, RefuseAFaceWithoutCorners) {
+  Mesh m;
+  m.add_vertex(0, 0, 0);
+  m.add_vertex(1, 0, 0);
+  m.add_vertex(0, 1, 0);
+  m.add_triangle(0, 1, 2);
+  m.face_offsets.push_back(m.face_offsets.back());  // face 1: no corners
+  ASSERT_TRUE(m.valid());
+  std::string out;
+  tsm::Status s = tsm::write_obj(m, out);
+  EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
+  EXPECT_TRUE(tsm_test::contains(s.message(), "cannot write OBJ: face 1 has no corners")) << s.to_string();
+  s = tsm::write_off(m, tsm::WriteOptions(), out);
+  EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
+  EXPECT_TRUE(tsm_test::contains(s.message(), "cannot write OFF: face 1 has no corners")) << s.to_string();
+}
