@@ -16,6 +16,8 @@ PACKAGES=(
   # tests (and the sanitizer build's runtime comes with gcc); python3 runs the
   # format spec's independent reference decoder (format-spec/check_decoder.sh)
   libgtest-dev python3 python3-zstandard zstd
+  # the Python module tsmcodec (python/) and its tests, for Debian's python3
+  pybind11-dev python3-numpy python3-pytest
   # comparison (optional at build time; the bench shows its columns when present)
   libdraco-dev draco
   # fuzzers (clang's libFuzzer)

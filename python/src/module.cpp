@@ -1,0 +1,327 @@
+// tsmcodec._tsmcodec: the Python binding of tsm (pybind11, numpy arrays).
+// Positions are float32 (N, 3), faces (M, k) integer arrays or a flat
+// `indices` with `face_offsets` for mixed polygons. Errors raise
+// tsmcodec.Error with the library's message. The GIL is released while the
+// library codes, reads or writes.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
+#include "tsm/version.h"
+
+namespace py = pybind11;
+
+namespace {
+
+struct TsmError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void check(const tsm::Status& status) {
+  if (!status.ok()) throw TsmError(status.message());
+}
+
+const char* kind_name(tsm::AttributeKind k) {
+  switch (k) {
+    case tsm::AttributeKind::normal: return "normal";
+    case tsm::AttributeKind::color: return "color";
+    case tsm::AttributeKind::texcoord: return "texcoord";
+    default: return "generic";
+  }
+}
+tsm::AttributeKind kind_from(const std::string& s) {
+  if (s == "normal") return tsm::AttributeKind::normal;
+  if (s == "color") return tsm::AttributeKind::color;
+  if (s == "texcoord") return tsm::AttributeKind::texcoord;
+  if (s == "generic") return tsm::AttributeKind::generic;
+  throw py::value_error("attribute kind must be 'generic', 'normal', 'color' or 'texcoord', not '" + s + "'");
+}
+const char* domain_name(tsm::AttributeDomain d) {
+  switch (d) {
+    case tsm::AttributeDomain::face: return "face";
+    case tsm::AttributeDomain::corner: return "corner";
+    default: return "vertex";
+  }
+}
+tsm::AttributeDomain domain_from(const std::string& s) {
+  if (s == "vertex") return tsm::AttributeDomain::vertex;
+  if (s == "face") return tsm::AttributeDomain::face;
+  if (s == "corner") return tsm::AttributeDomain::corner;
+  throw py::value_error("attribute domain must be 'vertex', 'face' or 'corner', not '" + s + "'");
+}
+const char* type_name(tsm::AttributeType t) {
+  switch (t) {
+    case tsm::AttributeType::u8: return "u8";
+    case tsm::AttributeType::u16: return "u16";
+    case tsm::AttributeType::i32: return "i32";
+    default: return "f32";
+  }
+}
+tsm::AttributeType type_from(const std::string& s) {
+  if (s == "f32") return tsm::AttributeType::f32;
+  if (s == "u8") return tsm::AttributeType::u8;
+  if (s == "u16") return tsm::AttributeType::u16;
+  if (s == "i32") return tsm::AttributeType::i32;
+  throw py::value_error("attribute type must be 'f32', 'u8', 'u16' or 'i32', not '" + s + "'");
+}
+
+template <typename T>
+py::array_t<T> to_array(const std::vector<T>& v, size_t cols) {
+  size_t rows = cols ? v.size() / cols : 0;
+  py::array_t<T> a = cols == 1 ? py::array_t<T>(rows) : py::array_t<T>({rows, cols});
+  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+  return a;
+}
+
+// Integer indices of any numpy integer type, checked to fit uint32.
+std::vector<uint32_t> to_indices(const py::handle& obj, const char* what, py::ssize_t* cols) {
+  auto a = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(obj);
+  if (!a) throw py::type_error(std::string(what) + " must be an integer array");
+  if (cols) {
+    if (a.ndim() != 2) throw py::value_error(std::string(what) + " must be 2-dimensional (faces, corners)");
+    *cols = a.shape(1);
+  } else if (a.ndim() != 1) {
+    throw py::value_error(std::string(what) + " must be 1-dimensional");
+  }
+  std::vector<uint32_t> out(size_t(a.size()));
+  const int64_t* p = a.data();
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (p[i] < 0 || p[i] > int64_t(UINT32_MAX))
+      throw py::value_error(std::string(what) + ": index " + std::to_string(p[i]) + " out of range");
+    out[i] = uint32_t(p[i]);
+  }
+  return out;
+}
+
+std::vector<float> to_floats(const py::handle& obj, const char* what, py::ssize_t want_cols, py::ssize_t* cols) {
+  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(obj);
+  if (!a) throw py::type_error(std::string(what) + " must be a float array");
+  py::ssize_t c = a.ndim() == 1 ? 1 : a.ndim() == 2 ? a.shape(1) : -1;
+  if (c < 0) throw py::value_error(std::string(what) + " must be 1- or 2-dimensional");
+  if (want_cols && (a.ndim() != 2 || c != want_cols))
+    throw py::value_error(std::string(what) + " must have shape (n, " + std::to_string(want_cols) + ")");
+  if (cols) *cols = c;
+  return std::vector<float>(a.data(), a.data() + a.size());
+}
+
+tsm::Mesh make_mesh(const py::handle& positions, const py::handle& faces, const py::handle& face_offsets) {
+  tsm::Mesh mesh;
+  mesh.positions = to_floats(positions, "positions", 3, nullptr);
+  if (face_offsets.is_none()) {
+    py::ssize_t k = 0;
+    mesh.indices = to_indices(faces, "faces", &k);
+    if (k < 3 && !mesh.indices.empty()) throw py::value_error("faces need at least 3 corners each");
+    size_t m = k ? mesh.indices.size() / size_t(k) : 0;
+    mesh.face_offsets.resize(m + 1);
+    for (size_t f = 0; f <= m; ++f) mesh.face_offsets[f] = uint32_t(f * size_t(k));
+  } else {
+    mesh.indices = to_indices(faces, "indices", nullptr);
+    mesh.face_offsets = to_indices(face_offsets, "face_offsets", nullptr);
+  }
+  return mesh;
+}
+
+void add_attribute(tsm::Mesh& mesh, const std::string& name, const py::handle& values, const std::string& kind,
+                   const std::string& domain, const std::string& type, const py::handle& indices) {
+  tsm::Attribute a;
+  a.name = name;
+  a.kind = kind_from(kind);
+  a.domain = domain_from(domain);
+  a.type = type_from(type);
+  py::ssize_t cols = 1;
+  a.values = to_floats(values, "attribute values", 0, &cols);
+  a.components = uint32_t(cols);
+  if (!indices.is_none()) a.indices = to_indices(indices, "attribute indices", nullptr);
+  mesh.attributes.push_back(std::move(a));
+}
+
+std::string_view view_of(const py::buffer_info& b) {
+  return std::string_view(static_cast<const char*>(b.ptr), size_t(b.size * b.itemsize));
+}
+
+tsm::EncodeOptions encode_options(int quantization_bits, int level, uint32_t segment_faces, int threads) {
+  tsm::EncodeOptions o;
+  o.quantization_bits = quantization_bits;
+  o.level = level;
+  o.segment_faces = segment_faces;
+  o.threads = threads;
+  return o;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_tsmcodec, m) {
+  m.doc() = "tsm triangle-mesh compression (binding of the C++ library)";
+  m.attr("__version__") = TSM_VERSION_STRING;
+  py::register_exception<TsmError>(m, "Error");
+
+  py::class_<tsm::Attribute>(m, "Attribute")
+      .def_readonly("name", &tsm::Attribute::name)
+      .def_property_readonly("kind", [](const tsm::Attribute& a) { return kind_name(a.kind); })
+      .def_property_readonly("domain", [](const tsm::Attribute& a) { return domain_name(a.domain); })
+      .def_property_readonly("type", [](const tsm::Attribute& a) { return type_name(a.type); })
+      .def_readonly("components", &tsm::Attribute::components)
+      .def_property_readonly("values", [](const tsm::Attribute& a) { return to_array(a.values, a.components); })
+      .def_property_readonly("indices", [](const tsm::Attribute& a) { return to_array(a.indices, 1); })
+      .def("__repr__", [](const tsm::Attribute& a) {
+        return "<tsmcodec.Attribute '" + a.name + "' " + kind_name(a.kind) + " " + domain_name(a.domain) + " x" +
+               std::to_string(a.components) + ">";
+      });
+
+  py::class_<tsm::Mesh>(m, "Mesh")
+      .def(py::init([](const py::handle& positions, const py::handle& faces, const py::handle& face_offsets) {
+             return make_mesh(positions, faces, face_offsets);
+           }),
+           py::arg("positions"), py::arg("faces"), py::arg("face_offsets") = py::none(),
+           "Mesh(positions (N,3) float, faces (M,k) int) or Mesh(positions, indices, face_offsets) for mixed polygons")
+      .def("add_attribute", &add_attribute, py::arg("name"), py::arg("values"), py::arg("kind") = "generic",
+           py::arg("domain") = "vertex", py::arg("type") = "f32", py::arg("indices") = py::none())
+      .def_property_readonly("vertex_count", [](const tsm::Mesh& mm) { return mm.vertex_count(); })
+      .def_property_readonly("face_count", [](const tsm::Mesh& mm) { return mm.face_count(); })
+      .def_property_readonly("positions", [](const tsm::Mesh& mm) { return to_array(mm.positions, 3); })
+      .def_property_readonly("indices", [](const tsm::Mesh& mm) { return to_array(mm.indices, 1); })
+      .def_property_readonly("face_offsets", [](const tsm::Mesh& mm) { return to_array(mm.face_offsets, 1); })
+      .def_property_readonly(
+          "faces",
+          [](const tsm::Mesh& mm) {
+            size_t f = mm.face_count();
+            size_t k = f ? mm.face_offsets[1] - mm.face_offsets[0] : 3;
+            for (size_t i = 0; i < f; ++i)
+              if (mm.face_offsets[i + 1] - mm.face_offsets[i] != k)
+                throw py::value_error("faces of different sizes: use indices and face_offsets");
+            return to_array(mm.indices, k);
+          },
+          "(M, k) uint32 when every face has k corners (k = 3: triangles)")
+      .def_readonly("attributes", &tsm::Mesh::attributes)
+      .def_property_readonly("metadata",
+                             [](const tsm::Mesh& mm) {
+                               py::dict d;
+                               for (const auto& e : mm.metadata) d[py::str(e.key)] = py::bytes(e.value);
+                               return d;
+                             })
+      .def("__repr__", [](const tsm::Mesh& mm) {
+        return "<tsmcodec.Mesh " + std::to_string(mm.vertex_count()) + " vertices, " +
+               std::to_string(mm.face_count()) + " faces, " + std::to_string(mm.attributes.size()) + " attributes>";
+      });
+
+  m.def(
+      "encode",
+      [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads) {
+        std::string out;
+        {
+          py::gil_scoped_release release;
+          check(tsm::encode(mesh, encode_options(quantization_bits, level, segment_faces, threads), out));
+        }
+        return py::bytes(out);
+      },
+      py::arg("mesh"), py::kw_only(), py::arg("quantization_bits") = tsm::kDefaultQuantizationBits,
+      py::arg("level") = tsm::kDefaultLevel, py::arg("segment_faces") = 0, py::arg("threads") = 0,
+      "Encodes a Mesh; returns the .tsm bytes");
+  m.def(
+      "encode",
+      [](const py::handle& positions, const py::handle& faces, const py::handle& attributes, int quantization_bits,
+         int level, uint32_t segment_faces, int threads) {
+        tsm::Mesh mesh = make_mesh(positions, faces, py::none());
+        if (!attributes.is_none()) {
+          for (auto item : py::reinterpret_borrow<py::dict>(attributes)) {
+            std::string name = py::str(item.first);
+            std::string kind = name == "normal" || name == "color" || name == "texcoord" ? name : "generic";
+            add_attribute(mesh, name, item.second, kind, "vertex", "f32", py::none());
+          }
+        }
+        std::string out;
+        {
+          py::gil_scoped_release release;
+          check(tsm::encode(mesh, encode_options(quantization_bits, level, segment_faces, threads), out));
+        }
+        return py::bytes(out);
+      },
+      py::arg("positions"), py::arg("faces"), py::arg("attributes") = py::none(), py::kw_only(),
+      py::arg("quantization_bits") = tsm::kDefaultQuantizationBits, py::arg("level") = tsm::kDefaultLevel,
+      py::arg("segment_faces") = 0, py::arg("threads") = 0,
+      "Encodes positions (N,3) and faces (M,k), with optional per-vertex attributes {name: (N,c) array} "
+      "('normal', 'color', 'texcoord' by name, others generic)");
+
+  m.def(
+      "decode",
+      [](py::buffer data, int threads, uint64_t max_vertices, uint64_t max_faces) {
+        py::buffer_info b = data.request();
+        tsm::DecodeOptions o;
+        o.threads = threads;
+        o.max_vertices = max_vertices;
+        o.max_faces = max_faces;
+        tsm::Mesh mesh;
+        {
+          py::gil_scoped_release release;
+          check(tsm::decode(view_of(b), mesh, o));
+        }
+        return mesh;
+      },
+      py::arg("data"), py::kw_only(), py::arg("threads") = 0, py::arg("max_vertices") = 0, py::arg("max_faces") = 0,
+      "Decodes .tsm bytes into a Mesh");
+
+  m.def(
+      "read",
+      [](const std::string& path) {
+        tsm::Mesh mesh;
+        {
+          py::gil_scoped_release release;
+          check(tsm::read_mesh(path, mesh));
+        }
+        return mesh;
+      },
+      py::arg("path"), "Reads a PLY, OBJ, STL, OFF or glTF/GLB file into a Mesh (format from content, then extension)");
+  m.def(
+      "write",
+      [](const std::string& path, const tsm::Mesh& mesh, bool ascii) {
+        tsm::WriteOptions o;
+        o.ascii = ascii;
+        py::gil_scoped_release release;
+        check(tsm::write_mesh(path, mesh, o));
+      },
+      py::arg("path"), py::arg("mesh"), py::kw_only(), py::arg("ascii") = false,
+      "Writes a Mesh by extension (.ply, .obj, .stl, .off, .gltf, .glb)");
+
+  m.def(
+      "info",
+      [](py::buffer data) {
+        py::buffer_info b = data.request();
+        tsm::FileInfo fi;
+        {
+          py::gil_scoped_release release;
+          check(tsm::inspect(view_of(b), fi));
+        }
+        py::dict d;
+        d["format_version"] = fi.format_version;
+        d["vertex_count"] = fi.vertex_count;
+        d["face_count"] = fi.face_count;
+        d["corner_count"] = fi.corner_count;
+        d["quantization_bits"] = fi.quantization_bits;
+        d["level"] = fi.level;
+        d["segment_count"] = fi.segment_count;
+        d["file_bytes"] = fi.file_bytes;
+        d["connectivity_bytes"] = fi.connectivity_bytes;
+        d["geometry_bytes"] = fi.geometry_bytes;
+        d["attribute_bytes"] = fi.attribute_bytes;
+        py::list attrs;
+        for (const auto& a : fi.attributes) {
+          py::dict ad;
+          ad["name"] = a.name;
+          ad["kind"] = kind_name(a.kind);
+          ad["domain"] = domain_name(a.domain);
+          ad["components"] = a.components;
+          ad["coding"] = a.coding;
+          ad["bits"] = a.bits;
+          attrs.append(ad);
+        }
+        d["attributes"] = attrs;
+        return d;
+      },
+      py::arg("data"), "What a .tsm file holds (counts, options, sizes), as a dict");
+}

@@ -1,0 +1,131 @@
+"""tsmcodec against the library and the tsm tool (TSM_CLI: the built tool)."""
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import tsmcodec
+
+
+def grid(n=12):
+    xs, ys = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
+    zs = ((xs * ys) % 5).astype(np.float32) * 0.3
+    positions = np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)
+    faces = []
+    for y in range(n):
+        for x in range(n):
+            a = y * (n + 1) + x
+            b, c = a + 1, a + n + 1
+            faces += [(a, b, c + 1), (a, c + 1, c)]
+    return positions, np.array(faces, dtype=np.int32)
+
+
+def test_round_trip_triangles():
+    positions, faces = grid()
+    data = tsmcodec.encode(positions, faces)
+    assert isinstance(data, bytes)
+    mesh = tsmcodec.decode(data)
+    assert mesh.vertex_count == len(positions)
+    assert mesh.face_count == len(faces)
+    assert mesh.positions.dtype == np.float32 and mesh.positions.shape == positions.shape
+    assert mesh.faces.dtype == np.uint32 and mesh.faces.shape == faces.shape
+    # Positions come back on the quantization grid, close to what went in,
+    # as the same set of triangles over the same positions.
+    got = {tuple(sorted(tuple(np.round(mesh.positions[v], 3)) for v in f)) for f in mesh.faces}
+    want = {tuple(sorted(tuple(np.round(positions[v], 3)) for v in f)) for f in faces}
+    assert got == want
+
+
+def test_face_index_types_give_the_same_bytes():
+    positions, faces = grid(6)
+    ref = tsmcodec.encode(positions, faces)
+    assert tsmcodec.encode(positions, faces.astype(np.uint32)) == ref
+    assert tsmcodec.encode(positions.astype(np.float64), faces.astype(np.int64)) == ref
+    assert tsmcodec.encode(tsmcodec.Mesh(positions, faces)) == ref
+
+
+def test_vertex_attributes():
+    positions, faces = grid(6)
+    colors = np.random.default_rng(1).random((len(positions), 3), dtype=np.float32)
+    data = tsmcodec.encode(positions, faces, {"color": colors, "weight": positions[:, 0] * 2})
+    mesh = tsmcodec.decode(data)
+    names = {a.name: a for a in mesh.attributes}
+    assert names["color"].kind == "color" and names["color"].values.shape == (len(positions), 3)
+    assert names["weight"].kind == "generic" and names["weight"].components == 1
+    assert tsmcodec.info(data)["attributes"][0]["name"] in ("color", "weight")
+
+
+def test_options_and_info():
+    positions, faces = grid()
+    small = tsmcodec.encode(positions, faces, quantization_bits=8, level=9)
+    info = tsmcodec.info(small)
+    assert info["quantization_bits"] == 8 and info["level"] == 9
+    assert info["vertex_count"] == len(positions) and info["face_count"] == len(faces)
+    assert info["file_bytes"] == len(small)
+
+
+def test_errors_raise_with_the_library_message():
+    with pytest.raises(tsmcodec.Error) as e:
+        tsmcodec.decode(b"not a tsm file at all")
+    assert str(e.value)
+    positions, faces = grid(2)
+    with pytest.raises(tsmcodec.Error):
+        tsmcodec.encode(positions, faces, quantization_bits=99)
+    with pytest.raises(ValueError):
+        tsmcodec.encode(positions[:, :2], faces)
+    with pytest.raises(ValueError):
+        tsmcodec.encode(positions, -faces - 1)
+    with pytest.raises(tsmcodec.Error):
+        tsmcodec.read("/nonexistent/mesh.ply")
+
+
+def test_read_write_files(tmp_path):
+    positions, faces = grid(4)
+    mesh = tsmcodec.decode(tsmcodec.encode(positions, faces))
+    for ext in (".ply", ".obj", ".off", ".stl", ".glb"):
+        path = str(tmp_path / ("m" + ext))
+        tsmcodec.write(path, mesh)
+        back = tsmcodec.read(path)
+        assert back.face_count == len(faces), ext
+
+
+def test_mixed_polygons():
+    positions = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], dtype=np.float32)
+    indices = np.array([0, 1, 2, 3, 1, 4, 2], dtype=np.uint32)
+    offsets = np.array([0, 4, 7], dtype=np.uint32)
+    mesh = tsmcodec.decode(tsmcodec.encode(tsmcodec.Mesh(positions, indices, offsets)))
+    assert mesh.face_count == 2
+    assert list(np.diff(mesh.face_offsets)) == [4, 3]
+    with pytest.raises(ValueError):
+        mesh.faces
+
+
+def test_threads_code_in_parallel():
+    positions, faces = grid(40)
+    ref = tsmcodec.encode(positions, faces)
+    out = [None] * 4
+
+    def work(i):
+        out[i] = tsmcodec.encode(positions, faces, threads=1)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(o == ref for o in out)
+
+
+@pytest.mark.skipif(not os.environ.get("TSM_CLI"), reason="TSM_CLI (the tsm tool) not given")
+@pytest.mark.parametrize("args,kwargs", [([], {}), (["-q", "10", "-l", "2"], {"quantization_bits": 10, "level": 2})])
+def test_bytes_equal_the_tools(tmp_path, args, kwargs):
+    positions, faces = grid(20)
+    ply = str(tmp_path / "grid.ply")
+    tsmcodec.write(ply, tsmcodec.Mesh(positions, faces))
+    out = str(tmp_path / "grid.tsm")
+    subprocess.run([os.environ["TSM_CLI"], "encode", ply, "-o", out] + args, check=True, capture_output=True)
+    with open(out, "rb") as f:
+        tool = f.read()
+    assert tsmcodec.encode(tsmcodec.read(ply), **kwargs) == tool

@@ -1,0 +1,13 @@
+"""tsmcodec: tsm triangle-mesh compression for Python (numpy arrays in and out).
+
+    import numpy as np, tsmcodec
+    data = tsmcodec.encode(positions, faces)          # bytes, as `tsm encode` writes
+    mesh = tsmcodec.decode(data)                      # mesh.positions (N,3) float32, mesh.faces (M,3) uint32
+    mesh = tsmcodec.read("bunny.ply"); tsmcodec.write("bunny.obj", mesh)
+    tsmcodec.info(data)["face_count"]
+
+Errors raise tsmcodec.Error with the library's message.
+"""
+from ._tsmcodec import Attribute, Error, Mesh, __version__, decode, encode, info, read, write
+
+__all__ = ["Attribute", "Error", "Mesh", "__version__", "decode", "encode", "info", "read", "write"]
