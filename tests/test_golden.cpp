@@ -146,7 +146,7 @@ Mesh attributes_mesh() {
   for (size_t f = 0; f < F; ++f) region.values.push_back(static_cast<float>(f / 40));
   m.attributes.push_back(region);
   m.metadata = {{"gltf", R"({"asset":{"version":"2.0","generator":"tsm golden files"}})"},
-                {"note", std::string("bytes \x00\x01\xff kept as given", 25)}};
+                {"note", std::string("bytes \x00\x01\xff kept as given\x00\x00", 25)}};
   return m;
 }
 
