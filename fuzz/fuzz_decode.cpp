@@ -30,6 +30,7 @@
 #include <utility>
 
 #include "container_forge.hpp"
+#include "tsm/compare.hpp"
 #include "tsm/tsm.hpp"
 
 namespace {

@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "tsm/io.hpp"
+#include "tsm/compare.hpp"
 #include "tsm/tsm.hpp"
 
 namespace {

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "tsm/compare.hpp"
 #include "tsm/tsm.hpp"
 
 namespace {
