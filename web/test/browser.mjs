@@ -11,7 +11,7 @@
 // the browser, whole, streamed and in a worker, with the same attribute
 // values, corner indices and metadata (FNV-1a of their bytes) as the native decoder
 // (web/test/attr-ref.c, a C client of tsm.h built here against the native
-// library: $TSM/../../libcodec/libtsm.a).
+// library: $TSM/../../libcodec/libtsm.a and libtsm_decoder.a).
 //   node web/test/browser.mjs [NAME ...]
 // Env: TSM (the native CLI, default build/release/cli/tsm), CORPUS (../shared/corpus).
 import { execFileSync } from 'node:child_process';
@@ -86,13 +86,14 @@ const newer = (a, b) => !fs.existsSync(b) || fs.statSync(a).mtimeMs > fs.statSyn
 function attributeReferences() {
   const tsm = process.env.TSM || path.join(root, 'build/release/cli/tsm');
   const lib = path.resolve(path.dirname(tsm), '../libcodec/libtsm.a');
+  const decoderLib = path.resolve(path.dirname(tsm), '../libcodec/libtsm_decoder.a');
   const corpus = process.env.CORPUS || path.resolve(root, '../shared/corpus');
   if (!fs.existsSync(tsm) || !fs.existsSync(lib)) return { reason: `no native ${tsm} or ${lib}` };
   const helper = path.join(root, 'build/web/attr-ref');
   const src = path.join(here, 'attr-ref.c');
   if (newer(src, helper) || newer(lib, helper)) {
     execFileSync('cc', ['-std=c99', '-pedantic', '-Wall', '-Wextra', '-Werror', `-I${path.join(root, 'libcodec/include')}`,
-      src, lib, '-lstdc++', '-lzstd', '-lxxhash', '-lm', '-lpthread', '-o', helper], { stdio: 'inherit' });
+      src, lib, decoderLib, '-lstdc++', '-lzstd', '-lxxhash', '-lm', '-lpthread', '-o', helper], { stdio: 'inherit' });
   }
   const out = [];
   for (const [name, rel, args] of ATTRIBUTE_FILES) {
