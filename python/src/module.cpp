@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -265,6 +266,41 @@ PYBIND11_MODULE(_tsmcodec, m) {
       },
       py::arg("data"), py::kw_only(), py::arg("threads") = 0, py::arg("max_vertices") = 0, py::arg("max_faces") = 0,
       "Decodes .tsm bytes into a Mesh");
+
+  py::class_<tsm::StreamDecoder>(m, "StreamDecoder",
+                                 "Decodes while the bytes arrive: feed() chunks of any size; each segment is "
+                                 "decoded as soon as its bytes are in and mesh grows (segment k's vertices and "
+                                 "faces after those of the segments before it)")
+      .def(py::init([](int threads, uint64_t max_vertices, uint64_t max_faces) {
+             tsm::DecodeOptions o;
+             o.threads = threads;
+             o.max_vertices = max_vertices;
+             o.max_faces = max_faces;
+             return std::make_unique<tsm::StreamDecoder>(o);
+           }),
+           py::kw_only(), py::arg("threads") = 0, py::arg("max_vertices") = 0, py::arg("max_faces") = 0)
+      .def(
+          "feed",
+          [](tsm::StreamDecoder& d, py::buffer chunk) {
+            py::buffer_info b = chunk.request();
+            py::gil_scoped_release release;
+            check(d.feed(view_of(b)));
+          },
+          py::arg("chunk"), "Adds bytes; raises tsmcodec.Error when they are not a valid .tsm stream")
+      .def(
+          "finish",
+          [](tsm::StreamDecoder& d) {
+            py::gil_scoped_release release;
+            check(d.finish());
+          },
+          "The input is over: raises tsmcodec.Error unless the whole file was decoded")
+      .def_property_readonly("segment_count", &tsm::StreamDecoder::segment_count, "0 until the header is in")
+      .def_property_readonly("segments_done", &tsm::StreamDecoder::segments_done)
+      .def_property_readonly("done", &tsm::StreamDecoder::done, "the end marker was read, no error")
+      .def_property_readonly(
+          "mesh", [](const tsm::StreamDecoder& d) { return d.mesh(); },
+          "a copy of the mesh decoded so far (the segments done)")
+      .def("take_mesh", &tsm::StreamDecoder::take_mesh, "moves the decoded mesh out (call when done)");
 
   m.def(
       "read",

@@ -129,3 +129,68 @@ def test_bytes_equal_the_tools(tmp_path, args, kwargs):
     with open(out, "rb") as f:
         tool = f.read()
     assert tsmcodec.encode(tsmcodec.read(ply), **kwargs) == tool
+
+
+def test_stream_decoder_grows_segment_by_segment():
+    positions, faces = grid(30)
+    data = tsmcodec.encode(positions, faces, segment_faces=400)
+    whole = tsmcodec.decode(data)
+    stream = tsmcodec.StreamDecoder(threads=1)
+    assert stream.segment_count == 0 and not stream.done
+    seen = []
+    for i in range(0, len(data), 97):
+        stream.feed(data[i:i + 97])
+        seen.append((stream.segments_done, stream.mesh.face_count))
+    stream.finish()
+    assert stream.done and stream.segment_count > 1
+    assert stream.segments_done == stream.segment_count
+    # The mesh grows in steps, never shrinks, and some step is a proper part.
+    assert seen == sorted(seen)
+    assert any(0 < f < len(faces) for _, f in seen)
+    mesh = stream.take_mesh()
+    assert np.array_equal(mesh.positions, whole.positions)
+    assert np.array_equal(mesh.faces, whole.faces)
+
+
+def test_stream_decoder_errors():
+    positions, faces = grid(8)
+    data = tsmcodec.encode(positions, faces)
+    stream = tsmcodec.StreamDecoder()
+    stream.feed(data[: len(data) // 2])
+    with pytest.raises(tsmcodec.Error) as e:
+        stream.finish()
+    assert str(e.value)
+    bad = tsmcodec.StreamDecoder()
+    with pytest.raises(tsmcodec.Error):
+        bad.feed(b"this is not a tsm stream, not at all")
+    with pytest.raises(tsmcodec.Error):  # after an error every call raises it again
+        bad.feed(data)
+
+
+def corpus_file(name):
+    """A file of ../shared/corpus (TSM_CORPUS): skipped when absent, a failure in CI."""
+    path = os.path.join(os.environ.get("TSM_CORPUS", ""), name)
+    if not os.path.isfile(path):
+        if os.environ.get("CI", "") not in ("", "0", "false"):
+            pytest.fail("corpus file %s is missing; CI is set, so that is a failure" % path)
+        pytest.skip("corpus file %s is missing (clone the project beside ../shared or set TSM_CORPUS)" % path)
+    return path
+
+
+@pytest.mark.skipif(not os.environ.get("TSM_CLI"), reason="TSM_CLI (the tsm tool) not given")
+def test_corpus_bunny_bytes_equal_the_tools(tmp_path):
+    ply = corpus_file("bun_zipper.ply")
+    out = str(tmp_path / "bunny.tsm")
+    subprocess.run([os.environ["TSM_CLI"], "encode", ply, "-o", out], check=True, capture_output=True)
+    with open(out, "rb") as f:
+        tool = f.read()
+    mesh = tsmcodec.read(ply)
+    data = tsmcodec.encode(mesh)
+    assert data == tool
+    back = tsmcodec.decode(data)
+    assert (back.vertex_count, back.face_count) == (35947, 69451)
+    # On the grid: every decoded position is within half a grid step of the
+    # input's bounding box (14 bits by default over the largest extent).
+    lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
+    step = float((hi - lo).max()) / ((1 << tsmcodec.info(data)["quantization_bits"]) - 1)
+    assert (back.positions >= lo - step).all() and (back.positions <= hi + step).all()

@@ -5,9 +5,12 @@
     mesh = tsmcodec.decode(data)                      # mesh.positions (N,3) float32, mesh.faces (M,3) uint32
     mesh = tsmcodec.read("bunny.ply"); tsmcodec.write("bunny.obj", mesh)
     tsmcodec.info(data)["face_count"]
+    stream = tsmcodec.StreamDecoder()                 # decoding as the bytes arrive
+    for chunk in chunks: stream.feed(chunk)           # stream.mesh grows segment by segment
+    stream.finish(); mesh = stream.take_mesh()
 
 Errors raise tsmcodec.Error with the library's message.
 """
-from ._tsmcodec import Attribute, Error, Mesh, __version__, decode, encode, info, read, write
+from ._tsmcodec import Attribute, Error, Mesh, StreamDecoder, __version__, decode, encode, info, read, write
 
-__all__ = ["Attribute", "Error", "Mesh", "__version__", "decode", "encode", "info", "read", "write"]
+__all__ = ["Attribute", "Error", "Mesh", "StreamDecoder", "__version__", "decode", "encode", "info", "read", "write"]
