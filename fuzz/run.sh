@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang, ASan + UBSan, the library instrumented
-# for coverage) and runs each for SECONDS with a generated seed corpus:
+# Builds the libFuzzer targets (in the asan preset's build, build/asan: clang,
+# ASan + UBSan, the libraries instrumented for coverage; the same build the
+# test suite runs its tests in) and runs each for SECONDS with a generated
+# seed corpus:
 #
 #   fuzz/run.sh SECONDS [TARGET...]     (targets: fuzz_decode fuzz_read_mesh fuzz_roundtrip)
 #   fuzz/run.sh --smoke [TARGET...]     (the test suite's run: reproducible)
@@ -16,7 +18,7 @@
 #
 # Prints, per target, the executions and the result; exits non-zero when a
 # target finds a crash, leak, timeout or out-of-memory, with the path of the
-# file that reproduces it (rerun it with: build/fuzz/fuzz/TARGET FILE).
+# file that reproduces it (rerun it with: build/asan/fuzz/TARGET FILE).
 # Seeds are generated into build/fuzz/seeds/TARGET/ by fuzz_seeds (never
 # committed); inputs the fuzzer finds go to build/fuzz/corpus/TARGET/ and are
 # kept for the next run; full logs in build/fuzz/logs/. Runs at nice 19, one
@@ -69,16 +71,16 @@ if ! clang++ -fsanitize=fuzzer,address,undefined "$probe_dir/p.cpp" -o "$probe_d
 fi
 
 mkdir -p "$build/logs"
-if ! CXX=clang++ cmake -S . -B "$build" -G Ninja -DTSM_FUZZ=ON -DTSM_SANITIZE=ON -DTSM_BUILD_TESTS=OFF \
-  -DTSM_WITH_DRACO=OFF >"$build/logs/configure.log" 2>&1; then
+if ! cmake --preset asan >"$build/logs/configure.log" 2>&1; then
   cat "$build/logs/configure.log" >&2
-  die "configuring $build failed (if it was first configured with another compiler, remove $build)"
+  die "configuring build/asan (cmake --preset asan) failed (if it was first configured with another compiler, remove build/asan)"
 fi
-if ! nice -n 19 cmake --build "$build" -j "${FUZZ_JOBS:-1}" --target tsm_fuzz >"$build/logs/build.log" 2>&1; then
+if ! nice -n 19 cmake --build build/asan -j "${FUZZ_JOBS:-1}" --target tsm_fuzz >"$build/logs/build.log" 2>&1; then
   tail -n 60 "$build/logs/build.log" >&2
   die "building the fuzz targets failed (full log: $build/logs/build.log)"
 fi
-"$build/fuzz/fuzz_seeds" "$build/seeds" || die "the seed generator failed"
+bin=build/asan/fuzz
+"$bin/fuzz_seeds" "$build/seeds" || die "the seed generator failed"
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
@@ -98,7 +100,7 @@ for t in "${targets[@]}"; do
   start=$(date +%s)
   rc=0
   # -malloc_limit_mb: no input of a few kilobytes justifies a 512 MB block.
-  nice -n 19 "$build/fuzz/$t" -max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -malloc_limit_mb=512 \
+  nice -n 19 "$bin/$t" -max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -malloc_limit_mb=512 \
     -print_final_stats=1 -artifact_prefix="$artifacts/" "${extra[@]}" "$corpus" "$build/seeds/$t" \
     >"$log" 2>&1 || rc=$?
   took=$(($(date +%s) - start))
@@ -113,7 +115,7 @@ for t in "${targets[@]}"; do
     artifact=$(sed -n "s/.*Test unit written to \(.*\)$/\1/p" "$log" | tail -n 1)
     kind=$(grep -m1 -oE 'ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|LeakSanitizer|libFuzzer): [a-z-]+[^ ]*|runtime error: .*' "$log" || true)
     echo "fuzz: $t: FAILED (exit $rc) after ${execs:-?} executions in ${took} s: ${kind:-see the log}"
-    echo "fuzz: $t: reproducer: ${artifact:-none written}   (rerun: $build/fuzz/$t ${artifact:-FILE})"
+    echo "fuzz: $t: reproducer: ${artifact:-none written}   (rerun: $bin/$t ${artifact:-FILE})"
     echo "fuzz: $t: log: $log; its end:"
     tail -n 40 "$log" | sed 's/^/    /'
     failed+=("$t")

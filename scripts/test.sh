@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The whole test suite: install, build release and ASan+UBSan, run both, then
-# the format spec's independent Python decoder against the C++ one, then
-# a short smoke run of every libFuzzer target (fuzz/run.sh; clang + libFuzzer
-# are required: without them this fails, it never skips), then the browser
+# The whole test suite: install, build release (gcc, -O2) and ASan+UBSan
+# (clang; the same build holds the libFuzzer targets), run the tests in both
+# (the format spec's independent Python decoder against the C++ one and the
+# Python module are release tests), then a short smoke run of every libFuzzer
+# target (fuzz/run.sh; clang + libFuzzer are required: without them this
+# fails, it never skips), then the browser
 # test (web/test.sh: emscripten and Chromium from Debian; when they cannot be
 # installed it prints "web test SKIPPED: <reason>" and the suite goes on,
 # except in CI (CI=true), where that is a failure). In CI a missing
@@ -19,8 +21,6 @@ for preset in release asan; do
   echo "== $preset tests"
   ctest --preset "$preset" -j "$jobs"
 done
-echo "== format spec: the independent Python decoder (format-spec/reference_decoder.py) against tsm decode"
-bash format-spec/check_decoder.sh build/release/cli/tsm
 echo "== fuzz smoke run (fixed executions and seed per target)"
 FUZZ_JOBS=$jobs bash fuzz/run.sh --smoke
 echo "== browser test: the WebAssembly decoder in headless Chromium (web/test.sh; it says plainly when it skips, and fails instead in CI)"
