@@ -624,13 +624,16 @@ struct SurfaceCoder {
 };
 
 // The fast levels' decoder: the gate predictor in march order without a
-// lattice, tangent step or mixing, residuals from tables (FORMAT.md
-// §8.5.11). It is SurfaceCoder::code<true> with multi false followed by
-// Coder::vertex<true>, written out for that one case: the gate's three
-// corners looked up once, the averages of one or two values as sums and
-// shifts, the table lookup inline. Same arithmetic as the general walk,
-// which the encoder runs (every level-0 round trip in the tests compares
-// the two). first: the half-edges to code, in order.
+// tangent step or mixing, residuals from tables (FORMAT.md §8.5.11). It is
+// SurfaceCoder::code with multi false followed by Coder::vertex, written
+// out for that one case: the gate's three corners looked up once, the
+// averages of one or two values as sums and shifts, the table lookup
+// inline. kLattice: some axis has lattice planes (a scan's or a
+// marching-cubes surface's), whose on-plane flags and plane offsets go
+// through the range coder as in Coder::vertex. Same arithmetic as the
+// general walk, which the encoder runs (every level-0 round trip in the
+// tests compares the two). first: the half-edges to code, in order.
+template <bool kLattice>
 bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
                         const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
   const uint32_t* cv = g.corners().data();
@@ -638,6 +641,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   uint8_t* act = c.act.data();
   uint32_t* Q = q.data();
   const int64_t qmax = c.qmax, alpha = c.alpha[0];
+  LatticeModels* lm = kLattice ? &c.lat() : nullptr;
   auto known = [&](uint32_t h) {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
@@ -674,18 +678,31 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
       activity = last_act;
     }
     uint64_t sum = 0, top = 0;
+    int on_count = 0;
     uint32_t* X = Q + 3 * size_t{v};
     for (int a = 0; a < 3; ++a) {
       const int ctx = std::min(a == 0 ? activity : (activity + bit_length(top) + 1) / 2, kActivity - 1);
       const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
-      int32_t r;
-      if (!s.tables.decode(s.bits, (a * kClasses + cls) * kActivity + ctx, r)) {
-        s.bad_code = true;
-        return false;
+      int64_t r;
+      const std::vector<uint32_t>* L = kLattice ? &c.lattice.values[a] : nullptr;
+      if (kLattice && !L->empty() && s.d.bit(lm->on[a][on_count])) {  // on a plane: its offset from the nearest
+        const int64_t k = static_cast<int64_t>(c.nearest_plane(a, static_cast<uint32_t>(p))) +
+                          lm->index[a][on_count][ctx].decode(s.d);
+        if (k < 0 || k >= static_cast<int64_t>(L->size())) return false;
+        X[a] = (*L)[static_cast<size_t>(k)];
+        ++on_count;
+        r = int64_t{X[a]} - p;
+      } else {
+        int32_t t;
+        if (!s.tables.decode(s.bits, (a * kClasses + cls) * kActivity + ctx, t)) {
+          s.bad_code = true;
+          return false;
+        }
+        r = t;
+        if (p + r < 0 || p + r > qmax) return false;
+        X[a] = static_cast<uint32_t>(p + r);
       }
-      if (p + r < 0 || p + r > qmax) return false;
-      X[a] = static_cast<uint32_t>(p + r);
-      const uint64_t ar = static_cast<uint64_t>(r < 0 ? -int64_t{r} : int64_t{r});
+      const uint64_t ar = static_cast<uint64_t>(r < 0 ? -r : r);
       sum += ar;
       top = std::max(top, ar);
     }
@@ -699,7 +716,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
 }
 
 // Level 1-2's decoder (predictor fan: every triangle around the vertex,
-// spread contexts, optionally the tangent step; no lattice, no mixing;
+// spread contexts, optionally the tangent step and lattice planes; no mixing;
 // residuals from tables): SurfaceCoder::code with multi true, the fan walk
 // written out as one loop (the general walk calls a lambda per half-edge),
 // then the general Coder::vertex. Same arithmetic as the general walk,
@@ -803,12 +820,14 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
     }
   }
   if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
-    if (!multi && c.plain()) {
-      if (!decode_gate_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
+    if (!multi && !c.tangent && !c.mix && !c.spread_ctx) {
+      if (!(no_lattice ? decode_gate_tables<false>(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)
+                       : decode_gate_tables<true>(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)))
+        return false;
       return sc.isolated();
     }
-    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
-    if (multi && c.spread_ctx && !c.mix && no_lattice) {
+    if (multi && c.spread_ctx && !c.mix) {
       if (!decode_fan_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
       return sc.isolated();
     }
