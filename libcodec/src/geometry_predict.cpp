@@ -806,7 +806,8 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   // listed first without branches (virtual corners map to the extra entry V,
   // marked seen), so the coding loop below does not mispredict on them.
   const uint32_t V = g.vertex_count;
-  std::vector<uint32_t> first(H);
+  // Not zero-filled (the loop writes every entry it later reads).
+  std::unique_ptr<uint32_t[]> first(new uint32_t[H]);
   uint32_t nfirst = 0;
   {
     std::vector<uint8_t> seen(size_t{V} + 1, 0);
@@ -822,13 +823,13 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
     const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
     if (!multi && !c.tangent && !c.mix && !c.spread_ctx) {
-      if (!(no_lattice ? decode_gate_tables<false>(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)
-                       : decode_gate_tables<true>(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)))
+      if (!(no_lattice ? decode_gate_tables<false>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)
+                       : decode_gate_tables<true>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)))
         return false;
       return sc.isolated();
     }
     if (multi && c.spread_ctx && !c.mix) {
-      if (!decode_fan_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+      if (!decode_fan_tables(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)) return false;
       return sc.isolated();
     }
   }
