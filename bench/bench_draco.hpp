@@ -17,8 +17,17 @@ struct DracoRun {
   size_t bytes = 0;
   double encode_ms = 0;       // median over runs
   double decode_ms = 0;       // median over runs
-  Mesh decoded;               // Draco's decoded mesh (its vertex order; polygons as triangles)
+  // Draco's decoded mesh on its own grid: positions are the grid indices its
+  // decoder reads (the dequantization skipped), in its vertex order,
+  // polygons as triangles. Compare with draco_grid(original) (bits = 0).
+  Mesh decoded_grid;
 };
+
+// The mesh as Draco's encoder puts it on its grid: polygons fan-triangulated
+// as Draco is given them, positions replaced by the grid indices Draco
+// computes for them (its quantization transform: float minimum and range,
+// Draco's quantizer). Empty when Draco is not built in.
+Mesh draco_grid(const Mesh& mesh, int qbits);
 
 // Encodes `mesh` with Draco's edgebreaker/sequential choice at compression
 // level `level` (0..10, speed = 10 - level) and `qbits` position bits, then

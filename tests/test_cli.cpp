@@ -327,12 +327,18 @@ TEST_F(Cli, BenchOnASmallMesh) {
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("| small.ply | 162 | 8 |"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("NOT exact"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tsm on one thread against Draco"), std::string::npos) << r.out;
   EXPECT_EQ(r.err, "");
 
   r = tsm("bench " + q("small.ply") + " --runs 1 -q 8 --json --quiet");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("\"tsm_exact\": true"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"failures\": 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"threads\": 1"), std::string::npos) << r.out;
+  // A closed manifold mesh: Draco's round trip is exact on Draco's own grid.
+  if (r.out.find("\"draco\": true") != std::string::npos) {
+    EXPECT_NE(r.out.find("\"draco_cl10_exact\": true"), std::string::npos) << r.out;
+  }
 
   // A file it cannot read is a failure, reported, with exit code 3.
   spit(file("bad.ply"), "ply\nbroken");

@@ -31,7 +31,15 @@ command -v emcc >/dev/null || { echo "web/build.sh: emcc not found (apt-get inst
 VERSION="$(sed -n 's/^project(tsm VERSION \([0-9.]*\).*/\1/p' "$ROOT/CMakeLists.txt")"
 OPT=(-O3 -DNDEBUG)
 LOPT=(-O3)
-if [ "${TSM_WEB_DEBUG:-0}" = 1 ]; then OPT=(-O1 -g); LOPT=(-O1 -g -sASSERTIONS=1); fi
+# Cold code, optimized for size (after OPT, so its -Oz wins): the container,
+# the C API, error messages, the segment table and zstd (small side-data
+# sections); the decoding stages keep -O3.
+COLD=(-Oz)
+if [ "${TSM_WEB_DEBUG:-0}" = 1 ]; then OPT=(-O1 -g); LOPT=(-O1 -g -sASSERTIONS=1); COLD=(); fi
+is_cold() {
+  case "$(basename "$1")" in c_api.cpp | container_read.cpp | mesh.cpp | parallel.cpp | segments.cpp | status.cpp) return 0 ;; esac
+  return 1
+}
 # TSM_WEB_FLAGS: extra compile and link flags, for trying variants (e.g. "-flto", "-msimd128")
 read -r -a EXTRA <<<"${TSM_WEB_FLAGS:-}"
 OPT+=("${EXTRA[@]}")
@@ -122,7 +130,7 @@ compile() {  # src obj flags...
     emcc "$@" -c "$src" -o "$obj"
   fi
 }
-FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}")"
+FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}" "${COLD[@]}")"
 if [ ! -f "$OUT/.flags" ] || [ "$(cat "$OUT/.flags")" != "$FLAGSIG" ]; then printf '%s\n' "$FLAGSIG" > "$OUT/.flags"; fi
 # headers: rebuild everything when any library header is newer than the last link
 if [ -f "$OUT/tsm_decoder.wasm" ]; then
@@ -133,10 +141,11 @@ OBJS=()
 pids=()
 run() { compile "$@" & pids+=($!); if [ "${#pids[@]}" -ge "$JOBS" ]; then wait "${pids[0]}"; pids=("${pids[@]:1}"); fi; }
 for f in "${LIB_FILES[@]}"; do
-  o="$OBJ/lib_$(basename "${f%.cpp}").o"; OBJS+=("$o"); run "$f" "$o" "${CXXFLAGS[@]}"
+  o="$OBJ/lib_$(basename "${f%.cpp}").o"; OBJS+=("$o")
+  if is_cold "$f"; then run "$f" "$o" "${CXXFLAGS[@]}" "${COLD[@]}"; else run "$f" "$o" "${CXXFLAGS[@]}"; fi
 done
 for f in "${ZSTD_FILES[@]}"; do
-  o="$OBJ/z_$(basename "${f%.c}").o"; OBJS+=("$o"); run "$f" "$o" "${OPT[@]}" "${ZSTD_CFLAGS[@]}" "${ZSTD_INC[@]}"
+  o="$OBJ/z_$(basename "${f%.c}").o"; OBJS+=("$o"); run "$f" "$o" "${OPT[@]}" "${COLD[@]}" "${ZSTD_CFLAGS[@]}" "${ZSTD_INC[@]}"
 done
 for p in "${pids[@]}"; do wait "$p"; done
 
@@ -160,7 +169,7 @@ fi
 emcc "${LOPT[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
   -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTsmModule \
   -sENVIRONMENT=web,worker -sFILESYSTEM=0 \
-  -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB -sINITIAL_MEMORY=16MB \
+  -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB -sINITIAL_MEMORY=16MB -sMALLOC=emmalloc \
   -sEXPORTED_FUNCTIONS="$EXPORTS" -sEXPORTED_RUNTIME_METHODS=[] \
   -sINCOMING_MODULE_JS_API=[wasmBinary,locateFile,instantiateWasm,print,printErr,onAbort] \
   -sTEXTDECODER=2 -sDYNAMIC_EXECUTION=0

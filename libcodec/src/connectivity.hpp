@@ -26,7 +26,8 @@ namespace tsm {
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 
-inline uint32_t he_next(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
+// As tests of divisibility by 3 (a multiply and a compare, no remainder).
+inline uint32_t he_next(uint32_t h) { return (h + 1) % 3 == 0 ? h - 2 : h + 1; }
 inline uint32_t he_prev(uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
 
 // Union-find over dense ids; unite() keeps the smaller id as the set's root,

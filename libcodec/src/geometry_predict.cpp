@@ -624,13 +624,16 @@ struct SurfaceCoder {
 };
 
 // The fast levels' decoder: the gate predictor in march order without a
-// lattice, tangent step or mixing, residuals from tables (FORMAT.md
-// §8.5.11). It is SurfaceCoder::code<true> with multi false followed by
-// Coder::vertex<true>, written out for that one case: the gate's three
-// corners looked up once, the averages of one or two values as sums and
-// shifts, the table lookup inline. Same arithmetic as the general walk,
-// which the encoder runs (every level-0 round trip in the tests compares
-// the two). first: the half-edges to code, in order.
+// tangent step or mixing, residuals from tables (FORMAT.md §8.5.11). It is
+// SurfaceCoder::code with multi false followed by Coder::vertex, written
+// out for that one case: the gate's three corners looked up once, the
+// averages of one or two values as sums and shifts, the table lookup
+// inline. kLattice: some axis has lattice planes (a scan's or a
+// marching-cubes surface's), whose on-plane flags and plane offsets go
+// through the range coder as in Coder::vertex. Same arithmetic as the
+// general walk, which the encoder runs (every level-0 round trip in the
+// tests compares the two). first: the half-edges to code, in order.
+template <bool kLattice>
 bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
                         const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
   const uint32_t* cv = g.corners().data();
@@ -638,6 +641,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   uint8_t* act = c.act.data();
   uint32_t* Q = q.data();
   const int64_t qmax = c.qmax, alpha = c.alpha[0];
+  LatticeModels* lm = kLattice ? &c.lat() : nullptr;
   auto known = [&](uint32_t h) {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
@@ -674,18 +678,31 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
       activity = last_act;
     }
     uint64_t sum = 0, top = 0;
+    int on_count = 0;
     uint32_t* X = Q + 3 * size_t{v};
     for (int a = 0; a < 3; ++a) {
       const int ctx = std::min(a == 0 ? activity : (activity + bit_length(top) + 1) / 2, kActivity - 1);
       const int64_t p = std::clamp<int64_t>(pred[a], 0, qmax);
-      int32_t r;
-      if (!s.tables.decode(s.bits, (a * kClasses + cls) * kActivity + ctx, r)) {
-        s.bad_code = true;
-        return false;
+      int64_t r;
+      const std::vector<uint32_t>* L = kLattice ? &c.lattice.values[a] : nullptr;
+      if (kLattice && !L->empty() && s.d.bit(lm->on[a][on_count])) {  // on a plane: its offset from the nearest
+        const int64_t k = static_cast<int64_t>(c.nearest_plane(a, static_cast<uint32_t>(p))) +
+                          lm->index[a][on_count][ctx].decode(s.d);
+        if (k < 0 || k >= static_cast<int64_t>(L->size())) return false;
+        X[a] = (*L)[static_cast<size_t>(k)];
+        ++on_count;
+        r = int64_t{X[a]} - p;
+      } else {
+        int32_t t;
+        if (!s.tables.decode(s.bits, (a * kClasses + cls) * kActivity + ctx, t)) {
+          s.bad_code = true;
+          return false;
+        }
+        r = t;
+        if (p + r < 0 || p + r > qmax) return false;
+        X[a] = static_cast<uint32_t>(p + r);
       }
-      if (p + r < 0 || p + r > qmax) return false;
-      X[a] = static_cast<uint32_t>(p + r);
-      const uint64_t ar = static_cast<uint64_t>(r < 0 ? -int64_t{r} : int64_t{r});
+      const uint64_t ar = static_cast<uint64_t>(r < 0 ? -r : r);
       sum += ar;
       top = std::max(top, ar);
     }
@@ -699,7 +716,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
 }
 
 // Level 1-2's decoder (predictor fan: every triangle around the vertex,
-// spread contexts, optionally the tangent step; no lattice, no mixing;
+// spread contexts, optionally the tangent step and lattice planes; no mixing;
 // residuals from tables): SurfaceCoder::code with multi true, the fan walk
 // written out as one loop (the general walk calls a lambda per half-edge),
 // then the general Coder::vertex. Same arithmetic as the general walk,
@@ -789,7 +806,8 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   // listed first without branches (virtual corners map to the extra entry V,
   // marked seen), so the coding loop below does not mispredict on them.
   const uint32_t V = g.vertex_count;
-  std::vector<uint32_t> first(H);
+  // Not zero-filled (the loop writes every entry it later reads).
+  std::unique_ptr<uint32_t[]> first(new uint32_t[H]);
   uint32_t nfirst = 0;
   {
     std::vector<uint8_t> seen(size_t{V} + 1, 0);
@@ -803,13 +821,15 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
     }
   }
   if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
-    if (!multi && c.plain()) {
-      if (!decode_gate_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
+    if (!multi && !c.tangent && !c.mix && !c.spread_ctx) {
+      if (!(no_lattice ? decode_gate_tables<false>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)
+                       : decode_gate_tables<true>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)))
+        return false;
       return sc.isolated();
     }
-    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
-    if (multi && c.spread_ctx && !c.mix && no_lattice) {
-      if (!decode_fan_tables(g, c, s, q, first.data(), nfirst, sc.last, sc.last_act)) return false;
+    if (multi && c.spread_ctx && !c.mix) {
+      if (!decode_fan_tables(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)) return false;
       return sc.isolated();
     }
   }
@@ -824,17 +844,32 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   return sc.isolated();
 }
 
+// The greedy order (below) depends on the connectivity alone: which
+// vertices are decoded, never their values. The encoder's passes over one
+// layout (fits and trial encodes) record it on the first and replay it on
+// the others.
+struct GreedyOrder {
+  std::vector<uint32_t> vertices;
+  bool recorded = false;
+};
+
 // Greedy order: next the vertex with the most complete parallelograms (then
 // the most decoded neighbours); ties first-in first-out. Counts are kept
 // incrementally: a parallelogram completes when the last of its three known
 // corners is decoded. A new component starts at the first undecoded corner
-// in march order.
+// in march order. order (encoder only): recorded, or replayed if it was.
 template <class Sink>
-bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q) {
+bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   const uint32_t n = g.vertex_count;
   const uint32_t H = static_cast<uint32_t>(g.corners().size());
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
+  if (order && order->recorded) {
+    for (uint32_t v : order->vertices)
+      if (!sc.code(first_he[v], true)) return false;
+    return sc.isolated();
+  }
+  if (order) order->vertices.clear();
   std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
   constexpr int kBuckets = 16;
   std::vector<uint32_t> bucket[kBuckets];
@@ -899,9 +934,11 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
       v = sc.cv[scan];
     }
     if (!sc.code(first_he[v], true)) return false;
+    if (order) order->vertices.push_back(v);
     decoded(v);
     if ((v & 4095) == 0 && s.truncated()) return false;
   }
+  if (order) order->recorded = true;
   return sc.isolated();
 }
 
@@ -1050,22 +1087,23 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
 
 // A statistics pass in a surface predictor's order: nothing coded, the
 // fitting samples collected in `fit`.
-void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predictor pred, Coder& fit) {
+void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predictor pred, Coder& fit,
+                  GreedyOrder* order) {
   fit.collect = true;
   CollectSink cs;
   std::vector<uint32_t> work = q;
   if (greedy_order(pred))
-    code_greedy(g, fit, cs, work);
+    code_greedy(g, fit, cs, work, order);
   else
     code_march_order(g, pred == Predictor::fan, fit, cs, work);
 }
 
 // The parallelogram weights for a predictor: fitted per class by least
 // squares and by the size estimate (fit_alpha); the caller codes both.
-void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                int32_t lsq[3], int32_t est[3]) {
+void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int32_t lsq[3],
+                int32_t est[3], GreedyOrder* order) {
   Coder fit(g.vertex_count, bits, false);
-  collect_pass(g, q, pred, fit);
+  collect_pass(g, q, pred, fit, order);
   for (int k = 0; k < 3; ++k) {
     est[k] = fit_alpha(fit.samples[k]);
     double num = 0, den = 0;
@@ -1082,14 +1120,14 @@ void fit_alphas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bit
 // for a predictor, lattice and parallelogram weights, by fit_alpha's size
 // estimate (0 .. 1.5).
 void fit_betas(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-               const Lattice& lattice, const int32_t* weights, int32_t beta[2]) {
+               const Lattice& lattice, const int32_t* weights, int32_t beta[2], GreedyOrder* order) {
   Coder fit(g.vertex_count, bits, false);
   fit.tangent = true;
   fit.lattice = lattice;
   fit.build_nearest();
   if (weights)
     for (int k = 0; k < 3; ++k) fit.alpha[k] = weights[k];
-  collect_pass(g, q, pred, fit);
+  collect_pass(g, q, pred, fit, order);
   for (int i = 0; i < 2; ++i) beta[i] = fit.tan_samples[i].empty() ? 0 : fit_alpha(fit.tan_samples[i]);
 }
 
@@ -1157,9 +1195,10 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
   return true;
 }
 
-std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
-                               int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix,
-                               bool top, bool tables) {
+// encode_geometry_as with the greedy order recorded or replayed (null: neither).
+std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                                 int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent,
+                                 bool mix, bool top, bool tables, GreedyOrder* order) {
   if (pred == Predictor::raw) {
     const bool all_on = covers(lattice, q, g.vertex_count);
     return encode_geometry_raw(g, q, bits, all_on ? lattice : Lattice(), top && all_on);
@@ -1209,7 +1248,7 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
     if (pred == Predictor::ancestors)
       code_ancestors(g, K, lambda, c, s, work);
     else if (greedy_order(pred))
-      code_greedy(g, c, s, work);
+      code_greedy(g, c, s, work, order);
     else
       code_march_order(g, pred == Predictor::fan, c, s, work);
   };
@@ -1229,6 +1268,11 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   return head + write_table_block(codes.lengths(), kTableMapBytes, s.bits.finish()) + s.e.finish();
 }
 
+std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
+                               const Lattice& lattice, const int32_t* weights, const int32_t* tangent, bool mix,
+                               bool top, bool tables) {
+  return encode_geometry_with(g, q, bits, pred, K, lattice, weights, tangent, mix, top, tables, nullptr);
+}
 
 std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
   const uint32_t n = g.vertex_count;
@@ -1319,17 +1363,19 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   st.tables = tables;
+  GreedyOrder order;  // every greedy pass below walks this layout in one order
   int32_t lsq[3], est[3];
-  fit_alphas(g, q, bits, st.predictor, lsq, est);
+  fit_alphas(g, q, bits, st.predictor, lsq, est, &order);
   const int32_t* weights = est;
-  std::string best = encode_geometry_as(g, q, bits, st.predictor, 0, st.lattice, est, nullptr, false, false, tables);
+  std::string best =
+      encode_geometry_with(g, q, bits, st.predictor, 0, st.lattice, est, nullptr, false, false, tables, &order);
   // `lattice` may be st.lattice itself (the assignment below is then a
   // self-assignment, which std::vector handles).
   int32_t beta[2];
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
                       bool mixed = false) {
     const bool top = top_pays(lattice, bits, g.vertex_count);
-    std::string alt = encode_geometry_as(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables);
+    std::string alt = encode_geometry_with(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables, &order);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
@@ -1363,10 +1409,10 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // where it makes the file smaller.
   int32_t fan_lsq[3], fan_est[3];
   if (level == 1 || level == 2) {
-    fit_alphas(g, q, bits, Predictor::fan, fan_lsq, fan_est);
+    fit_alphas(g, q, bits, Predictor::fan, fan_lsq, fan_est, &order);
     consider(Predictor::fan, 0, st.lattice, fan_est);
     if (level == 2) {
-      fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
+      fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta, &order);
       consider(st.predictor, 0, st.lattice, weights, beta);
     }
   }
@@ -1379,7 +1425,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // order, with its own weights.
   int32_t gate_lsq[3], gate_est[3];
   if (level >= 3) {
-    fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est);
+    fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est, &order);
     consider(Predictor::gate, 0, st.lattice, gate_est);
   }
   if (level >= 7)
@@ -1409,7 +1455,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   // The tangent step on whatever surface predictor won.
   if (level >= 3 && surface_predictor(st.predictor)) {
-    fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta);
+    fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta, &order);
     consider(st.predictor, 0, st.lattice, weights, beta);
   }
   // Residual mixing on whatever won: smaller, slower to decode.

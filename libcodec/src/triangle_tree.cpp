@@ -128,8 +128,9 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   uint32_t* const loop_he = out.loop_he;
   const uint32_t vb = out.vertex_base, hb = out.he_base;
   uint32_t k = 0;
-  // Triangle (a, b, x) entered through the parent's edge `slot`.
-  auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) {
+  // Triangle (a, b, x) entered through the parent's edge `slot` (inlined at
+  // its four uses: the walk's inner loop).
+  auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) __attribute__((always_inline)) {
     const uint32_t va = loop[a], vbb = loop[b], vx = loop[x];
     ++valence[va];
     ++valence[vbb];
