@@ -754,6 +754,11 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
     o_rank = [UIntModel(), UIntModel()]                      # §8.3.2
     o_has_poly = probs(1)
+    o_on_edges = probs(1)                                    # §8.3.3
+    o_edge_any = probs(4)                                    # [prev][touched] at 2 prev + touched
+    o_edge_more = probs(1)
+    o_edge_count = UIntModel()
+    o_edge_end = probs(2)
 
     def overrun():
         return dv.overrun > 8 or dt.overrun > 8 or do.overrun > 8
@@ -1019,7 +1024,48 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     nside = o_count.decode(do)
     if nside > face_count:
         reject('side face count')
-    for i in range(nside):
+    nverbatim = nside
+    if nside > 0 and do.bit(o_on_edges, 0):
+        # §8.3.3 side faces on edges
+        nverbatim = o_count.decode(do)
+        if nverbatim >= nside:
+            reject('side face count')
+        target = nside - nverbatim
+        found = 0
+        touched = [0] * vertex_count
+        prev = 0
+        for h in range(len(tri)):
+            if found == target:
+                break
+            if twin[h] < h:
+                continue
+            a, b = tri[h], tri[h - 2 if h % 3 == 2 else h + 1]
+            if virtual[a] or virtual[b] or ids[a] == ids[b]:
+                continue
+            u, v = ids[a], ids[b]
+            anyf = do.bit(o_edge_any, 2 * prev + (touched[u] | touched[v]))
+            prev = anyf
+            if anyf:
+                touched[u] = touched[v] = 1
+                n = 1
+                if do.bit(o_edge_more, 0):
+                    more = o_edge_count.decode(do)
+                    if more >= target:
+                        reject('side faces on edges')
+                    n = 2 + more
+                if n > target - found:
+                    reject('side faces on edges')
+                pe = 0
+                for j in range(n):
+                    pe = do.bit(o_edge_end, pe)
+                    r, o = (v, u) if pe else (u, v)
+                    push([r, r, o])
+                found += n
+            if overrun():
+                reject('side faces on edges')
+        if found != target:
+            reject('side faces on edges')
+    for i in range(nverbatim):
         sz = o_face_size.decode(do)
         if sz > corner_count or overrun():
             reject('side face size')
@@ -2220,7 +2266,7 @@ def decode_part(streams, counts, bits, earlier, trace):
     if rc > vc:
         reject('references')
     D = lambda b: 2843 * (len(b) + 8)
-    if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + D(s5) // 6:
+    if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + 3 * D(s5):
         reject('stream budget')
     if sr is not None and vc > D(sr):
         reject('references budget')

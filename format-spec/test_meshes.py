@@ -5,7 +5,8 @@
   mixed.obj     a latitude-longitude sphere (its vertex tree suits the ancestor
                 predictor), a torus of quads with two holes (a handle, polygons),
                 a fin of three triangles on one edge (a non-manifold edge), a
-                hexagon, a degenerate face (a side face), three isolated vertices
+                hexagon, degenerate faces (side faces: four on edges, one verbatim),
+                three isolated vertices
   mixed_small.obj  the same with a 6 x 10 sphere (at -q 10 -l 9: the gate
                 predictor with its weights left out, §8.5.1 bit 7)
   irregular.obj  a 30 x 30 grid of jittered points on a wavy sheet, quads
@@ -210,7 +211,11 @@ def mixed(n_=30, m_=60):
           for k in range(6)]
     F.append(hc)                                           # a hexagon
     F.append([hc[0], hc[5], v(-1.9, -0.3, 0.2)])
-    F.append([hc[1], hc[2], hc[2]])                        # a degenerate face
+    F.append([hc[1], hc[2], hc[2]])                        # degenerate faces on edges (side faces)
+    F.append([hc[2], hc[1], hc[2]])
+    F.append([hc[1], hc[1], hc[2]])
+    F.append([hc[3], hc[0], hc[0]])                        # on a polygon diagonal
+    F.append([hc[1], hc[1], hc[4]])                        # on no edge: verbatim
     v(2.6, 0.05, 0.3)                                      # isolated vertices
     v(-3, -3, 2)
     v(-2.45, 0.1, 0.1)

@@ -26,8 +26,7 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 }  // namespace
 
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
-                           uint64_t corner_count, Mesh& out, GeometryLayout& layout,
-                           ConnectivityStats* stats) {
+                           uint64_t corner_count, Mesh& out, GeometryLayout& layout, ConnectivityStats* stats) {
   // §8.3.1: the mode byte, and with tables the bit stream's length, the run
   // tables and the bit stream before the range-coded rest.
   std::string_view topology = in.topology;
@@ -204,7 +203,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     // surface closes (no half-edge is left without a twin: checked below).
     for (uint32_t p = 0; p < L; ++p) {
       const uint32_t o = loop_twin[p];
-      if (loop_he[p] == kNone || o >= L || o == p || loop_twin[o] != p) return corrupt("the cut surface does not close");
+      if (loop_he[p] == kNone || o >= L || o == p || loop_twin[o] != p)
+        return corrupt("the cut surface does not close");
       twin[loop_he[p]] = loop_he[o];
     }
     if (polygons)
@@ -225,7 +225,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   uint32_t at = 0;
   for (uint32_t i = 0; i < nvirt; ++i) {
     uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-    if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("virtual vertex position out of range");
+    if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0))
+      return corrupt("virtual vertex position out of range");
     at += d;
     is_virtual[at] = 1;
   }
@@ -238,7 +239,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     std::vector<uint32_t> at_list(nstitch);
     for (uint32_t i = 0; i < nstitch; ++i) {
       const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
+      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0))
+        return corrupt("stitch position out of range");
       at += d;
       stitched[at] = 1;
       at_list[i] = at;
@@ -287,11 +289,47 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       layout.parent[out_id[p]] = out_id[parent[p]];
     }
   }
-  // Side faces: kept verbatim (the topology stream's last list).
+  // Side faces (the topology stream's last list): on edges (§8.3.3), then
+  // verbatim.
   const uint32_t nside = om.count.decode(dop);
   if (nside > face_count) return corrupt("more side faces than faces");
   std::vector<uint32_t> side, side_start(1, 0);
-  for (uint32_t i = 0; i < nside; ++i) {
+  uint32_t nverbatim = nside;
+  if (nside > 0 && dop.bit(om.on_edges)) {
+    nverbatim = om.count.decode(dop);
+    if (nverbatim >= nside) return corrupt("bad side face count");
+    const uint32_t target = nside - nverbatim;
+    uint32_t found = 0;
+    std::vector<uint8_t> touched(vertex_count, 0);
+    int prev = 0;
+    bool bad = false;
+    each_side_edge(
+        corner, twin, [&](uint32_t p) { return out_id[p]; },
+        [&](uint32_t u, uint32_t v) {
+          const int any = dop.bit(om.edge_any[prev][touched[u] | touched[v]]);
+          prev = any;
+          if (!any) return !(bad = overrun());
+          touched[u] = touched[v] = 1;
+          uint32_t n = 1;
+          if (dop.bit(om.edge_more)) {
+            const uint32_t more = om.edge_count.decode(dop);
+            if (more >= target) return !(bad = true);
+            n = 2 + more;
+          }
+          if (n > target - found) return !(bad = true);
+          int pe = 0;
+          for (uint32_t j = 0; j < n; ++j) {
+            pe = dop.bit(om.edge_end[pe]);
+            const uint32_t r = pe ? v : u, o = pe ? u : v;
+            side.insert(side.end(), {r, r, o});
+            side_start.push_back(static_cast<uint32_t>(side.size()));
+          }
+          found += n;
+          return !(bad = overrun()) && found < target;
+        });
+    if (bad || found != target) return corrupt("bad side faces on edges");
+  }
+  for (uint32_t i = 0; i < nverbatim; ++i) {
     uint32_t n = om.face_size.decode(dop);
     if (n > corner_count || side.size() + n > corner_count || overrun()) return corrupt("bad side face size");
     for (uint32_t j = 0; j < n; ++j) {

@@ -49,8 +49,9 @@ struct PartStreams {
 // max_decisions(n) = 2843 (n + 8) decisions. Every own vertex costs at least
 // 3 in the geometry stream, every vertex of a segment 1 in its references
 // stream, every triangle of the cut surface at least 1 in the triangle-tree
-// stream (a marching bit or a run's end), every side-face corner at least 6
-// in the topology stream: counts beyond that are forged, refused before
+// stream (a marching bit or a run's end), every side face at least 1 in the
+// topology stream (a face on an edge: its end bit, for 3 corners; a verbatim
+// one at least 6 per corner): counts beyond that are forged, refused before
 // allocating.
 uint64_t decisions(std::string_view stream) { return max_decisions(stream.size()); }
 
@@ -64,7 +65,7 @@ Status check_budget(const PartCounts& c, const PartStreams& s) {
   if (s.segmented && c.vertex_count > decisions(s.references))
     return corrupt("the segment's " + std::to_string(c.vertex_count) +
                    " vertices cannot be flagged in a references stream of this size");
-  if (c.corner_count > 3 * decisions(s.triangle_tree) + decisions(s.topology) / 6)
+  if (c.corner_count > 3 * decisions(s.triangle_tree) + 3 * decisions(s.topology))
     return corrupt("the header's " + std::to_string(c.corner_count) +
                    " corners cannot be coded in connectivity sections of this size");
   return Status::Ok();
