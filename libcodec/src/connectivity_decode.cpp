@@ -30,15 +30,16 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   // §8.3.1: the mode byte, and with tables the bit stream's length, the run
   // tables and the bit stream before the range-coded rest.
   std::string_view topology = in.topology;
-  bool tables = false;
+  bool tables = false, welded = false;
   TableSet run_tables;
   BitReader run_bits;
   {
     ByteReader r(topology);
     uint8_t mode;
     if (!r.u8(mode)) return corrupt("topology stream is empty (no run coding mode)");
-    if (mode > 1) return corrupt("run coding mode " + std::to_string(mode) + " (0 adaptive or 1 tables)");
-    if (mode == 1) {
+    if (mode > 3) return corrupt("topology mode " + std::to_string(mode) + " (bit 0 tables, bit 1 welded)");
+    welded = (mode & 2) != 0;
+    if (mode & 1) {
       std::string why;
       if (!read_table_block(r, kRunContexts, kRunMapBytes, run_tables, run_bits, why))
         return corrupt("run values: " + why);
@@ -274,6 +275,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       out_id[p] = next_id++;
     }
   }
+  // Welded (§8.13): the ids are points, at most one per vertex; from here
+  // on they are what the counts and bounds are about.
+  if (welded && next_id <= vertex_count) vertex_count = next_id;
   if (next_id != vertex_count)
     return corrupt("connectivity gives " + std::to_string(next_id) + " vertices, the header says " +
                    std::to_string(vertex_count));
@@ -492,6 +496,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   st.stitches = nstitch;
   st.side_faces = nside;
   st.run_tables = tables;
+  st.welded = welded;
+  st.points = welded ? vertex_count : 0;
   if (stats) *stats = st;
   return Status::Ok();
 }

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "attributes.hpp"
+#include "byte_io.hpp"
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
@@ -16,6 +17,7 @@
 #include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
+#include "split_layout.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm {
@@ -59,7 +61,11 @@ Status check_budget(const PartCounts& c, const PartStreams& s) {
   if (c.vertex_count >= 0x3FFFFFFFu || c.corner_count >= 0x3FFFFFFFu || c.face_count > c.corner_count)
     return corrupt("vertex, face or corner count out of range");
   if (c.reference_count > c.vertex_count) return corrupt("more references than vertices");
-  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3)
+  // Welded (§8.13): the geometry codes the points; every vertex beyond its
+  // point's first costs a decision of the split stream, in the attributes.
+  const bool welded = !s.topology.empty() && (static_cast<uint8_t>(s.topology[0]) & 2) != 0;
+  const uint64_t split = welded ? decisions(s.attributes) : 0;
+  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3 + split)
     return corrupt("the header's " + std::to_string(c.vertex_count - c.reference_count) +
                    " vertices cannot be coded in a geometry section of this size");
   if (s.segmented && c.vertex_count > decisions(s.references))
@@ -105,6 +111,54 @@ struct DecodedPart {
   Status status;
 };
 
+// After a welded part's attributes: walk order to output order (the
+// positions, the faces' corners, the vertex attributes' values).
+void to_output_order(const std::vector<uint32_t>& walk_out, DecodedPart& out) {
+  const size_t n = walk_out.size();
+  std::vector<uint32_t> q(out.q.size());
+  for (size_t w = 0; w < n; ++w)
+    for (int a = 0; a < 3; ++a) q[3 * size_t{walk_out[w]} + a] = out.q[3 * w + a];
+  out.q = std::move(q);
+  for (uint32_t& x : out.faces.indices) x = walk_out[x];
+  for (Attribute& at : out.faces.attributes) {
+    if (at.domain != AttributeDomain::vertex) continue;
+    const size_t k = at.components;
+    std::vector<float> values(at.values.size());
+    for (size_t w = 0; w < n && (w + 1) * k <= at.values.size(); ++w)
+      std::copy(at.values.begin() + static_cast<std::ptrdiff_t>(w * k),
+                at.values.begin() + static_cast<std::ptrdiff_t>((w + 1) * k),
+                values.begin() + static_cast<std::ptrdiff_t>(walk_out[w] * k));
+    at.values = std::move(values);
+  }
+}
+
+// FORMAT.md §8.13: a welded part's attribute payload opens with the split
+// stream (its length first), which turns the faces' points into vertices,
+// numbered in walk order for the attributes (`walk_out`: per walk vertex
+// its output id); each vertex takes its point's position.
+Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_t points, DecodedPart& out,
+                    std::vector<uint32_t>& walk_out) {
+  ByteReader r(attributes);
+  uint64_t len = 0;
+  std::string_view split;
+  if (!r.varint(len) || len > r.remaining() || !r.bytes(static_cast<size_t>(len), split))
+    return corrupt("a welded part's split stream is cut off");
+  uint8_t order = 0;
+  if (!r.u8(order) || order > 1) return corrupt("a welded part's attribute order is missing or not 0 or 1");
+  attributes = attributes.substr(r.offset());
+  std::vector<uint32_t> walk_point;
+  TSM_RETURN_IF_ERROR(decode_split_layout(split, vertex_count, points, out.q, out.faces, walk_out, walk_point));
+  std::vector<uint32_t> q(3 * walk_point.size());
+  for (size_t w = 0; w < walk_point.size(); ++w)
+    for (int a = 0; a < 3; ++a) q[3 * w + a] = out.q[3 * size_t{walk_point[w]} + a];
+  out.q = std::move(q);
+  if (order == 1) {  // the attributes in output order: the walk is not needed after this
+    to_output_order(walk_out, out);
+    walk_out.clear();
+  }
+  return Status::Ok();
+}
+
 Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, DecodedPart& out) {
   TSM_RETURN_IF_ERROR(check_budget(out.counts, s));
   ConnectivityStreams cs;
@@ -115,9 +169,14 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   const PartCounts& c = out.counts;
   TSM_RETURN_IF_ERROR(
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
+  std::string_view attributes = s.attributes;
+  std::vector<uint32_t> walk_out;  // welded: per walk vertex its output id
+  if (out.cstats.welded && s.segmented) return corrupt("a segment's topology mode says welded (§8.13)");
   if (!s.segmented) {
     if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
     TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
+    if (out.cstats.welded)
+      TSM_RETURN_IF_ERROR(split_welded(attributes, c.vertex_count, layout.vertex_count, out, walk_out));
   } else {
     TSM_RETURN_IF_ERROR(
         decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
@@ -131,7 +190,9 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.segmented = s.segmented;
   ap.table_coded = &out.table_coded_attributes;
   if (out.want_costs) ap.costs = &out.attribute_costs;
-  return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
+  TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
+  if (!walk_out.empty()) to_output_order(walk_out, out);
+  return Status::Ok();
 }
 
 // A segment section as a part: its streams (views into the section) and counts.
@@ -384,6 +445,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     info.side_faces += st.side_faces;
     info.marching_bits += st.marching_bits;
     info.run_table_parts += st.run_tables;
+    info.welded_points += st.points;
     info.table_coded_attributes += parts[k].table_coded_attributes;
     info.references += parts[k].counts.reference_count;
     SegmentSummary sum;
