@@ -2322,40 +2322,35 @@ def decode_part(streams, counts, bits, earlier, trace):
         layout = own
     q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 28
     info.update(ginfo)
-    walk_out = None
-    if info['welded']:                                              # §8.13
-        if sr is not None:
-            reject('a segment cannot be welded')
-        n, p = read_varint(sa, 0, len(sa))
-        if n > len(sa) - p or p + n >= len(sa):
-            reject('split stream cut off')
-        split, order, sa = sa[p:p + n], sa[p + n], sa[p + n + 1:]
-        if order > 1:
-            reject('attribute order')
-        faces, walk_out, walk_point = decode_split_layout(split, vc, info['points'], q, faces)
-        q = [q[w] for w in walk_point]
-        if order == 1:
-            faces, q = to_output_order(walk_out, faces, q)
-            walk_out = None
-    attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 29
-    if walk_out is not None:
-        faces, q = to_output_order(walk_out, faces, q)
-        for a in attrs:
-            if a['header'].domain == 0:
-                for key in ('ints', 'values'):
-                    vals = [None] * len(walk_out)
-                    for w, x in enumerate(a[key]):
-                        vals[walk_out[w]] = x
-                    a[key] = vals
-    return faces, q, glob, info, attrs
-
-
-def to_output_order(walk_out, faces, q):
-    """§8.13: faces and positions from walk vertices to output vertices."""
-    out_q = [None] * len(q)
-    for w, o in enumerate(walk_out):
-        out_q[o] = q[w]
-    return [[walk_out[x] for x in f] for f in faces], out_q
+    if not info['welded']:
+        attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 29
+        return faces, q, glob, info, attrs
+    if sr is not None:                                              # §8.13
+        reject('a segment cannot be welded')
+    n, p = read_varint(sa, 0, len(sa))
+    if n > len(sa) - p or p + n >= len(sa):
+        reject('split stream cut off')
+    split, order, sa = sa[p:p + n], sa[p + n], sa[p + n + 1:]
+    if order > 1:
+        reject('attribute order')
+    wfaces, walk_out, walk_point, orig = decode_split_layout(split, vc, info['points'], q, faces)
+    lst = [w for w in range(len(walk_out)) if orig[w] == w]      # the originals, in the order coded
+    if order == 1:
+        lst.sort(key=lambda w: walk_out[w])
+    rank = {w: k for k, w in enumerate(lst)}
+    afaces = [[rank[orig[x]] for x in f] for f in wfaces]
+    attrs = decode_attributes(sa, afaces, [NONE] * len(lst), [q[walk_point[w]] for w in lst])   # step 29
+    out_q = [None] * vc
+    for w in range(vc):
+        out_q[walk_out[w]] = q[walk_point[w]]
+    for a in attrs:
+        if a['header'].domain == 0:
+            for key in ('ints', 'values'):
+                vals = [None] * vc
+                for w in range(vc):
+                    vals[walk_out[w]] = a[key][rank[orig[w]]]
+                a[key] = vals
+    return [[walk_out[x] for x in f] for f in wfaces], out_q, glob, info, attrs
 
 
 def split_reduced(v):
@@ -2388,6 +2383,9 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     d = RangeDecoder(stream)
     fresh = probs(4 * 3 * 6)                               # fresh[nb][before][closeness]
     rank = [UIntModel() for _ in range(6)]
+    copy = probs(4)                                         # copy[nb]
+    copy_rank = UIntModel()
+    orig = []                                               # per walk vertex: the one whose values it has
     made = [[] for _ in range(points)]
     total = []                                              # per walk vertex: its faces' normals summed
     edge = {}
@@ -2409,6 +2407,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
             if not made[p]:
                 v[i] = len(total)
                 total.append([0, 0, 0])
+                orig.append(v[i])
                 made[p].append(v[i])
                 before = 1
             else:
@@ -2430,7 +2429,14 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 before = 1 if d.bit(fresh, (nb * 3 + before) * 6 + best) else 2
                 if before == 1:
                     v[i] = len(total)
+                    o = v[i]
+                    if d.bit(copy, nb):
+                        r = copy_rank.decode(d) if len(cand) > 1 else 0
+                        if r >= len(cand):
+                            reject('split: copy rank')
+                        o = orig[cand[r]]
                     total.append([0, 0, 0])
+                    orig.append(o)
                     made[p].append(v[i])
                 else:
                     r = rank[best].decode(d) if len(cand) > 1 else 0
@@ -2450,6 +2456,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
         if not made[p]:
             walk_out.append(nid)
             walk_point.append(p)
+            orig.append(len(orig))
             nid += 1
         for w in made[p]:
             walk_out[w] = nid
@@ -2457,7 +2464,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
             nid += 1
     if len(walk_out) != vertex_count:
         reject('split: vertex count')
-    return out_faces, walk_out, walk_point
+    return out_faces, walk_out, walk_point, orig
 
 
 def read_streams(body, p, n, what):

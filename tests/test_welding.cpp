@@ -142,6 +142,34 @@ TEST(Welding, TextureSeam) {
   EXPECT_LT(bytes.size(), size_without_attributes(plain) + 2 * m.vertex_count()) << "the seam costs little";
 }
 
+// An unindexed mesh (glTF without indices, the Fox): every face has
+// vertices of its own, with the same values at a position: the copies cost
+// a few bits each, their values nothing.
+TEST(Welding, UnindexedSmoothSphereCostsAboutTheIndexedOne) {
+  Mesh indexed = icosphere(3);
+  Attribute n = vertex_attribute("normal", AttributeKind::normal, 3);
+  for (size_t v = 0; v < indexed.vertex_count(); ++v)
+    for (int a = 0; a < 3; ++a) n.values.push_back(indexed.positions[3 * v + a]);
+  indexed.attributes = {n};
+  Mesh soup;
+  Attribute sn = vertex_attribute("normal", AttributeKind::normal, 3);
+  for (uint32_t f = 0; f < indexed.face_count(); ++f) {
+    uint32_t c[3];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t v = indexed.face(f)[k];
+      c[k] = static_cast<uint32_t>(soup.vertex_count());
+      soup.add_vertex(indexed.positions[3 * size_t{v}], indexed.positions[3 * size_t{v} + 1],
+                      indexed.positions[3 * size_t{v} + 2]);
+      for (int a = 0; a < 3; ++a) sn.values.push_back(n.values[3 * size_t{v} + a]);
+    }
+    soup.add_triangle(c[0], c[1], c[2]);
+  }
+  soup.attributes = {sn};
+  const size_t a = expect_exact(indexed, "indexed sphere").size();
+  const size_t b = expect_exact(soup, "unindexed sphere").size();
+  EXPECT_LT(b, a + a / 4) << "indexed " << a << ", unindexed " << b;
+}
+
 // A CAD-like part: flat-shaded, with slivers on edges (r, r, o) using the
 // split vertices, duplicated faces, a vertex on no face at a surface
 // position, and two faces sharing vertices across a crease.

@@ -107,37 +107,18 @@ struct DecodedPart {
   GeometryStats gstats;
   uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
   std::vector<AttributeCost> attribute_costs;  // filled for inspect() only
+  std::vector<uint32_t> split_q, split_corners;  // welded: per output vertex, per corner (walk ids)
   bool want_costs = false;
   Status status;
 };
 
-// After a welded part's attributes: walk order to output order (the
-// positions, the faces' corners, the vertex attributes' values).
-void to_output_order(const std::vector<uint32_t>& walk_out, DecodedPart& out) {
-  const size_t n = walk_out.size();
-  std::vector<uint32_t> q(out.q.size());
-  for (size_t w = 0; w < n; ++w)
-    for (int a = 0; a < 3; ++a) q[3 * size_t{walk_out[w]} + a] = out.q[3 * w + a];
-  out.q = std::move(q);
-  for (uint32_t& x : out.faces.indices) x = walk_out[x];
-  for (Attribute& at : out.faces.attributes) {
-    if (at.domain != AttributeDomain::vertex) continue;
-    const size_t k = at.components;
-    std::vector<float> values(at.values.size());
-    for (size_t w = 0; w < n && (w + 1) * k <= at.values.size(); ++w)
-      std::copy(at.values.begin() + static_cast<std::ptrdiff_t>(w * k),
-                at.values.begin() + static_cast<std::ptrdiff_t>((w + 1) * k),
-                values.begin() + static_cast<std::ptrdiff_t>(walk_out[w] * k));
-    at.values = std::move(values);
-  }
-}
-
 // FORMAT.md §8.13: a welded part's attribute payload opens with the split
-// stream (its length first), which turns the faces' points into vertices,
-// numbered in walk order for the attributes (`walk_out`: per walk vertex
-// its output id); each vertex takes its point's position.
+// stream (its length first) and the order byte. The split stream turns the
+// faces' points into walk vertices; the attributes are decoded on the
+// originals (`list`: walk vertices that copy no other, in walk order or in
+// output order), the corners naming their vertices' originals.
 Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_t points, DecodedPart& out,
-                    std::vector<uint32_t>& walk_out) {
+                    std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& list) {
   ByteReader r(attributes);
   uint64_t len = 0;
   std::string_view split;
@@ -147,16 +128,55 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
   if (!r.u8(order) || order > 1) return corrupt("a welded part's attribute order is missing or not 0 or 1");
   attributes = attributes.substr(r.offset());
   std::vector<uint32_t> walk_point;
-  TSM_RETURN_IF_ERROR(decode_split_layout(split, vertex_count, points, out.q, out.faces, walk_out, walk_point));
-  std::vector<uint32_t> q(3 * walk_point.size());
-  for (size_t w = 0; w < walk_point.size(); ++w)
-    for (int a = 0; a < 3; ++a) q[3 * w + a] = out.q[3 * size_t{walk_point[w]} + a];
-  out.q = std::move(q);
-  if (order == 1) {  // the attributes in output order: the walk is not needed after this
-    to_output_order(walk_out, out);
-    walk_out.clear();
-  }
+  std::vector<uint32_t> point_q = std::move(out.q);
+  TSM_RETURN_IF_ERROR(
+      decode_split_layout(split, vertex_count, points, point_q, out.faces, walk_out, walk_point, walk_orig));
+  const size_t n = walk_out.size();
+  list.clear();
+  for (uint32_t w = 0; w < n; ++w)
+    if (walk_orig[w] == w) list.push_back(w);
+  if (order == 1)
+    std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
+  std::vector<uint32_t> rank(n, kNone);
+  for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+  // The faces on the originals for the attributes; the positions per output vertex.
+  std::vector<uint32_t> corner_walk = out.faces.indices;
+  for (uint32_t& x : out.faces.indices) x = rank[walk_orig[x]];
+  out.q.assign(3 * list.size(), 0);
+  for (size_t k = 0; k < list.size(); ++k)
+    for (int a = 0; a < 3; ++a) out.q[3 * k + a] = point_q[3 * size_t{walk_point[list[k]]} + a];
+  out.split_q.assign(3 * n, 0);
+  for (size_t w = 0; w < n; ++w)
+    for (int a = 0; a < 3; ++a) out.split_q[3 * size_t{walk_out[w]} + a] = point_q[3 * size_t{walk_point[w]} + a];
+  out.split_corners = std::move(corner_walk);
+  out.global.assign(list.size(), kNone);  // the attributes' vertices
   return Status::Ok();
+}
+
+// After a welded part's attributes: the output vertices (positions, the
+// faces' corners, every vertex attribute's values from its original's).
+void to_output(const std::vector<uint32_t>& walk_out, const std::vector<uint32_t>& walk_orig,
+               const std::vector<uint32_t>& list, DecodedPart& out) {
+  const size_t n = walk_out.size();
+  std::vector<uint32_t> rank(n, kNone);
+  for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+  out.q = std::move(out.split_q);
+  out.global.assign(n, kNone);
+  out.faces.indices = std::move(out.split_corners);
+  for (uint32_t& x : out.faces.indices) x = walk_out[x];
+  for (Attribute& at : out.faces.attributes) {
+    if (at.domain != AttributeDomain::vertex) continue;
+    const size_t k = at.components;
+    if (at.values.size() != k * list.size()) continue;
+    std::vector<float> values(k * n);
+    for (size_t w = 0; w < n; ++w) {
+      const size_t from = rank[walk_orig[w]];
+      std::copy(at.values.begin() + static_cast<std::ptrdiff_t>(from * k),
+                at.values.begin() + static_cast<std::ptrdiff_t>((from + 1) * k),
+                values.begin() + static_cast<std::ptrdiff_t>(walk_out[w] * k));
+    }
+    at.values = std::move(values);
+  }
 }
 
 Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, DecodedPart& out) {
@@ -170,13 +190,13 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   TSM_RETURN_IF_ERROR(
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
   std::string_view attributes = s.attributes;
-  std::vector<uint32_t> walk_out;  // welded: per walk vertex its output id
+  std::vector<uint32_t> walk_out, walk_orig, list;  // welded: per walk vertex its output id and original
   if (out.cstats.welded && s.segmented) return corrupt("a segment's topology mode says welded (§8.13)");
   if (!s.segmented) {
     if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
     TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
     if (out.cstats.welded)
-      TSM_RETURN_IF_ERROR(split_welded(attributes, c.vertex_count, layout.vertex_count, out, walk_out));
+      TSM_RETURN_IF_ERROR(split_welded(attributes, c.vertex_count, layout.vertex_count, out, walk_out, walk_orig, list));
   } else {
     TSM_RETURN_IF_ERROR(
         decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
@@ -191,7 +211,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.table_coded = &out.table_coded_attributes;
   if (out.want_costs) ap.costs = &out.attribute_costs;
   TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
-  if (!walk_out.empty()) to_output_order(walk_out, out);
+  if (out.cstats.welded) to_output(walk_out, walk_orig, list, out);
   return Status::Ok();
 }
 

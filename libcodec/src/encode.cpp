@@ -709,28 +709,28 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   }
   if (rep.size() == V) return Status::Ok();
   const uint32_t np = static_cast<uint32_t>(rep.size());
-  Mesh w;
+  Mesh wm;
   std::vector<uint32_t> qw(3 * size_t{np});
-  w.positions.resize(3 * size_t{np});
+  wm.positions.resize(3 * size_t{np});
   for (uint32_t p = 0; p < np; ++p)
     for (int a = 0; a < 3; ++a) {
-      w.positions[3 * size_t{p} + a] = mesh.positions[3 * size_t{rep[p]} + a];
+      wm.positions[3 * size_t{p} + a] = mesh.positions[3 * size_t{rep[p]} + a];
       qw[3 * size_t{p} + a] = qin[3 * size_t{rep[p]} + a];
     }
-  w.face_offsets = mesh.face_offsets;
-  w.indices.resize(mesh.indices.size());
-  for (size_t k = 0; k < mesh.indices.size(); ++k) w.indices[k] = point[mesh.indices[k]];
+  wm.face_offsets = mesh.face_offsets;
+  wm.indices.resize(mesh.indices.size());
+  for (size_t k = 0; k < mesh.indices.size(); ++k) wm.indices[k] = point[mesh.indices[k]];
   EncodedPart pw;
-  TSM_RETURN_IF_ERROR(encode_part(w, qw, {}, {}, options, pw));
+  TSM_RETURN_IF_ERROR(encode_part(wm, qw, {}, {}, options, pw));
   pw.streams.topology[0] = static_cast<char>(pw.streams.topology[0] | 2);
   Mesh dec;
   GeometryLayout scratch;
-  TSM_RETURN_IF_ERROR(decode_connectivity(pw.streams, V, w.face_count(), w.corner_count(), dec, scratch));
+  TSM_RETURN_IF_ERROR(decode_connectivity(pw.streams, V, wm.face_count(), wm.corner_count(), dec, scratch));
   // The decoded faces on w's points, matched to the input faces.
   Mesh on_w = dec;
   for (uint32_t& x : on_w.indices) x = pw.order[x];
   std::vector<uint32_t> face, shift;
-  if (!match_faces(on_w, w, face, shift)) return Status(ErrorCode::internal, "welded faces do not match the input's");
+  if (!match_faces(on_w, wm, face, shift)) return Status(ErrorCode::internal, "welded faces do not match the input's");
   std::vector<uint32_t> corner_vertex(dec.indices.size());
   for (uint32_t f = 0; f < dec.face_count(); ++f) {
     const uint32_t n = dec.face_size(f), g = face[f];
@@ -741,30 +741,76 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   std::vector<uint32_t> indices, q_out(3 * size_t{np});
   for (uint32_t o = 0; o < np; ++o)
     for (int a = 0; a < 3; ++a) q_out[3 * size_t{o} + a] = qw[3 * size_t{pw.order[o]} + a];
-  const std::string split = encode_split_layout(dec, np, q_out, corner_vertex, point_vertex, out.order, walk_out,
-                                                walk_point, indices);
+  // Value classes: vertices of one point whose vertex attributes are equal
+  // on their grids (a copy is coded as such, its values not again). Not
+  // with corner attributes, whose coding follows the vertices' sharing of
+  // corner values (on the originals alone they would cost more: the
+  // corpus's OBJ exports nearly twice).
+  std::vector<uint32_t> value_class(V);
+  std::iota(value_class.begin(), value_class.end(), 0u);
+  const bool corner_attributes = std::any_of(headers.begin(), headers.end(), [](const AttributeHeader& h) {
+    return h.domain == AttributeDomain::corner;
+  });
+  if (!corner_attributes) {
+    std::vector<std::vector<int32_t>> key(V);
+    for (size_t i = 0; i < headers.size(); ++i) {
+      if (headers[i].domain != AttributeDomain::vertex) continue;
+      const Attribute& at = mesh.attributes[i];
+      std::vector<int32_t> k(attribute_key_size(headers[i]));
+      for (uint32_t v = 0; v < V; ++v) {
+        attribute_key(headers[i], &at.values[size_t{at.components} * v], k.data());
+        key[v].insert(key[v].end(), k.begin(), k.end());
+      }
+    }
+    std::vector<uint32_t> ids(V);
+    std::iota(ids.begin(), ids.end(), 0u);
+    std::stable_sort(ids.begin(), ids.end(), [&](uint32_t x, uint32_t y) {
+      return std::tie(point[x], key[x]) < std::tie(point[y], key[y]);
+    });
+    for (size_t i = 0; i < ids.size(); ++i)
+      value_class[ids[i]] = i > 0 && point[ids[i]] == point[ids[i - 1]] && key[ids[i]] == key[ids[i - 1]]
+                                ? value_class[ids[i - 1]]
+                                : ids[i];
+  }
+  std::vector<uint32_t> walk_input, walk_orig;
+  const std::string split = encode_split_layout(dec, np, q_out, corner_vertex, point_vertex, value_class, walk_input,
+                                                walk_out, walk_point, walk_orig, indices);
   out.streams = std::move(pw.streams);
   out.geometry = std::move(pw.geometry);
-  out.ref_out.assign(V, 0);
-  // The attributes in walk order (vertices as the faces make them: a face's
-  // texture coordinates and normals together) or in output order (point by
-  // point: what a position carries whatever the face, such as skin
-  // weights, repeats there), whichever is smaller.
+  // The attributes of the originals (the vertices that are not copies), in
+  // walk order (as the faces make them: a face's texture coordinates and
+  // normals together) or in output order (point by point: what a position
+  // carries whatever the face, such as skin weights, repeats there),
+  // whichever is smaller; the corners name the originals.
+  // The input with every corner on its vertex's original (what the
+  // attribute coder matches the decoded faces against).
+  Mesh on_originals = mesh;
+  {
+    std::vector<uint32_t> walk_of(V);
+    for (uint32_t w = 0; w < V; ++w) walk_of[walk_input[w]] = w;
+    for (uint32_t& x : on_originals.indices) x = walk_input[walk_orig[walk_of[x]]];
+  }
   EncodedPart by_walk, by_point;
-  by_walk.faces = dec;
-  by_walk.faces.indices = indices;
-  by_walk.order = out.order;
-  by_point.faces = std::move(dec);
-  by_point.faces.indices.resize(indices.size());
-  for (size_t k = 0; k < indices.size(); ++k) by_point.faces.indices[k] = walk_out[indices[k]];
-  by_point.order.resize(V);
-  for (uint32_t k = 0; k < V; ++k) by_point.order[walk_out[k]] = out.order[k];
-  for (EncodedPart* e : {&by_walk, &by_point}) {
-    e->ref_out.assign(V, 0);
-    e->q.resize(3 * size_t{V});
-    for (uint32_t k = 0; k < V; ++k)
-      for (int a = 0; a < 3; ++a) e->q[3 * size_t{k} + a] = qin[3 * size_t{e->order[k]} + a];
-    TSM_RETURN_IF_ERROR(encode_part_attributes(mesh, headers, nullptr, nullptr, attribute_tables(options), *e));
+  for (int point_order = 0; point_order < 2; ++point_order) {
+    EncodedPart& e = point_order ? by_point : by_walk;
+    std::vector<uint32_t> list;  // walk vertices that are originals, in the order coded
+    for (uint32_t w = 0; w < V; ++w)
+      if (walk_orig[w] == w) list.push_back(w);
+    if (point_order)
+      std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
+    std::vector<uint32_t> rank(V, kNone);
+    for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+    e.faces = dec;
+    for (size_t k = 0; k < indices.size(); ++k) e.faces.indices[k] = rank[walk_orig[indices[k]]];
+    e.order.resize(list.size());
+    e.ref_out.assign(list.size(), 0);
+    e.q.resize(3 * list.size());
+    for (uint32_t k = 0; k < list.size(); ++k) {
+      e.order[k] = walk_input[list[k]];
+      for (int a = 0; a < 3; ++a) e.q[3 * size_t{k} + a] = qin[3 * size_t{e.order[k]} + a];
+    }
+    TSM_RETURN_IF_ERROR(
+        encode_part_attributes(on_originals, headers, nullptr, nullptr, attribute_tables(options), e));
   }
   const bool point_order = by_point.attributes.size() < by_walk.attributes.size();
   EncodedPart& best = point_order ? by_point : by_walk;

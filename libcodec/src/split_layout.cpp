@@ -78,6 +78,8 @@ struct SplitModels {
   // 2 an old one][the first candidate's closeness (0-5)]
   Prob fresh[4][3][6];
   UIntModel rank[6];  // [the first candidate's closeness]
+  Prob copy[4];       // a new vertex with an earlier vertex's values, [neighbours]
+  UIntModel copy_rank;
 };
 
 // The walk both sides make: per corner, the candidates, then (after the
@@ -118,11 +120,15 @@ class SplitWalk {
   const std::vector<uint32_t>& cand() const { return sorted_; }
   int best() const { return best_; }
   size_t vertices_at(uint32_t p) const { return made_[p].size(); }
-  uint32_t make(uint32_t p) {
+  // A new vertex at p; `original`: the vertex whose attribute values it
+  // has (kNoVertex: its own).
+  uint32_t make(uint32_t p, uint32_t original = kNoVertex) {
     made_[p].push_back(next_);
     sum_.emplace_back();
+    original_.push_back(original == kNoVertex ? next_ : original_[original]);
     return next_++;
   }
+  const std::vector<uint32_t>& originals() const { return original_; }
   // After a face: its edges (corner points c, their vertices v) and its
   // normal added to its vertices' (once per corner).
   void remember(const uint32_t* c, const uint32_t* v, uint32_t n) {
@@ -157,8 +163,9 @@ class SplitWalk {
   static uint64_t key(uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; }
   std::vector<std::vector<uint32_t>> made_;
   const std::vector<uint32_t>& q_;
-  std::vector<Normal> sum_;  // per walk vertex: its faces' normals summed
-  Normal normal_;            // the current face's
+  std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
+  std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
+  Normal normal_;                   // the current face's
   std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> edge_;
   std::vector<uint32_t> cand_, sorted_, order_;
   std::vector<int> close_;
@@ -170,8 +177,9 @@ class SplitWalk {
 
 std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::vector<uint32_t>& q,
                                 const std::vector<uint32_t>& corner_vertex, const std::vector<uint32_t>& point_vertex,
-                                std::vector<uint32_t>& walk_input, std::vector<uint32_t>& walk_out,
-                                std::vector<uint32_t>& walk_point, std::vector<uint32_t>& indices) {
+                                const std::vector<uint32_t>& value_class, std::vector<uint32_t>& walk_input,
+                                std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point,
+                                std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& indices) {
   RangeEncoder e;
   SplitModels m;
   SplitWalk walk(points, q);
@@ -195,7 +203,14 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
         e.bit(m.fresh[nb][before][walk.best()], fresh);
         if (fresh) {
-          v[i] = walk.make(p);
+          // A copy: the values of a vertex of the point (the first such
+          // candidate).
+          const auto& cand = walk.cand();
+          uint32_t r = 0;
+          while (r < cand.size() && value_class[input_of[cand[r]]] != value_class[x]) ++r;
+          e.bit(m.copy[nb], r < cand.size());
+          if (r < cand.size() && cand.size() > 1) m.copy_rank.encode(e, r);
+          v[i] = walk.make(p, r < cand.size() ? cand[r] : kNoVertex);
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
@@ -213,6 +228,8 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
     walk.remember(c, v.data(), n);
   }
   walk.number(walk_out, walk_point);
+  walk_orig = walk.originals();
+  for (size_t w = walk_orig.size(); w < walk_point.size(); ++w) walk_orig.push_back(static_cast<uint32_t>(w));
   walk_input = input_of;
   for (size_t w = input_of.size(); w < walk_point.size(); ++w) walk_input.push_back(point_vertex[walk_point[w]]);
   indices = std::move(corner_walk);
@@ -221,7 +238,7 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
 
 Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint32_t points,
                            const std::vector<uint32_t>& q, Mesh& faces, std::vector<uint32_t>& walk_out,
-                           std::vector<uint32_t>& walk_point) {
+                           std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
   auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
   RangeDecoder d(stream);
   SplitModels m;
@@ -244,7 +261,14 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
         before = d.bit(m.fresh[nb][before][walk.best()]) ? 1 : 2;
         if (before == 1) {
-          v[i] = walk.make(p);
+          const auto& cand = walk.cand();
+          uint32_t original = kNoVertex;
+          if (d.bit(m.copy[nb])) {
+            const uint32_t r = cand.size() > 1 ? m.copy_rank.decode(d) : 0;
+            if (r >= cand.size()) return corrupt("a copy's rank out of range");
+            original = cand[r];
+          }
+          v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = cand.size() > 1 ? m.rank[walk.best()].decode(d) : 0;
@@ -260,6 +284,8 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
   }
   walk.number(walk_out, walk_point);
   if (walk_point.size() != vertex_count) return corrupt("the vertex count differs from the header's");
+  walk_orig = walk.originals();
+  for (size_t w = walk_orig.size(); w < walk_point.size(); ++w) walk_orig.push_back(static_cast<uint32_t>(w));
   return Status::Ok();
 }
 
