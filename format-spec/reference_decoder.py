@@ -727,9 +727,10 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     tables = rbits = None
     if len(s5) < 1:                                         # §8.3.1: the mode byte
         reject('topology stream is empty (no run coding mode)')
-    if s5[0] > 1:
-        reject('run coding mode %d' % s5[0])
-    if s5[0] == 1:
+    if s5[0] > 3:
+        reject('topology mode %d' % s5[0])
+    welded = (s5[0] & 2) != 0                               # §8.13
+    if s5[0] & 1:
         tables, rbits, p = read_tables(s5, 1, 8, 1, 'run values')
         s5 = s5[p:]
     else:
@@ -754,6 +755,11 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     o_count, o_corner, o_partner, o_position, o_distance, o_face_size, o_index = (UIntModel() for _ in range(7))
     o_rank = [UIntModel(), UIntModel()]                      # §8.3.2
     o_has_poly = probs(1)
+    o_on_edges = probs(1)                                    # §8.3.3
+    o_edge_any = probs(4)                                    # [prev][touched] at 2 prev + touched
+    o_edge_more = probs(1)
+    o_edge_count = UIntModel()
+    o_edge_end = probs(2)
 
     def overrun():
         return dv.overrun > 8 or dt.overrun > 8 or do.overrun > 8
@@ -925,6 +931,8 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
         else:
             ids[p] = nxt
             nxt += 1
+    if welded and nxt <= vertex_count:                       # §8.13: the ids are points
+        vertex_count = nxt
     if nxt != vertex_count:
         reject('vertex count')
     # §8.10 step 4
@@ -1019,7 +1027,48 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     nside = o_count.decode(do)
     if nside > face_count:
         reject('side face count')
-    for i in range(nside):
+    nverbatim = nside
+    if nside > 0 and do.bit(o_on_edges, 0):
+        # §8.3.3 side faces on edges
+        nverbatim = o_count.decode(do)
+        if nverbatim >= nside:
+            reject('side face count')
+        target = nside - nverbatim
+        found = 0
+        touched = [0] * vertex_count
+        prev = 0
+        for h in range(len(tri)):
+            if found == target:
+                break
+            if twin[h] < h:
+                continue
+            a, b = tri[h], tri[h - 2 if h % 3 == 2 else h + 1]
+            if virtual[a] or virtual[b] or ids[a] == ids[b]:
+                continue
+            u, v = ids[a], ids[b]
+            anyf = do.bit(o_edge_any, 2 * prev + (touched[u] | touched[v]))
+            prev = anyf
+            if anyf:
+                touched[u] = touched[v] = 1
+                n = 1
+                if do.bit(o_edge_more, 0):
+                    more = o_edge_count.decode(do)
+                    if more >= target:
+                        reject('side faces on edges')
+                    n = 2 + more
+                if n > target - found:
+                    reject('side faces on edges')
+                pe = 0
+                for j in range(n):
+                    pe = do.bit(o_edge_end, pe)
+                    r, o = (v, u) if pe else (u, v)
+                    push([r, r, o])
+                found += n
+            if overrun():
+                reject('side faces on edges')
+        if found != target:
+            reject('side faces on edges')
+    for i in range(nverbatim):
         sz = o_face_size.decode(do)
         if sz > corner_count or overrun():
             reject('side face size')
@@ -1035,7 +1084,8 @@ def decode_connectivity(s3, s4, s5, vertex_count, face_count, corner_count):
     if len(faces) != face_count or ncorners[0] != corner_count:
         reject('face/corner count mismatch')
     layout = {'tri': tri, 'twin': twin, 'id': ids, 'vparent': vparent, 'vertex_count': vertex_count}
-    info.update(virtual=nvirt, stitches=nstitch, side_faces=nside, polygons=polygons, triangles=NT)
+    info.update(virtual=nvirt, stitches=nstitch, side_faces=nside, polygons=polygons, triangles=NT,
+                welded=welded, points=vertex_count)
     return faces, layout, info
 
 
@@ -2220,7 +2270,8 @@ def decode_part(streams, counts, bits, earlier, trace):
     if rc > vc:
         reject('references')
     D = lambda b: 2843 * (len(b) + 8)
-    if vc - rc > D(s6) // 3 or cc > 3 * D(s4) + D(s5) // 6:
+    split = D(sa) if len(s5) > 0 and s5[0] & 2 else 0                # §8.13
+    if vc - rc > D(s6) // 3 + split or cc > 3 * D(s4) + 3 * D(s5):
         reject('stream budget')
     if sr is not None and vc > D(sr):
         reject('references budget')
@@ -2271,8 +2322,149 @@ def decode_part(streams, counts, bits, earlier, trace):
         layout = own
     q, ginfo = decode_geometry(s6, layout, bits, trace)             # step 28
     info.update(ginfo)
-    attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 29
-    return faces, q, glob, info, attrs
+    if not info['welded']:
+        attrs = decode_attributes(sa, faces, glob, q, sr is not None)   # step 29
+        return faces, q, glob, info, attrs
+    if sr is not None:                                              # §8.13
+        reject('a segment cannot be welded')
+    n, p = read_varint(sa, 0, len(sa))
+    if n > len(sa) - p or p + n >= len(sa):
+        reject('split stream cut off')
+    split, order, sa = sa[p:p + n], sa[p + n], sa[p + n + 1:]
+    if order > 1:
+        reject('attribute order')
+    wfaces, walk_out, walk_point, orig = decode_split_layout(split, vc, info['points'], q, faces)
+    lst = [w for w in range(len(walk_out)) if orig[w] == w]      # the originals, in the order coded
+    if order == 1:
+        lst.sort(key=lambda w: walk_out[w])
+    rank = {w: k for k, w in enumerate(lst)}
+    afaces = [[rank[orig[x]] for x in f] for f in wfaces]
+    attrs = decode_attributes(sa, afaces, [NONE] * len(lst), [q[walk_point[w]] for w in lst])   # step 29
+    out_q = [None] * vc
+    for w in range(vc):
+        out_q[walk_out[w]] = q[walk_point[w]]
+    for a in attrs:
+        if a['header'].domain == 0:
+            for key in ('ints', 'values'):
+                vals = [None] * vc
+                for w in range(vc):
+                    vals[walk_out[w]] = a[key][rank[orig[w]]]
+                a[key] = vals
+    return [[walk_out[x] for x in f] for f in wfaces], out_q, glob, info, attrs
+
+
+def split_reduced(v):
+    """§8.13: a normal to 9 bits a component (floor shifts)."""
+    m = max(abs(x) for x in v)
+    s = 0
+    while (m >> s) >= 512:
+        s += 1
+    return [x >> s for x in v]
+
+
+def split_closeness(f, total):
+    v = split_reduced(total)
+    if not any(f) or not any(v):
+        return 5
+    dot = f[0] * v[0] + f[1] * v[1] + f[2] * v[2]
+    if dot <= 0:
+        return 4
+    d2 = dot * dot * 1024
+    n2 = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    for k, t in enumerate((1023, 1004, 829, 256)):
+        if d2 >= t * n2:
+            return k
+    return 4
+
+
+def decode_split_layout(stream, vertex_count, points, q, faces):
+    """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
+    ids), per walk vertex its output id and its point."""
+    d = RangeDecoder(stream)
+    fresh = probs(4 * 3 * 6)                               # fresh[nb][before][closeness]
+    rank = [UIntModel() for _ in range(6)]
+    copy = probs(4)                                         # copy[nb]
+    copy_rank = UIntModel()
+    orig = []                                               # per walk vertex: the one whose values it has
+    made = [[] for _ in range(points)]
+    total = []                                              # per walk vertex: its faces' normals summed
+    edge = {}
+    out_faces = []
+    for f in faces:
+        n = len(f)
+        if any(p >= points for p in f):
+            reject('split: a corner outside the points')
+        fn = [0, 0, 0]
+        if n >= 3:
+            d1 = [q[f[1]][a] - q[f[0]][a] for a in range(3)]
+            d2 = [q[f[2]][a] - q[f[0]][a] for a in range(3)]
+            fn = split_reduced([d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2],
+                                d1[0] * d2[1] - d1[1] * d2[0]])
+        v = [NONE] * n
+        before = 0
+        for i in range(n):
+            p = f[i]
+            if not made[p]:
+                v[i] = len(total)
+                total.append([0, 0, 0])
+                orig.append(v[i])
+                made[p].append(v[i])
+                before = 1
+            else:
+                cand = []
+                a = edge.get((f[(i + 1) % n], p))
+                if a is not None:
+                    cand.append(a[1])
+                b = edge.get((p, f[(i + n - 1) % n]))
+                if b is not None and b[0] not in cand:
+                    cand.append(b[0])
+                nb = 0 if not cand else 1 if (a is None or b is None) else 2 if len(cand) == 1 else 3
+                for w in reversed(made[p]):
+                    if w not in cand:
+                        cand.append(w)
+                close = [split_closeness(fn, total[w]) for w in cand]
+                order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
+                cand = [cand[k] for k in order]
+                best = close[order[0]]
+                before = 1 if d.bit(fresh, (nb * 3 + before) * 6 + best) else 2
+                if before == 1:
+                    v[i] = len(total)
+                    o = v[i]
+                    if d.bit(copy, nb):
+                        r = copy_rank.decode(d) if len(cand) > 1 else 0
+                        if r >= len(cand):
+                            reject('split: copy rank')
+                        o = orig[cand[r]]
+                    total.append([0, 0, 0])
+                    orig.append(o)
+                    made[p].append(v[i])
+                else:
+                    r = rank[best].decode(d) if len(cand) > 1 else 0
+                    if r >= len(cand):
+                        reject('split: vertex rank')
+                    v[i] = cand[r]
+            if len(total) > vertex_count or d.truncated():
+                reject('split: too many vertices or truncated')
+        for i in range(n):
+            edge[(f[i], f[(i + 1) % n])] = (v[i], v[(i + 1) % n])
+            total[v[i]] = [total[v[i]][a] + fn[a] for a in range(3)]
+        out_faces.append(v)
+    walk_out = [NONE] * len(total)
+    walk_point = [NONE] * len(total)
+    nid = 0
+    for p in range(points):
+        if not made[p]:
+            walk_out.append(nid)
+            walk_point.append(p)
+            orig.append(len(orig))
+            nid += 1
+        for w in made[p]:
+            walk_out[w] = nid
+            walk_point[w] = p
+            nid += 1
+    if len(walk_out) != vertex_count:
+        reject('split: vertex count')
+    return out_faces, walk_out, walk_point, orig
 
 
 def read_streams(body, p, n, what):

@@ -5,7 +5,8 @@
   mixed.obj     a latitude-longitude sphere (its vertex tree suits the ancestor
                 predictor), a torus of quads with two holes (a handle, polygons),
                 a fin of three triangles on one edge (a non-manifold edge), a
-                hexagon, a degenerate face (a side face), three isolated vertices
+                hexagon, degenerate faces (side faces: four on edges, one verbatim),
+                three isolated vertices
   mixed_small.obj  the same with a 6 x 10 sphere (at -q 10 -l 9: the gate
                 predictor with its weights left out, §8.5.1 bit 7)
   irregular.obj  a 30 x 30 grid of jittered points on a wavy sheet, quads
@@ -31,6 +32,8 @@
                 shared and unused values
   attributes.ply  mixed(12, 20) with vertex, face and corner attributes of
                 every kind and type
+  flat.ply      a flat-shaded sphere and box (a vertex per face corner carrying
+                the face's normal, slivers, a vertex on no face): welded (§8.13)
   uv_vertex.ply   curved surfaces with per-vertex texture coordinates (s t) in
                 smooth charts, one mirrored: predictor 2 in the vertex domain
   uv_corner.obj   a UV sphere, a torus and a box with corner texture
@@ -210,7 +213,11 @@ def mixed(n_=30, m_=60):
           for k in range(6)]
     F.append(hc)                                           # a hexagon
     F.append([hc[0], hc[5], v(-1.9, -0.3, 0.2)])
-    F.append([hc[1], hc[2], hc[2]])                        # a degenerate face
+    F.append([hc[1], hc[2], hc[2]])                        # degenerate faces on edges (side faces)
+    F.append([hc[2], hc[1], hc[2]])
+    F.append([hc[1], hc[1], hc[2]])
+    F.append([hc[3], hc[0], hc[0]])                        # on a polygon diagonal
+    F.append([hc[1], hc[1], hc[4]])                        # on no edge: verbatim
     v(2.6, 0.05, 0.3)                                      # isolated vertices
     v(-3, -3, 2)
     v(-2.45, 0.1, 0.1)
@@ -437,6 +444,50 @@ def uv_surfaces():
                   [ring[i, j], ring[i + 1, (j + 1) % m_], ring[i, (j + 1) % m_]]]
     v((5, 5, 5), (0.3, 0.7))                               # an isolated vertex
     return V, F, UV
+
+
+def flat_ply(path):
+    """A sphere and a box, flat-shaded as glTF has it: every face has vertices
+    of its own carrying its normal (nx ny nz), plus a few slivers (r, r, o) on
+    split vertices and a vertex on no face: welded (§8.13)."""
+    V0, F0 = [(0.0, 0.0, -1.0), (0.0, 0.0, 1.0)], []
+    n_, m_ = 8, 12
+    for i in range(1, n_):
+        th = math.pi * i / n_
+        for j in range(m_):
+            ph = 2 * math.pi * j / m_
+            V0.append((math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), -math.cos(th)))
+    r = lambda i, j: 2 + (i - 1) * m_ + j % m_
+    for j in range(m_):
+        F0.append([0, r(1, j + 1), r(1, j)])
+        F0.append([1, r(n_ - 1, j), r(n_ - 1, j + 1)])
+        for i in range(1, n_ - 1):
+            F0.append([r(i, j), r(i, j + 1), r(i + 1, j + 1)])
+            F0.append([r(i, j), r(i + 1, j + 1), r(i + 1, j)])
+    B, FB = box()
+    F0 = F0 + [[x + len(V0) for x in fa] for fa in FB]
+    V0 = V0 + [(x + 2.5, y, z) for x, y, z in B]
+    V, N, F = [], [], []
+    for fa in F0:
+        nx, ny, nz = face_normal(V0, fa)
+        F.append(list(range(len(V), len(V) + len(fa))))
+        for x in fa:
+            V.append(V0[x])
+            N.append((nx, ny, nz))
+    for k in range(0, 30, 7):
+        fa = F[k]
+        F.append([fa[0], fa[0], fa[1]])
+    V.append(V[0])
+    N.append((0.0, 0.0, 1.0))
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
+        f.write('property float x\nproperty float y\nproperty float z\n')
+        f.write('property float nx\nproperty float ny\nproperty float nz\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
+        for (x, y, z), (a, b, c) in zip(V, N):
+            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
+        for fa in F:
+            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
 
 
 def uv_vertex_ply(path):
@@ -722,6 +773,7 @@ def main():
     attr_obj(os.path.join(out, 'attributes.obj'), *mixed(12, 20))
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
+    flat_ply(os.path.join(out, 'flat.ply'))
     uv_corner_obj(os.path.join(out, 'uv_corner.obj'))
 
 

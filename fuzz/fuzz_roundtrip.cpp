@@ -6,7 +6,8 @@
 //   byte 0   quantization bits, 1 + b % 30; bit 7: with attributes (a u8
 //            colour and a normal per vertex, an i32 per face, and a texture
 //            coordinate per corner with seams and values shared far apart,
-//            across segment borders too)
+//            across segment borders too); with byte 3's bit 7 also split
+//            vertices: about half the corners get a copy of their vertex
 //   byte 1   level b % 10 (low nibble), position mode (b >> 4) % 4, bit 6:
 //            also check that a second encode gives the same bytes, bit 7:
 //            segments of at most 8 + byte 2 % 32 faces, also decoded
@@ -83,6 +84,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (uint32_t i = 0; i < n; ++i) corners[i] = data[at++] % nv;
     m.add_face(corners, n);
   }
+  uint32_t na = nv;  // vertices that carry attributes
+  if ((data[0] & 0x80) && (data[3] & 0x80)) {
+    // Split vertices (FORMAT.md §8.13, welded): about half the corners get
+    // a copy of their vertex of their own (other attribute values at the
+    // same position, as flat shading and seams make them).
+    for (size_t k = 0; k < m.indices.size(); ++k)
+      if (mix(k + 7) & 1) {
+        const uint32_t v = m.indices[k];
+        m.add_vertex(m.positions[3 * size_t{v}], m.positions[3 * size_t{v} + 1], m.positions[3 * size_t{v} + 2]);
+        m.indices[k] = static_cast<uint32_t>(m.vertex_count() - 1);
+      }
+    na = static_cast<uint32_t>(m.vertex_count());
+  }
   if (data[0] & 0x80) {
     tsm::Attribute c, n, f, t;
     c.name = "color";
@@ -92,7 +106,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     n.name = "normal";
     n.kind = tsm::AttributeKind::normal;
     n.components = 3;
-    for (uint32_t i = 0; i < nv; ++i) {
+    for (uint32_t i = 0; i < na; ++i) {
       for (uint32_t k = 0; k < 3; ++k) c.values.push_back(static_cast<float>(mix(i * 7u + k) & 255));
       for (uint32_t k = 0; k < 3; ++k) n.values.push_back(static_cast<float>(static_cast<int64_t>(mix(i * 5u + k) % 2001) - 1000));
     }
@@ -108,9 +122,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       t.components = 2;
       for (size_t k = 0; k < m.corner_count(); ++k) {
         const uint64_t r = mix(k + 99);
-        t.indices.push_back(r & 1 ? m.indices[k] : nv + static_cast<uint32_t>(r % 5));
+        t.indices.push_back(r & 1 ? m.indices[k] : na + static_cast<uint32_t>(r % 5));
       }
-      for (uint32_t j = 0; j < nv + 5; ++j) {
+      for (uint32_t j = 0; j < na + 5; ++j) {
         t.values.push_back(static_cast<float>(mix(j) % 1000) / 999.0f);
         t.values.push_back(static_cast<float>(mix(j + 1000) % 1000) / 999.0f);
       }
@@ -132,7 +146,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   tsm::FileInfo info;
   s = tsm::inspect(bytes, info);
   if (!s.ok()) fail("inspect refused the encoder's output: " + s.to_string());
-  if (info.vertex_count != nv || info.face_count != m.face_count() || info.corner_count != m.corner_count())
+  if (info.vertex_count != m.vertex_count() || info.face_count != m.face_count() || info.corner_count != m.corner_count())
     fail("inspect's counts differ from the mesh");
   tsm::CompareResult cr = tsm::compare_meshes(m, back, options.quantization_bits);
   if (!cr.equal) fail("oracle: the decoded mesh differs: " + cr.difference);

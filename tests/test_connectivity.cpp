@@ -234,6 +234,39 @@ TEST(Connectivity, DuplicateAndDegenerateFaces) {
   expect_round_trip(m, "duplicate and degenerate faces");
 }
 
+// Triangles on two vertices (r, r, o) lying on an edge of the surface (a
+// CAD export's slivers, strip padding) are coded on that edge (FORMAT.md
+// §8.3.3): a few bits each instead of a size and three vertex ids; those on
+// no edge stay verbatim.
+TEST(Connectivity, DegenerateTrianglesOnEdges) {
+  const Mesh base = icosphere(3);
+  Mesh m = base;
+  std::mt19937 rng(36);
+  size_t added = 0;
+  for (size_t f = 0; f < base.face_count(); f += 1 + rng() % 4) {
+    const uint32_t* c = base.face(static_cast<uint32_t>(f));
+    const uint32_t k = static_cast<uint32_t>(rng() % 3), r = c[k], o = c[(k + 1) % 3];
+    const int copies = rng() % 5 == 0 ? 2 + static_cast<int>(rng() % 3) : 1;
+    for (int i = 0; i < copies; ++i, ++added) {
+      const uint32_t rot = static_cast<uint32_t>(rng() % 3);  // any rotation, either end repeated
+      const uint32_t t[3] = {r, r, o};
+      const uint32_t u[3] = {t[rot], t[(rot + 1) % 3], t[(rot + 2) % 3]};
+      m.add_triangle(u[0], u[1], u[2]);
+    }
+  }
+  m.add_triangle(0, 0, 100);  // on no edge
+  m.add_triangle(7, 7, 7);
+  expect_round_trip(m, "degenerate triangles on edges");
+  EXPECT_EQ(stats_of(m).side_faces, added + 2);
+  std::string with, without;
+  EncodeOptions eo;
+  eo.quantization_bits = 14;
+  ASSERT_TRUE(encode(m, eo, with).ok());
+  ASSERT_TRUE(encode(base, eo, without).ok());
+  // Verbatim, each would cost a face size and three vertex ids (~37 bits).
+  EXPECT_LT(with.size() - without.size(), added / 2 + 16) << added << " faces on edges";
+}
+
 TEST(Connectivity, QuadsAndNgons) {
   expect_round_trip(cube_quads(), "cube of quads");
   for (int n : {4, 5, 8, 17}) expect_round_trip(ngon(n), "ngon " + std::to_string(n));

@@ -168,6 +168,33 @@ Mesh smooth_sphere() { return snapped(noisy(tsm_test::icosphere(4), 0.002f, 5));
 
 Mesh cube() { return tsm_test::cube_quads(); }
 
+// Welded (FORMAT.md §8.13): a flat-shaded sphere, every face with vertices
+// of its own carrying its normal and a colour, a sliver on split vertices.
+Mesh welded_mesh() {
+  const Mesh base = snapped(tsm_test::icosphere(1));
+  Mesh m;
+  Attribute n = attribute("normal", AttributeKind::normal, AttributeDomain::vertex, AttributeType::f32, 3);
+  Attribute c = attribute("color", AttributeKind::color, AttributeDomain::vertex, AttributeType::u8, 3);
+  for (uint32_t f = 0; f < base.face_count(); ++f) {
+    uint32_t corner[3];
+    float sum[3] = {0, 0, 0};
+    for (uint32_t k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) sum[a] += base.positions[3 * size_t{base.face(f)[k]} + a];
+    const float r = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+    for (uint32_t k = 0; k < 3; ++k) {
+      const float* p = &base.positions[3 * size_t{base.face(f)[k]}];
+      corner[k] = static_cast<uint32_t>(m.vertex_count());
+      m.add_vertex(p[0], p[1], p[2]);
+      for (int a = 0; a < 3; ++a) n.values.push_back(sum[a] / r);
+      for (int a = 0; a < 3; ++a) c.values.push_back(static_cast<float>((29 * f + 70 * a) % 256));
+    }
+    m.add_triangle(corner[0], corner[1], corner[2]);
+  }
+  m.add_triangle(0, 0, 1);
+  m.attributes = {n, c};
+  return m;
+}
+
 bool has(const std::string& s, const char* part) { return s.find(part) != std::string::npos; }
 
 struct Case {
@@ -203,6 +230,11 @@ const std::vector<Case>& cases() {
        [](const tsm::FileInfo& fi) { EXPECT_EQ(fi.geometry_predictor.rfind("fan", 0), 0u) << fi.geometry_predictor; }},
       {"high_level9.tsm", "noisy_sphere", 14, 9, 0, noisy_sphere,
        [](const tsm::FileInfo& fi) { EXPECT_TRUE(has(fi.geometry_predictor, "+mix")) << fi.geometry_predictor; }},
+      {"welded.tsm", "welded", 12, 6, 0, welded_mesh,
+       [](const tsm::FileInfo& fi) {
+         EXPECT_EQ(fi.welded_points, 42u);
+         EXPECT_GT(fi.side_faces, 0u);
+       }},
       {"cube_raw.tsm", "cube", 16, 6, 0, cube,
        [](const tsm::FileInfo& fi) {
          EXPECT_EQ(fi.geometry_predictor, "raw+top");

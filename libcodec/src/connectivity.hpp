@@ -279,7 +279,9 @@ Status decode_triangle_tree(uint32_t loop_length, const TriangleRuns& runs, cons
 struct ConnectivityStats {
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
            virtual_vertices = 0, side_faces = 0, polygons = 0, marching_bits = 0;
-  uint64_t run_tables = 0;  // 1 when the run values were table-coded (mode 1)
+  uint64_t run_tables = 0;  // 1 when the run values were table-coded (mode bit 0)
+  uint64_t welded = 0;      // 1 when the faces are on welded points (mode bit 1, FORMAT.md §8.13)
+  uint64_t points = 0;      // then the number of points
   uint64_t bytes = 0;
 };
 

@@ -25,10 +25,10 @@ struct VertexTreeModels {
 
 struct TriangleTreeModels {
   UIntModel root;
-  UIntModel march[2][2];  // [previous run's end type][this run's end type]
-  Prob end[2][2];         // [previous run's end][the end of the run before it]
+  UIntModel march[2][2];     // [previous run's end type][this run's end type]
+  Prob end[2][2];            // [previous run's end][the end of the run before it]
   Prob bit[kMarchContexts];  // see MarchBitDecoder
-  Prob diagonal[2];    // by previous flag
+  Prob diagonal[2];          // by previous flag
 };
 
 struct TopologyModels {
@@ -37,7 +37,33 @@ struct TopologyModels {
   // StitchCandidates::context.
   UIntModel rank[2];
   Prob has_polygons;
+  // Side faces on edges (FORMAT.md §8.3.3): whether the list is coded;
+  // per edge, whether faces lie on it (by the previous edge's bit and
+  // whether an end already had some), more than one, how many more, and
+  // per face its repeated end (by the previous face's on the edge).
+  Prob on_edges;
+  Prob edge_any[2][2];
+  Prob edge_more;
+  UIntModel edge_count;
+  Prob edge_end[2];
 };
+
+// FORMAT.md §8.3.3: the edges a degenerate triangle (a, a, b) may be coded
+// on: the cut surface's half-edges h in decode order, each pair once (h
+// before its twin), as output ids (u, v) from h's start to its end; left
+// out when an end is virtual or both ends are one vertex. `id` maps a
+// pre-order position (decoder) or an output id (encoder) to an output id,
+// kNone for a virtual position. f(u, v) returns false to stop.
+template <class Id, class F>
+void each_side_edge(const std::vector<uint32_t>& corner, const std::vector<uint32_t>& twin, Id id, F f) {
+  const uint32_t nh = static_cast<uint32_t>(corner.size());
+  for (uint32_t h = 0; h < nh; ++h) {
+    if (twin[h] < h) continue;
+    const uint32_t u = id(corner[h]), v = id(corner[h % 3 == 2 ? h - 2 : h + 1]);
+    if (u == kNone || v == kNone || u == v) continue;
+    if (!f(u, v)) return;
+  }
+}
 
 // FORMAT.md §8.3.2: the candidates for a stitch's target. A
 // stitched position d is a copy of a vertex T; each of d's neighbours in

@@ -26,20 +26,20 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 }  // namespace
 
 Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count, uint64_t face_count,
-                           uint64_t corner_count, Mesh& out, GeometryLayout& layout,
-                           ConnectivityStats* stats) {
+                           uint64_t corner_count, Mesh& out, GeometryLayout& layout, ConnectivityStats* stats) {
   // §8.3.1: the mode byte, and with tables the bit stream's length, the run
   // tables and the bit stream before the range-coded rest.
   std::string_view topology = in.topology;
-  bool tables = false;
+  bool tables = false, welded = false;
   TableSet run_tables;
   BitReader run_bits;
   {
     ByteReader r(topology);
     uint8_t mode;
     if (!r.u8(mode)) return corrupt("topology stream is empty (no run coding mode)");
-    if (mode > 1) return corrupt("run coding mode " + std::to_string(mode) + " (0 adaptive or 1 tables)");
-    if (mode == 1) {
+    if (mode > 3) return corrupt("topology mode " + std::to_string(mode) + " (bit 0 tables, bit 1 welded)");
+    welded = (mode & 2) != 0;
+    if (mode & 1) {
       std::string why;
       if (!read_table_block(r, kRunContexts, kRunMapBytes, run_tables, run_bits, why))
         return corrupt("run values: " + why);
@@ -204,7 +204,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     // surface closes (no half-edge is left without a twin: checked below).
     for (uint32_t p = 0; p < L; ++p) {
       const uint32_t o = loop_twin[p];
-      if (loop_he[p] == kNone || o >= L || o == p || loop_twin[o] != p) return corrupt("the cut surface does not close");
+      if (loop_he[p] == kNone || o >= L || o == p || loop_twin[o] != p)
+        return corrupt("the cut surface does not close");
       twin[loop_he[p]] = loop_he[o];
     }
     if (polygons)
@@ -225,7 +226,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   uint32_t at = 0;
   for (uint32_t i = 0; i < nvirt; ++i) {
     uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-    if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("virtual vertex position out of range");
+    if (d > P || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0))
+      return corrupt("virtual vertex position out of range");
     at += d;
     is_virtual[at] = 1;
   }
@@ -238,7 +240,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
     std::vector<uint32_t> at_list(nstitch);
     for (uint32_t i = 0; i < nstitch; ++i) {
       const uint32_t d = run_value(om.position, dop, kRunPositionCtx);
-      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0)) return corrupt("stitch position out of range");
+      if (overrun() || at + static_cast<uint64_t>(d) >= P || (i > 0 && d == 0))
+        return corrupt("stitch position out of range");
       at += d;
       stitched[at] = 1;
       at_list[i] = at;
@@ -272,6 +275,9 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       out_id[p] = next_id++;
     }
   }
+  // Welded (§8.13): the ids are points, at most one per vertex; from here
+  // on they are what the counts and bounds are about.
+  if (welded && next_id <= vertex_count) vertex_count = next_id;
   if (next_id != vertex_count)
     return corrupt("connectivity gives " + std::to_string(next_id) + " vertices, the header says " +
                    std::to_string(vertex_count));
@@ -287,11 +293,47 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
       layout.parent[out_id[p]] = out_id[parent[p]];
     }
   }
-  // Side faces: kept verbatim (the topology stream's last list).
+  // Side faces (the topology stream's last list): on edges (§8.3.3), then
+  // verbatim.
   const uint32_t nside = om.count.decode(dop);
   if (nside > face_count) return corrupt("more side faces than faces");
   std::vector<uint32_t> side, side_start(1, 0);
-  for (uint32_t i = 0; i < nside; ++i) {
+  uint32_t nverbatim = nside;
+  if (nside > 0 && dop.bit(om.on_edges)) {
+    nverbatim = om.count.decode(dop);
+    if (nverbatim >= nside) return corrupt("bad side face count");
+    const uint32_t target = nside - nverbatim;
+    uint32_t found = 0;
+    std::vector<uint8_t> touched(vertex_count, 0);
+    int prev = 0;
+    bool bad = false;
+    each_side_edge(
+        corner, twin, [&](uint32_t p) { return out_id[p]; },
+        [&](uint32_t u, uint32_t v) {
+          const int any = dop.bit(om.edge_any[prev][touched[u] | touched[v]]);
+          prev = any;
+          if (!any) return !(bad = overrun());
+          touched[u] = touched[v] = 1;
+          uint32_t n = 1;
+          if (dop.bit(om.edge_more)) {
+            const uint32_t more = om.edge_count.decode(dop);
+            if (more >= target) return !(bad = true);
+            n = 2 + more;
+          }
+          if (n > target - found) return !(bad = true);
+          int pe = 0;
+          for (uint32_t j = 0; j < n; ++j) {
+            pe = dop.bit(om.edge_end[pe]);
+            const uint32_t r = pe ? v : u, o = pe ? u : v;
+            side.insert(side.end(), {r, r, o});
+            side_start.push_back(static_cast<uint32_t>(side.size()));
+          }
+          found += n;
+          return !(bad = overrun()) && found < target;
+        });
+    if (bad || found != target) return corrupt("bad side faces on edges");
+  }
+  for (uint32_t i = 0; i < nverbatim; ++i) {
     uint32_t n = om.face_size.decode(dop);
     if (n > corner_count || side.size() + n > corner_count || overrun()) return corrupt("bad side face size");
     for (uint32_t j = 0; j < n; ++j) {
@@ -454,6 +496,8 @@ Status decode_connectivity(const ConnectivityStreams& in, uint64_t vertex_count,
   st.stitches = nstitch;
   st.side_faces = nside;
   st.run_tables = tables;
+  st.welded = welded;
+  st.points = welded ? vertex_count : 0;
   if (stats) *stats = st;
   return Status::Ok();
 }

@@ -60,18 +60,51 @@ struct RunEncoder {
 
 // The topology stream from the virtual vertices on: the lists it codes.
 struct TopologyTail {
-  std::vector<uint32_t> virtual_pos;                     // ascending
+  std::vector<uint32_t> virtual_pos;                    // ascending
   std::vector<std::pair<uint32_t, uint32_t>> stitches;  // (position, target), ascending positions
-  uint32_t side_faces = 0;
-  std::vector<uint32_t> side;  // per side face: its size, then its corners (output ids)
+  uint32_t side_faces = 0;                              // all of them: on edges and verbatim
+  std::vector<uint32_t> side;  // per verbatim side face: its size, then its corners (output ids)
+  // Side faces on edges (§8.3.3): the edges up to the last with faces
+  // (each_side_edge order) and per edge the faces with end 0 and end 1.
+  std::vector<std::pair<uint32_t, uint32_t>> edge;
+  std::vector<std::pair<uint32_t, uint32_t>> edge_n;
+  uint32_t edge_faces = 0;
+  uint32_t vertex_count = 0;
 };
+
+// The side faces on edges (FORMAT.md §8.3.3).
+void code_edge_faces(RangeEncoder& e, TopologyModels& o, const TopologyTail& t) {
+  e.bit(o.on_edges, t.edge_faces > 0);
+  if (t.edge_faces == 0) return;
+  o.count.encode(e, t.side_faces - t.edge_faces);
+  std::vector<uint8_t> touched(t.vertex_count, 0);
+  int prev = 0;
+  for (size_t i = 0; i < t.edge.size(); ++i) {
+    const auto [u, v] = t.edge[i];
+    const auto [n0, n1] = t.edge_n[i];
+    const int any = n0 + n1 > 0;
+    e.bit(o.edge_any[prev][touched[u] | touched[v]], any);
+    prev = any;
+    if (!any) continue;
+    touched[u] = touched[v] = 1;
+    const uint32_t n = n0 + n1;
+    e.bit(o.edge_more, n > 1);
+    if (n > 1) o.edge_count.encode(e, n - 2);
+    int pe = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+      const int b = j >= n0;
+      e.bit(o.edge_end[pe], b);
+      pe = b;
+    }
+  }
+}
 
 // Codes the tail: with `sc`, stitch targets by their rank among the
 // candidates (§8.3.2; positions all first), as the file has them; without,
 // every target as a distance, after its position (what the encoder
 // measures the run tables on and orders codings by, encode_connectivity).
-void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const TopologyTail& t,
-               StitchCandidates* sc = nullptr, std::vector<uint32_t>* target = nullptr) {
+void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const TopologyTail& t, StitchCandidates* sc = nullptr,
+               std::vector<uint32_t>* target = nullptr) {
   o.count.encode(e, static_cast<uint32_t>(t.virtual_pos.size()));
   uint32_t prev = 0;
   for (uint32_t p : t.virtual_pos) {
@@ -94,6 +127,7 @@ void code_tail(RangeEncoder& e, TopologyModels& o, RunEncoder& r, const Topology
       (*target)[dup] = orig;
     }
   o.count.encode(e, t.side_faces);
+  if (t.side_faces > 0) code_edge_faces(e, o, t);
   for (size_t i = 0; i < t.side.size(); i += 1 + size_t{t.side[i]}) {
     o.face_size.encode(e, t.side[i]);
     for (uint32_t j = 1; j <= t.side[i]; ++j) o.index.encode(e, t.side[i + j]);
@@ -318,7 +352,75 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     std::vector<uint32_t> input_to_out(mesh.vertex_count());
     for (uint32_t i = 0; i < out.vertex_order.size(); ++i) input_to_out[out.vertex_order[i]] = i;
     tail.side_faces = static_cast<uint32_t>(prep.side_faces.size());
+    tail.vertex_count = g.vertex_count;
+    // A triangle on two vertices (r, r, o) goes on an edge between them
+    // (§8.3.3), when the cut surface has one: the first in each_side_edge
+    // order; its end bit says which end r is.
+    std::vector<uint64_t> on_edge;  // (edge key << 1 | end) per such face
+    std::vector<uint32_t> verbatim;
+    std::vector<uint64_t> keys;  // (u, v) with u < v, per enumerated edge, << 32 | index
     for (uint32_t face : prep.side_faces) {
+      const uint32_t* c = mesh.face(face);
+      if (mesh.face_size(face) == 3) {
+        const uint32_t a = input_to_out[c[0]], b = input_to_out[c[1]], d = input_to_out[c[2]];
+        uint32_t r = kNone, o = kNone;
+        if (a == b && b != d)
+          r = a, o = d;
+        else if (b == d && d != a)
+          r = b, o = a;
+        else if (d == a && a != b)
+          r = d, o = b;
+        if (r != kNone) {
+          on_edge.push_back((uint64_t{std::min(r, o)} << 32 | std::max(r, o)) << 1 | (r > o));
+          continue;
+        }
+      }
+      verbatim.push_back(face);
+    }
+    if (!on_edge.empty()) {
+      std::vector<std::pair<uint64_t, uint32_t>> edges;  // (key, enumeration index)
+      each_side_edge(
+          g.corner, g.twin, [](uint32_t x) { return x; },
+          [&](uint32_t u, uint32_t v) {
+            tail.edge.emplace_back(u, v);
+            edges.emplace_back(uint64_t{std::min(u, v)} << 32 | std::max(u, v), static_cast<uint32_t>(edges.size()));
+            return true;
+          });
+      std::sort(edges.begin(), edges.end());  // the first of equal keys first
+      tail.edge_n.assign(tail.edge.size(), {0, 0});
+      size_t last = 0;
+      for (uint64_t x : on_edge) {
+        const uint64_t key = x >> 1;
+        const auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, uint32_t{0}));
+        if (it == edges.end() || it->first != key) continue;  // on no edge: verbatim (below)
+        const uint32_t i = it->second;
+        // end 0: r is the edge's start u
+        const uint32_t r = (x & 1) ? static_cast<uint32_t>(key) : static_cast<uint32_t>(key >> 32);
+        (r == tail.edge[i].first ? tail.edge_n[i].first : tail.edge_n[i].second)++;
+        ++tail.edge_faces;
+        last = std::max<size_t>(last, i + 1);
+      }
+      tail.edge.resize(last);
+      tail.edge_n.resize(last);
+      // The faces on no edge stay verbatim (in input order).
+      verbatim.clear();
+      for (uint32_t face : prep.side_faces) {
+        const uint32_t* c = mesh.face(face);
+        bool coded = false;
+        if (mesh.face_size(face) == 3) {
+          const uint32_t a = input_to_out[c[0]], b = input_to_out[c[1]], d = input_to_out[c[2]];
+          const uint32_t lo = std::min({a, b, d}), hi = std::max({a, b, d});
+          const bool two = lo != hi && (a == b || b == d || d == a);
+          if (two) {
+            const uint64_t key = uint64_t{lo} << 32 | hi;
+            const auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, uint32_t{0}));
+            coded = it != edges.end() && it->first == key;
+          }
+        }
+        if (!coded) verbatim.push_back(face);
+      }
+    }
+    for (uint32_t face : verbatim) {
       tail.side.push_back(mesh.face_size(face));
       for (uint32_t i = 0; i < mesh.face_size(face); ++i) tail.side.push_back(input_to_out[mesh.face(face)[i]]);
     }

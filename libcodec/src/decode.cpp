@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "attributes.hpp"
+#include "byte_io.hpp"
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
@@ -16,6 +17,7 @@
 #include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
+#include "split_layout.hpp"
 #include "tsm/tsm.hpp"
 
 namespace tsm {
@@ -49,8 +51,9 @@ struct PartStreams {
 // max_decisions(n) = 2843 (n + 8) decisions. Every own vertex costs at least
 // 3 in the geometry stream, every vertex of a segment 1 in its references
 // stream, every triangle of the cut surface at least 1 in the triangle-tree
-// stream (a marching bit or a run's end), every side-face corner at least 6
-// in the topology stream: counts beyond that are forged, refused before
+// stream (a marching bit or a run's end), every side face at least 1 in the
+// topology stream (a face on an edge: its end bit, for 3 corners; a verbatim
+// one at least 6 per corner): counts beyond that are forged, refused before
 // allocating.
 uint64_t decisions(std::string_view stream) { return max_decisions(stream.size()); }
 
@@ -58,13 +61,17 @@ Status check_budget(const PartCounts& c, const PartStreams& s) {
   if (c.vertex_count >= 0x3FFFFFFFu || c.corner_count >= 0x3FFFFFFFu || c.face_count > c.corner_count)
     return corrupt("vertex, face or corner count out of range");
   if (c.reference_count > c.vertex_count) return corrupt("more references than vertices");
-  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3)
+  // Welded (§8.13): the geometry codes the points; every vertex beyond its
+  // point's first costs a decision of the split stream, in the attributes.
+  const bool welded = !s.topology.empty() && (static_cast<uint8_t>(s.topology[0]) & 2) != 0;
+  const uint64_t split = welded ? decisions(s.attributes) : 0;
+  if (c.vertex_count - c.reference_count > decisions(s.geometry) / 3 + split)
     return corrupt("the header's " + std::to_string(c.vertex_count - c.reference_count) +
                    " vertices cannot be coded in a geometry section of this size");
   if (s.segmented && c.vertex_count > decisions(s.references))
     return corrupt("the segment's " + std::to_string(c.vertex_count) +
                    " vertices cannot be flagged in a references stream of this size");
-  if (c.corner_count > 3 * decisions(s.triangle_tree) + decisions(s.topology) / 6)
+  if (c.corner_count > 3 * decisions(s.triangle_tree) + 3 * decisions(s.topology))
     return corrupt("the header's " + std::to_string(c.corner_count) +
                    " corners cannot be coded in connectivity sections of this size");
   return Status::Ok();
@@ -100,9 +107,77 @@ struct DecodedPart {
   GeometryStats gstats;
   uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
   std::vector<AttributeCost> attribute_costs;  // filled for inspect() only
+  std::vector<uint32_t> split_q, split_corners;  // welded: per output vertex, per corner (walk ids)
   bool want_costs = false;
   Status status;
 };
+
+// FORMAT.md §8.13: a welded part's attribute payload opens with the split
+// stream (its length first) and the order byte. The split stream turns the
+// faces' points into walk vertices; the attributes are decoded on the
+// originals (`list`: walk vertices that copy no other, in walk order or in
+// output order), the corners naming their vertices' originals.
+Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_t points, DecodedPart& out,
+                    std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& list) {
+  ByteReader r(attributes);
+  uint64_t len = 0;
+  std::string_view split;
+  if (!r.varint(len) || len > r.remaining() || !r.bytes(static_cast<size_t>(len), split))
+    return corrupt("a welded part's split stream is cut off");
+  uint8_t order = 0;
+  if (!r.u8(order) || order > 1) return corrupt("a welded part's attribute order is missing or not 0 or 1");
+  attributes = attributes.substr(r.offset());
+  std::vector<uint32_t> walk_point;
+  std::vector<uint32_t> point_q = std::move(out.q);
+  TSM_RETURN_IF_ERROR(
+      decode_split_layout(split, vertex_count, points, point_q, out.faces, walk_out, walk_point, walk_orig));
+  const size_t n = walk_out.size();
+  list.clear();
+  for (uint32_t w = 0; w < n; ++w)
+    if (walk_orig[w] == w) list.push_back(w);
+  if (order == 1)
+    std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
+  std::vector<uint32_t> rank(n, kNone);
+  for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+  // The faces on the originals for the attributes; the positions per output vertex.
+  std::vector<uint32_t> corner_walk = out.faces.indices;
+  for (uint32_t& x : out.faces.indices) x = rank[walk_orig[x]];
+  out.q.assign(3 * list.size(), 0);
+  for (size_t k = 0; k < list.size(); ++k)
+    for (int a = 0; a < 3; ++a) out.q[3 * k + a] = point_q[3 * size_t{walk_point[list[k]]} + a];
+  out.split_q.assign(3 * n, 0);
+  for (size_t w = 0; w < n; ++w)
+    for (int a = 0; a < 3; ++a) out.split_q[3 * size_t{walk_out[w]} + a] = point_q[3 * size_t{walk_point[w]} + a];
+  out.split_corners = std::move(corner_walk);
+  out.global.assign(list.size(), kNone);  // the attributes' vertices
+  return Status::Ok();
+}
+
+// After a welded part's attributes: the output vertices (positions, the
+// faces' corners, every vertex attribute's values from its original's).
+void to_output(const std::vector<uint32_t>& walk_out, const std::vector<uint32_t>& walk_orig,
+               const std::vector<uint32_t>& list, DecodedPart& out) {
+  const size_t n = walk_out.size();
+  std::vector<uint32_t> rank(n, kNone);
+  for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+  out.q = std::move(out.split_q);
+  out.global.assign(n, kNone);
+  out.faces.indices = std::move(out.split_corners);
+  for (uint32_t& x : out.faces.indices) x = walk_out[x];
+  for (Attribute& at : out.faces.attributes) {
+    if (at.domain != AttributeDomain::vertex) continue;
+    const size_t k = at.components;
+    if (at.values.size() != k * list.size()) continue;
+    std::vector<float> values(k * n);
+    for (size_t w = 0; w < n; ++w) {
+      const size_t from = rank[walk_orig[w]];
+      std::copy(at.values.begin() + static_cast<std::ptrdiff_t>(from * k),
+                at.values.begin() + static_cast<std::ptrdiff_t>((from + 1) * k),
+                values.begin() + static_cast<std::ptrdiff_t>(walk_out[w] * k));
+    }
+    at.values = std::move(values);
+  }
+}
 
 Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, DecodedPart& out) {
   TSM_RETURN_IF_ERROR(check_budget(out.counts, s));
@@ -114,9 +189,14 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   const PartCounts& c = out.counts;
   TSM_RETURN_IF_ERROR(
       decode_connectivity(cs, c.vertex_count, c.face_count, c.corner_count, out.faces, layout, &out.cstats));
+  std::string_view attributes = s.attributes;
+  std::vector<uint32_t> walk_out, walk_orig, list;  // welded: per walk vertex its output id and original
+  if (out.cstats.welded && s.segmented) return corrupt("a segment's topology mode says welded (§8.13)");
   if (!s.segmented) {
     if (!s.attributes.empty()) out.global.assign(c.vertex_count, kNone);  // only attributes look (all own)
     TSM_RETURN_IF_ERROR(decode_geometry(s.geometry, layout, bits, out.q, &out.gstats));
+    if (out.cstats.welded)
+      TSM_RETURN_IF_ERROR(split_welded(attributes, c.vertex_count, layout.vertex_count, out, walk_out, walk_orig, list));
   } else {
     TSM_RETURN_IF_ERROR(
         decode_references(s.references, reference_contexts(layout), c.reference_count, earlier_vertices, out.global));
@@ -130,7 +210,9 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.segmented = s.segmented;
   ap.table_coded = &out.table_coded_attributes;
   if (out.want_costs) ap.costs = &out.attribute_costs;
-  return decode_attributes(s.attributes, ap, out.faces.attributes, &out.alias);
+  TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
+  if (out.cstats.welded) to_output(walk_out, walk_orig, list, out);
+  return Status::Ok();
 }
 
 // A segment section as a part: its streams (views into the section) and counts.
@@ -383,6 +465,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     info.side_faces += st.side_faces;
     info.marching_bits += st.marching_bits;
     info.run_table_parts += st.run_tables;
+    info.welded_points += st.points;
     info.table_coded_attributes += parts[k].table_coded_attributes;
     info.references += parts[k].counts.reference_count;
     SegmentSummary sum;

@@ -19,6 +19,8 @@
 #include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
+#include "split_layout.hpp"
+#include "byte_io.hpp"
 #include "tsm/quantization.hpp"
 #include "tsm/tsm.hpp"
 
@@ -632,6 +634,199 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
   return Status::Ok();
 }
 
+// Per face of `a` (faces on the same ids as `b`'s, as multisets of corner
+// cycles), the face of `b` with the same cycle and the rotation that takes
+// b's corners to a's: b's corner (start + k) mod n is a's corner k. Equal
+// cycles pair in face order.
+bool match_faces(const Mesh& a, const Mesh& b, std::vector<uint32_t>& face, std::vector<uint32_t>& shift) {
+  if (a.face_count() != b.face_count()) return false;
+  auto sorted = [](const Mesh& m, std::vector<uint32_t>& rot) {
+    std::vector<uint32_t> f(m.face_count());
+    std::iota(f.begin(), f.end(), 0u);
+    rot.resize(m.face_count());
+    for (uint32_t i = 0; i < m.face_count(); ++i) rot[i] = smallest_rotation(m.face(i), m.face_size(i));
+    std::stable_sort(f.begin(), f.end(), [&](uint32_t x, uint32_t y) {
+      const uint32_t nx = m.face_size(x), ny = m.face_size(y);
+      if (nx != ny) return nx < ny;
+      for (uint32_t k = 0; k < nx; ++k) {
+        const uint32_t u = m.face(x)[(rot[x] + k) % nx], v = m.face(y)[(rot[y] + k) % ny];
+        if (u != v) return u < v;
+      }
+      return false;
+    });
+    return f;
+  };
+  std::vector<uint32_t> ra, rb;
+  const std::vector<uint32_t> fa = sorted(a, ra), fb = sorted(b, rb);
+  face.assign(a.face_count(), kNone);
+  shift.assign(a.face_count(), 0);
+  for (size_t i = 0; i < fa.size(); ++i) {
+    const uint32_t x = fa[i], y = fb[i], n = a.face_size(x);
+    if (b.face_size(y) != n) return false;
+    for (uint32_t k = 0; k < n; ++k)
+      if (a.face(x)[(ra[x] + k) % n] != b.face(y)[(rb[y] + k) % n]) return false;
+    face[x] = y;
+    shift[x] = (rb[y] + n - ra[x]) % n;
+  }
+  return true;
+}
+
+// FORMAT.md §8.13: a mesh with attributes whose faces use several vertices
+// at one grid position is coded welded: one point per grid position among
+// the vertices on faces (numbered by their first vertex; a vertex on no face
+// is a point of its own), the connectivity and the positions on the points,
+// then the split stream saying which vertex each corner was, then the
+// attributes of the vertices as usual. The decoder numbers the vertices
+// point by point, so a decoded mesh welds to the same points in the same
+// order (canonical re-encoding). `welded` is false when no two vertices on
+// faces share a grid position (nothing is coded then).
+Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<AttributeHeader>& headers,
+                     const EncodeOptions& options, EncodedPart& out, bool& welded) {
+  welded = false;
+  const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
+  std::vector<uint8_t> used(V, 0);
+  for (uint32_t x : mesh.indices) used[x] = 1;
+  std::vector<uint32_t> by_q;
+  for (uint32_t v = 0; v < V; ++v)
+    if (used[v]) by_q.push_back(v);
+  std::stable_sort(by_q.begin(), by_q.end(), [&](uint32_t x, uint32_t y) {
+    return std::lexicographical_compare(&qin[3 * size_t{x}], &qin[3 * size_t{x}] + 3, &qin[3 * size_t{y}],
+                                        &qin[3 * size_t{y}] + 3);
+  });
+  std::vector<uint32_t> leader(V, kNone), point(V, kNone), rep;
+  for (size_t i = 0; i < by_q.size(); ++i) {
+    const bool same = i > 0 && std::equal(&qin[3 * size_t{by_q[i]}], &qin[3 * size_t{by_q[i]}] + 3,
+                                          &qin[3 * size_t{by_q[i - 1]}]);
+    leader[by_q[i]] = same ? leader[by_q[i - 1]] : by_q[i];
+  }
+  for (uint32_t v = 0; v < V; ++v) {
+    if (used[v] && leader[v] != v) {
+      point[v] = point[leader[v]];
+    } else {
+      point[v] = static_cast<uint32_t>(rep.size());
+      rep.push_back(v);
+    }
+  }
+  if (rep.size() == V) return Status::Ok();
+  const uint32_t np = static_cast<uint32_t>(rep.size());
+  Mesh wm;
+  std::vector<uint32_t> qw(3 * size_t{np});
+  wm.positions.resize(3 * size_t{np});
+  for (uint32_t p = 0; p < np; ++p)
+    for (int a = 0; a < 3; ++a) {
+      wm.positions[3 * size_t{p} + a] = mesh.positions[3 * size_t{rep[p]} + a];
+      qw[3 * size_t{p} + a] = qin[3 * size_t{rep[p]} + a];
+    }
+  wm.face_offsets = mesh.face_offsets;
+  wm.indices.resize(mesh.indices.size());
+  for (size_t k = 0; k < mesh.indices.size(); ++k) wm.indices[k] = point[mesh.indices[k]];
+  EncodedPart pw;
+  TSM_RETURN_IF_ERROR(encode_part(wm, qw, {}, {}, options, pw));
+  pw.streams.topology[0] = static_cast<char>(pw.streams.topology[0] | 2);
+  Mesh dec;
+  GeometryLayout scratch;
+  TSM_RETURN_IF_ERROR(decode_connectivity(pw.streams, V, wm.face_count(), wm.corner_count(), dec, scratch));
+  // The decoded faces on w's points, matched to the input faces.
+  Mesh on_w = dec;
+  for (uint32_t& x : on_w.indices) x = pw.order[x];
+  std::vector<uint32_t> face, shift;
+  if (!match_faces(on_w, wm, face, shift)) return Status(ErrorCode::internal, "welded faces do not match the input's");
+  std::vector<uint32_t> corner_vertex(dec.indices.size());
+  for (uint32_t f = 0; f < dec.face_count(); ++f) {
+    const uint32_t n = dec.face_size(f), g = face[f];
+    for (uint32_t k = 0; k < n; ++k) corner_vertex[dec.face_offsets[f] + k] = mesh.face(g)[(shift[f] + k) % n];
+  }
+  std::vector<uint32_t> point_vertex(np), walk_out, walk_point;
+  for (uint32_t o = 0; o < np; ++o) point_vertex[o] = rep[pw.order[o]];
+  std::vector<uint32_t> indices, q_out(3 * size_t{np});
+  for (uint32_t o = 0; o < np; ++o)
+    for (int a = 0; a < 3; ++a) q_out[3 * size_t{o} + a] = qw[3 * size_t{pw.order[o]} + a];
+  // Value classes: vertices of one point whose vertex attributes are equal
+  // on their grids (a copy is coded as such, its values not again). Not
+  // with corner attributes, whose coding follows the vertices' sharing of
+  // corner values (on the originals alone they would cost more: the
+  // corpus's OBJ exports nearly twice).
+  std::vector<uint32_t> value_class(V);
+  std::iota(value_class.begin(), value_class.end(), 0u);
+  const bool corner_attributes = std::any_of(headers.begin(), headers.end(), [](const AttributeHeader& h) {
+    return h.domain == AttributeDomain::corner;
+  });
+  if (!corner_attributes) {
+    std::vector<std::vector<int32_t>> key(V);
+    for (size_t i = 0; i < headers.size(); ++i) {
+      if (headers[i].domain != AttributeDomain::vertex) continue;
+      const Attribute& at = mesh.attributes[i];
+      std::vector<int32_t> k(attribute_key_size(headers[i]));
+      for (uint32_t v = 0; v < V; ++v) {
+        attribute_key(headers[i], &at.values[size_t{at.components} * v], k.data());
+        key[v].insert(key[v].end(), k.begin(), k.end());
+      }
+    }
+    std::vector<uint32_t> ids(V);
+    std::iota(ids.begin(), ids.end(), 0u);
+    std::stable_sort(ids.begin(), ids.end(), [&](uint32_t x, uint32_t y) {
+      return std::tie(point[x], key[x]) < std::tie(point[y], key[y]);
+    });
+    for (size_t i = 0; i < ids.size(); ++i)
+      value_class[ids[i]] = i > 0 && point[ids[i]] == point[ids[i - 1]] && key[ids[i]] == key[ids[i - 1]]
+                                ? value_class[ids[i - 1]]
+                                : ids[i];
+  }
+  std::vector<uint32_t> walk_input, walk_orig;
+  const std::string split = encode_split_layout(dec, np, q_out, corner_vertex, point_vertex, value_class, walk_input,
+                                                walk_out, walk_point, walk_orig, indices);
+  out.streams = std::move(pw.streams);
+  out.geometry = std::move(pw.geometry);
+  // The attributes of the originals (the vertices that are not copies), in
+  // walk order (as the faces make them: a face's texture coordinates and
+  // normals together) or in output order (point by point: what a position
+  // carries whatever the face, such as skin weights, repeats there),
+  // whichever is smaller; the corners name the originals.
+  // The input with every corner on its vertex's original (what the
+  // attribute coder matches the decoded faces against).
+  Mesh on_originals = mesh;
+  {
+    std::vector<uint32_t> walk_of(V);
+    for (uint32_t w = 0; w < V; ++w) walk_of[walk_input[w]] = w;
+    for (uint32_t& x : on_originals.indices) x = walk_input[walk_orig[walk_of[x]]];
+  }
+  EncodedPart by_walk, by_point;
+  for (int point_order = 0; point_order < 2; ++point_order) {
+    EncodedPart& e = point_order ? by_point : by_walk;
+    std::vector<uint32_t> list;  // walk vertices that are originals, in the order coded
+    for (uint32_t w = 0; w < V; ++w)
+      if (walk_orig[w] == w) list.push_back(w);
+    if (point_order)
+      std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
+    std::vector<uint32_t> rank(V, kNone);
+    for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
+    e.faces = dec;
+    for (size_t k = 0; k < indices.size(); ++k) e.faces.indices[k] = rank[walk_orig[indices[k]]];
+    e.order.resize(list.size());
+    e.ref_out.assign(list.size(), 0);
+    e.q.resize(3 * list.size());
+    for (uint32_t k = 0; k < list.size(); ++k) {
+      e.order[k] = walk_input[list[k]];
+      for (int a = 0; a < 3; ++a) e.q[3 * size_t{k} + a] = qin[3 * size_t{e.order[k]} + a];
+    }
+    TSM_RETURN_IF_ERROR(
+        encode_part_attributes(on_originals, headers, nullptr, nullptr, attribute_tables(options), e));
+  }
+  const bool point_order = by_point.attributes.size() < by_walk.attributes.size();
+  EncodedPart& best = point_order ? by_point : by_walk;
+  out.order = std::move(best.order);
+  out.faces = std::move(best.faces);
+  out.q = std::move(best.q);
+  std::string head;
+  ByteWriter bw(head);
+  bw.varint(split.size());
+  bw.bytes(split);
+  bw.u8(point_order ? 1 : 0);
+  out.attributes = head + best.attributes;
+  welded = true;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
@@ -695,7 +890,9 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   }
   if (segments.size() == 1) {
     EncodedPart p;
-    TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
+    bool welded = false;
+    if (!headers.empty()) TSM_RETURN_IF_ERROR(encode_welded(mesh, qin, headers, options, p, welded));
+    if (!welded) TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
   } else {

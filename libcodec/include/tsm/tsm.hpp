@@ -119,6 +119,9 @@ struct FileInfo {
   // Parts (segments) whose connectivity run values are table-coded (the
   // fast levels; FORMAT.md §8.3.1).
   uint64_t run_table_parts = 0;
+  // Welded files (FORMAT.md §8.13): the points the connectivity and the
+  // positions are coded on (0 when not welded).
+  uint64_t welded_points = 0;
   // Attributes whose residuals are table-coded, summed over the parts
   // (the fast levels; FORMAT.md §8.12.1).
   uint64_t table_coded_attributes = 0;

@@ -1,0 +1,292 @@
+// Welding, the split layout (FORMAT.md §8.13; issue 36): a mesh with
+// attributes usually repeats a position wherever a normal, texture
+// coordinate or colour changes (a flat-shaded model three times per
+// triangle, a CAD part once per face normal). The encoder codes one point
+// per grid position (connectivity and positions on the welded surface) and
+// here, per corner of the welded faces in the decoder's order, which of its
+// point's vertices the corner was: the first corner of a point makes its
+// first vertex; each later corner is either a new vertex or one of the
+// point's vertices so far, ranked with those the neighbouring faces across
+// the corner's two edges use at the point first (across an edge that is not
+// a seam the corner is the neighbour's vertex: rank 0 at a small cost).
+// The vertices are then numbered point by point in point order, each
+// point's in the order its corners made them: a decoded mesh welds back to
+// the same points in the same order, and codes the same layout again.
+#include "split_layout.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "range_coder.hpp"
+
+namespace tsm {
+
+namespace {
+
+constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
+
+// Normals as small integers (9 bits a component, FORMAT.md §8.13): exact,
+// so that every decoder ranks and buckets alike.
+struct Normal {
+  int64_t x[3] = {0, 0, 0};
+  bool zero() const { return x[0] == 0 && x[1] == 0 && x[2] == 0; }
+};
+
+Normal reduced(const int64_t v[3]) {
+  int64_t m = 0;
+  for (int a = 0; a < 3; ++a) m = std::max(m, v[a] < 0 ? -v[a] : v[a]);
+  int s = 0;
+  while ((m >> s) >= 512) ++s;  // the largest component below 2^9
+  Normal n;
+  for (int a = 0; a < 3; ++a) n.x[a] = v[a] >> s;  // floor
+  return n;
+}
+
+// A face's normal from its first three corners' grid positions.
+Normal face_normal(const std::vector<uint32_t>& q, const uint32_t* c) {
+  int64_t d1[3], d2[3];
+  for (int a = 0; a < 3; ++a) {
+    d1[a] = int64_t{q[3 * size_t{c[1]} + a]} - int64_t{q[3 * size_t{c[0]} + a]};
+    d2[a] = int64_t{q[3 * size_t{c[2]} + a]} - int64_t{q[3 * size_t{c[0]} + a]};
+  }
+  const int64_t n[3] = {d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]};
+  return reduced(n);
+}
+
+// How close a vertex's normal (the sum of its faces' so far) is to a
+// face's: 0 within 1.8 degrees (cos^2 >= 1023/1024), 1 within 8 (1004/1024),
+// 2 within 26 (829/1024), 3 within 60 (256/1024), 4 farther, 5 either is 0.
+int closeness(const Normal& f, const int64_t sum[3]) {
+  const Normal v = reduced(sum);
+  if (f.zero() || v.zero()) return 5;
+  const int64_t dot = f.x[0] * v.x[0] + f.x[1] * v.x[1] + f.x[2] * v.x[2];
+  if (dot <= 0) return 4;
+  const int64_t ff = f.x[0] * f.x[0] + f.x[1] * f.x[1] + f.x[2] * f.x[2];
+  const int64_t vv = v.x[0] * v.x[0] + v.x[1] * v.x[1] + v.x[2] * v.x[2];
+  const int64_t d2 = dot * dot * 1024, n2 = ff * vv;
+  if (d2 >= 1023 * n2) return 0;
+  if (d2 >= 1004 * n2) return 1;
+  if (d2 >= 829 * n2) return 2;
+  if (d2 >= 256 * n2) return 3;
+  return 4;
+}
+
+// The neighbours' say (SplitWalk::gather): 0 none known, 1 one, 2 both the
+// same vertex, 3 two different vertices.
+struct SplitModels {
+  // [neighbours (0-3)][the face's previous corner: 0 none, 1 a new vertex,
+  // 2 an old one][the first candidate's closeness (0-5)]
+  Prob fresh[4][3][6];
+  UIntModel rank[6];  // [the first candidate's closeness]
+  Prob copy[4];       // a new vertex with an earlier vertex's values, [neighbours]
+  UIntModel copy_rank;
+};
+
+// The walk both sides make: per corner, the candidates, then (after the
+// choice) the vertex it is; per face, its edges and its normal remembered.
+class SplitWalk {
+ public:
+  SplitWalk(uint32_t points, const std::vector<uint32_t>& q) : made_(points), q_(q) {}
+  void start_face(const uint32_t* c, uint32_t n) { normal_ = n >= 3 ? face_normal(q_, c) : Normal(); }
+  // The candidates for a corner at p whose face continues to `next` and
+  // comes from `prev`, in cand(): the vertices of the neighbours across the
+  // corner's two edges, then the point's other vertices (the latest made
+  // first), then stably by closeness to the face's normal. Returns the
+  // neighbours' say (0-3); best() is the first candidate's closeness.
+  int gather(uint32_t p, uint32_t next, uint32_t prev) {
+    cand_.clear();
+    auto offer = [&](uint32_t v) {
+      if (v != kNoVertex && std::find(cand_.begin(), cand_.end(), v) == cand_.end()) cand_.push_back(v);
+    };
+    const auto a = edge_.find(key(next, p));  // the neighbour across p -> next runs next -> p
+    if (a != edge_.end()) offer(a->second.second);
+    const auto b = edge_.find(key(p, prev));  // across prev -> p: p -> prev
+    if (b != edge_.end()) offer(b->second.first);
+    const bool both = a != edge_.end() && b != edge_.end();
+    const int nb = cand_.empty() ? 0 : !both ? 1 : cand_.size() == 1 ? 2 : 3;
+    for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
+    close_.resize(cand_.size());
+    order_.resize(cand_.size());
+    for (size_t i = 0; i < cand_.size(); ++i) {
+      close_[i] = closeness(normal_, sum_[cand_[i]].x);
+      order_[i] = static_cast<uint32_t>(i);
+    }
+    std::stable_sort(order_.begin(), order_.end(), [&](uint32_t x, uint32_t y) { return close_[x] < close_[y]; });
+    sorted_.resize(cand_.size());
+    for (size_t i = 0; i < cand_.size(); ++i) sorted_[i] = cand_[order_[i]];
+    best_ = close_[order_[0]];
+    return nb;
+  }
+  const std::vector<uint32_t>& cand() const { return sorted_; }
+  int best() const { return best_; }
+  size_t vertices_at(uint32_t p) const { return made_[p].size(); }
+  // A new vertex at p; `original`: the vertex whose attribute values it
+  // has (kNoVertex: its own).
+  uint32_t make(uint32_t p, uint32_t original = kNoVertex) {
+    made_[p].push_back(next_);
+    sum_.emplace_back();
+    original_.push_back(original == kNoVertex ? next_ : original_[original]);
+    return next_++;
+  }
+  const std::vector<uint32_t>& originals() const { return original_; }
+  // After a face: its edges (corner points c, their vertices v) and its
+  // normal added to its vertices' (once per corner).
+  void remember(const uint32_t* c, const uint32_t* v, uint32_t n) {
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t j = (i + 1) % n;
+      edge_[key(c[i], c[j])] = {v[i], v[j]};
+      for (int a = 0; a < 3; ++a) sum_[v[i]].x[a] += normal_.x[a];
+    }
+  }
+  // Final numbering: the output ids go point by point, each point's
+  // vertices in the order made, a point on no corner getting one. The walk
+  // vertices are those made, in order, then one per point on no corner, in
+  // point order; per walk vertex its output id and its point.
+  void number(std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point) const {
+    walk_out.assign(next_, kNoVertex);
+    walk_point.assign(next_, kNoVertex);
+    uint32_t id = 0;
+    for (uint32_t p = 0; p < made_.size(); ++p) {
+      if (made_[p].empty()) {
+        walk_out.push_back(id++);
+        walk_point.push_back(p);
+      }
+      for (uint32_t w : made_[p]) {
+        walk_out[w] = id++;
+        walk_point[w] = p;
+      }
+    }
+  }
+  uint32_t made() const { return next_; }
+
+ private:
+  static uint64_t key(uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; }
+  std::vector<std::vector<uint32_t>> made_;
+  const std::vector<uint32_t>& q_;
+  std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
+  std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
+  Normal normal_;                   // the current face's
+  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> edge_;
+  std::vector<uint32_t> cand_, sorted_, order_;
+  std::vector<int> close_;
+  int best_ = 5;
+  uint32_t next_ = 0;
+};
+
+}  // namespace
+
+std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::vector<uint32_t>& q,
+                                const std::vector<uint32_t>& corner_vertex, const std::vector<uint32_t>& point_vertex,
+                                const std::vector<uint32_t>& value_class, std::vector<uint32_t>& walk_input,
+                                std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point,
+                                std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& indices) {
+  RangeEncoder e;
+  SplitModels m;
+  SplitWalk walk(points, q);
+  std::unordered_map<uint32_t, uint32_t> walk_of;  // input vertex -> walk vertex
+  std::vector<uint32_t> input_of;                  // walk vertex -> input vertex
+  std::vector<uint32_t> corner_walk(faces.indices.size());
+  std::vector<uint32_t> v;
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t* c = faces.face(f);
+    const uint32_t n = faces.face_size(f), base = faces.face_offsets[f];
+    v.assign(n, kNoVertex);
+    walk.start_face(c, n);
+    int before = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t p = c[i], x = corner_vertex[base + i];
+      const auto it = walk_of.find(x);
+      const bool fresh = it == walk_of.end();
+      if (walk.vertices_at(p) == 0) {
+        v[i] = walk.make(p);
+      } else {
+        const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
+        e.bit(m.fresh[nb][before][walk.best()], fresh);
+        if (fresh) {
+          // A copy: the values of a vertex of the point (the first such
+          // candidate).
+          const auto& cand = walk.cand();
+          uint32_t r = 0;
+          while (r < cand.size() && value_class[input_of[cand[r]]] != value_class[x]) ++r;
+          e.bit(m.copy[nb], r < cand.size());
+          if (r < cand.size() && cand.size() > 1) m.copy_rank.encode(e, r);
+          v[i] = walk.make(p, r < cand.size() ? cand[r] : kNoVertex);
+        } else {
+          const auto& cand = walk.cand();
+          const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
+          if (cand.size() > 1) m.rank[walk.best()].encode(e, r);
+          v[i] = it->second;
+        }
+      }
+      before = fresh ? 1 : 2;
+      if (it == walk_of.end()) {
+        walk_of.emplace(x, v[i]);
+        input_of.push_back(x);
+      }
+      corner_walk[base + i] = v[i];
+    }
+    walk.remember(c, v.data(), n);
+  }
+  walk.number(walk_out, walk_point);
+  walk_orig = walk.originals();
+  for (size_t w = walk_orig.size(); w < walk_point.size(); ++w) walk_orig.push_back(static_cast<uint32_t>(w));
+  walk_input = input_of;
+  for (size_t w = input_of.size(); w < walk_point.size(); ++w) walk_input.push_back(point_vertex[walk_point[w]]);
+  indices = std::move(corner_walk);
+  return e.finish();
+}
+
+Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint32_t points,
+                           const std::vector<uint32_t>& q, Mesh& faces, std::vector<uint32_t>& walk_out,
+                           std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
+  auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
+  RangeDecoder d(stream);
+  SplitModels m;
+  SplitWalk walk(points, q);
+  std::vector<uint32_t> v;
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    uint32_t* c = faces.indices.data() + faces.face_offsets[f];
+    const uint32_t n = faces.face_size(f);
+    v.assign(n, kNoVertex);
+    for (uint32_t i = 0; i < n; ++i)
+      if (c[i] >= points) return corrupt("a corner outside the points");
+    walk.start_face(c, n);
+    int before = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t p = c[i];
+      if (walk.vertices_at(p) == 0) {
+        v[i] = walk.make(p);
+        before = 1;
+      } else {
+        const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
+        before = d.bit(m.fresh[nb][before][walk.best()]) ? 1 : 2;
+        if (before == 1) {
+          const auto& cand = walk.cand();
+          uint32_t original = kNoVertex;
+          if (d.bit(m.copy[nb])) {
+            const uint32_t r = cand.size() > 1 ? m.copy_rank.decode(d) : 0;
+            if (r >= cand.size()) return corrupt("a copy's rank out of range");
+            original = cand[r];
+          }
+          v[i] = walk.make(p, original);
+        } else {
+          const auto& cand = walk.cand();
+          const uint32_t r = cand.size() > 1 ? m.rank[walk.best()].decode(d) : 0;
+          if (r >= cand.size()) return corrupt("a vertex rank out of range");
+          v[i] = cand[r];
+        }
+      }
+      if (walk.made() > vertex_count || d.overrun() > RangeDecoder::kMaxOverrun)
+        return corrupt("more vertices than the header says, or the stream is truncated");
+    }
+    walk.remember(c, v.data(), n);
+    std::copy(v.begin(), v.end(), c);  // walk vertices for now
+  }
+  walk.number(walk_out, walk_point);
+  if (walk_point.size() != vertex_count) return corrupt("the vertex count differs from the header's");
+  walk_orig = walk.originals();
+  for (size_t w = walk_orig.size(); w < walk_point.size(); ++w) walk_orig.push_back(static_cast<uint32_t>(w));
+  return Status::Ok();
+}
+
+}  // namespace tsm

@@ -1,0 +1,41 @@
+// Internal: the split layout of a welded mesh (FORMAT.md §8.13): which
+// corners of a point were one vertex of the input. See split_layout.cpp.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tsm/mesh.hpp"
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+// The walk (split_layout.cpp) numbers the vertices as the corners make
+// them, then one per point on no corner: the order vertex attributes are
+// coded in. The output ids go point by point.
+//
+// Encoder. `faces`: the welded faces as the decoder gives them (corners are
+// output point ids, `points` of them; `q` their grid positions, 3 each);
+// `corner_vertex`: per corner, the input vertex it was; `point_vertex`: per
+// point, an input vertex of it (for a point on no corner, its only vertex).
+// `value_class`: per input vertex, the same number for vertices at one
+// point whose vertex attribute values are equal on their grids (a new
+// vertex with an earlier one's values is coded as its copy). Returns the
+// split stream and fills per walk vertex its input vertex, its output id,
+// its point and its original (the vertex whose values it has: itself, or
+// the one it copies), and `indices` (the corners as walk vertices).
+std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::vector<uint32_t>& q,
+                                const std::vector<uint32_t>& corner_vertex, const std::vector<uint32_t>& point_vertex,
+                                const std::vector<uint32_t>& value_class, std::vector<uint32_t>& walk_input,
+                                std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point,
+                                std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& indices);
+
+// Decoder: rewrites `faces.indices` from points to walk vertices and fills
+// per walk vertex its output id, its point and its original; the stream must give
+// exactly `vertex_count` vertices.
+Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint32_t points,
+                           const std::vector<uint32_t>& q, Mesh& faces, std::vector<uint32_t>& walk_out,
+                           std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig);
+
+}  // namespace tsm

@@ -1,0 +1,235 @@
+// Welding (issue 36, FORMAT.md §8.13): a mesh with attributes whose faces
+// use several vertices at one position (flat shading, texture seams, CAD
+// parts) is coded on one point per grid position and the split layout; the
+// decoder gives back the same split vertices with the same values. Exact by
+// the oracle, canonical on re-encoding, positions-only meshes never welded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/compare.hpp"
+#include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
+
+using namespace tsm;
+using namespace tsm_test;
+
+namespace {
+
+Attribute vertex_attribute(const std::string& name, AttributeKind kind, uint32_t comps) {
+  Attribute a;
+  a.name = name;
+  a.kind = kind;
+  a.domain = AttributeDomain::vertex;
+  a.type = AttributeType::f32;
+  a.components = comps;
+  return a;
+}
+
+// Every face gets vertices of its own carrying its normal (flat shading,
+// glTF style).
+Mesh flat_shaded(const Mesh& in) {
+  Mesh m;
+  Attribute n = vertex_attribute("normal", AttributeKind::normal, 3);
+  for (uint32_t f = 0; f < in.face_count(); ++f) {
+    const uint32_t* c = in.face(f);
+    const float* a = &in.positions[3 * size_t{c[0]}];
+    const float* b = &in.positions[3 * size_t{c[1]}];
+    const float* d = &in.positions[3 * size_t{c[2]}];
+    const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    float nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    std::vector<uint32_t> corners;
+    for (uint32_t k = 0; k < in.face_size(f); ++k) {
+      const float* p = &in.positions[3 * size_t{c[k]}];
+      corners.push_back(static_cast<uint32_t>(m.vertex_count()));
+      m.add_vertex(p[0], p[1], p[2]);
+      for (float x : nn) n.values.push_back(len > 0 ? x / len : 0.0f);
+    }
+    m.add_face(corners.data(), corners.size());
+  }
+  m.attributes = {n};
+  return m;
+}
+
+// A sphere with spherical UVs per vertex and a seam: the faces on one side
+// of the seam use copies of its vertices with u + 1.
+Mesh uv_seam_sphere(int level) {
+  Mesh m = icosphere(level);
+  Attribute t = vertex_attribute("texcoord", AttributeKind::texcoord, 2);
+  const size_t n = m.vertex_count();
+  for (size_t v = 0; v < n; ++v) {
+    const float* p = &m.positions[3 * v];
+    t.values.push_back(0.5f + std::atan2(p[1], p[0]) / 6.2831853f);
+    t.values.push_back(0.5f + std::asin(std::max(-1.0f, std::min(1.0f, p[2]))) / 3.1415927f);
+  }
+  std::vector<uint32_t> copy(n, ~0u);
+  for (uint32_t f = 0; f < m.face_count(); ++f) {
+    uint32_t* c = &m.indices[m.face_offsets[f]];
+    float cx = 0;
+    for (int k = 0; k < 3; ++k) cx += m.positions[3 * size_t{c[k]}];
+    if (cx <= 0) continue;  // the x > 0 half uses copies
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = c[k];
+      if (m.positions[3 * size_t{v}] > 0.2f) continue;  // copies only along the seam
+      if (copy[v] == ~0u) {
+        copy[v] = static_cast<uint32_t>(m.vertex_count());
+        m.add_vertex(m.positions[3 * size_t{v}], m.positions[3 * size_t{v} + 1], m.positions[3 * size_t{v} + 2]);
+        t.values.push_back(t.values[2 * size_t{v}] + 1.0f);
+        t.values.push_back(t.values[2 * size_t{v} + 1]);
+      }
+      c[k] = copy[v];
+    }
+  }
+  m.attributes = {t};
+  return m;
+}
+
+// Encodes, decodes, checks the oracle and canonical re-encoding; returns the
+// file.
+std::string expect_exact(const Mesh& m, const std::string& what, int q = 12) {
+  EncodeOptions eo;
+  eo.quantization_bits = q;
+  std::string bytes;
+  Status s = encode(m, eo, bytes);
+  EXPECT_TRUE(s.ok()) << what << ": " << s.to_string();
+  Mesh back;
+  s = decode(bytes, back);
+  EXPECT_TRUE(s.ok()) << what << ": " << s.to_string();
+  EXPECT_EQ(back.vertex_count(), m.vertex_count()) << what;
+  const CompareResult r = compare_meshes(m, back, q, eo.attribute_bits);
+  EXPECT_TRUE(r.equal) << what << ": " << r.difference;
+  std::string again;
+  EXPECT_TRUE(encode(back, eo, again).ok());
+  EXPECT_TRUE(again == bytes) << what << ": re-encoding the decoded mesh gives other bytes (" << again.size() << " vs "
+                              << bytes.size() << ")";
+  return bytes;
+}
+
+size_t size_without_attributes(Mesh m, int q = 12) {
+  m.attributes.clear();
+  EncodeOptions eo;
+  eo.quantization_bits = q;
+  std::string bytes;
+  EXPECT_TRUE(encode(m, eo, bytes).ok());
+  return bytes.size();
+}
+
+}  // namespace
+
+TEST(Welding, FlatShadedSphereAndCube) {
+  for (const auto& [name, base] : {std::pair<std::string, Mesh>{"sphere", icosphere(2)}, {"cube", cube_quads()}}) {
+    const Mesh m = flat_shaded(base);
+    ASSERT_GT(m.vertex_count(), base.vertex_count());
+    const std::string bytes = expect_exact(m, "flat-shaded " + name);
+    // Welded, the positions and connectivity are those of the base mesh;
+    // split, they would be a soup of separate faces (the cube's 6 normals
+    // cost about what its 24 vertices' soup saves).
+    if (name == "sphere") {
+      EXPECT_LT(bytes.size(), size_without_attributes(m)) << name;
+    }
+  }
+}
+
+TEST(Welding, TextureSeam) {
+  const Mesh m = uv_seam_sphere(3);
+  const std::string bytes = expect_exact(m, "uv seam sphere");
+  const Mesh plain = icosphere(3);
+  EXPECT_LT(bytes.size(), size_without_attributes(plain) + 2 * m.vertex_count()) << "the seam costs little";
+}
+
+// An unindexed mesh (glTF without indices, the Fox): every face has
+// vertices of its own, with the same values at a position: the copies cost
+// a few bits each, their values nothing.
+TEST(Welding, UnindexedSmoothSphereCostsAboutTheIndexedOne) {
+  Mesh indexed = icosphere(3);
+  Attribute n = vertex_attribute("normal", AttributeKind::normal, 3);
+  for (size_t v = 0; v < indexed.vertex_count(); ++v)
+    for (int a = 0; a < 3; ++a) n.values.push_back(indexed.positions[3 * v + a]);
+  indexed.attributes = {n};
+  Mesh soup;
+  Attribute sn = vertex_attribute("normal", AttributeKind::normal, 3);
+  for (uint32_t f = 0; f < indexed.face_count(); ++f) {
+    uint32_t c[3];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t v = indexed.face(f)[k];
+      c[k] = static_cast<uint32_t>(soup.vertex_count());
+      soup.add_vertex(indexed.positions[3 * size_t{v}], indexed.positions[3 * size_t{v} + 1],
+                      indexed.positions[3 * size_t{v} + 2]);
+      for (int a = 0; a < 3; ++a) sn.values.push_back(n.values[3 * size_t{v} + a]);
+    }
+    soup.add_triangle(c[0], c[1], c[2]);
+  }
+  soup.attributes = {sn};
+  const size_t a = expect_exact(indexed, "indexed sphere").size();
+  const size_t b = expect_exact(soup, "unindexed sphere").size();
+  EXPECT_LT(b, a + a / 4) << "indexed " << a << ", unindexed " << b;
+}
+
+// A CAD-like part: flat-shaded, with slivers on edges (r, r, o) using the
+// split vertices, duplicated faces, a vertex on no face at a surface
+// position, and two faces sharing vertices across a crease.
+TEST(Welding, CadLikePartWithDegenerateAndDuplicateFaces) {
+  Mesh m = flat_shaded(genus_surface(1, 2));
+  std::mt19937 rng(7);
+  const uint32_t faces = static_cast<uint32_t>(m.face_count());
+  for (uint32_t i = 0; i < 40; ++i) {
+    const uint32_t* c = m.face(rng() % faces);
+    m.add_triangle(c[0], c[0], c[1]);
+  }
+  for (uint32_t i = 0; i < 20; ++i) {
+    const uint32_t* c = m.face(rng() % faces);
+    m.add_triangle(c[0], c[1], c[2]);  // a duplicate on the same vertices
+  }
+  m.add_vertex(m.positions[0], m.positions[1], m.positions[2]);  // on no face
+  m.attributes[0].values.insert(m.attributes[0].values.end(), {0.0f, 0.0f, 1.0f});
+  expect_exact(m, "CAD-like part");
+}
+
+TEST(Welding, VertexOrderDoesNotMatter) {
+  const Mesh m = flat_shaded(icosphere(1));
+  const std::string a = expect_exact(m, "flat icosphere");
+  const std::vector<uint32_t> perm = random_permutation(m.vertex_count(), 3);
+  Mesh p = permute_vertices(m, perm);
+  EncodeOptions eo;
+  eo.quantization_bits = 12;
+  std::string b;
+  ASSERT_TRUE(encode(p, eo, b).ok());
+  Mesh back;
+  ASSERT_TRUE(decode(b, back).ok());
+  EXPECT_TRUE(compare_meshes(p, back, 12).equal);
+}
+
+TEST(Welding, PositionsOnlyMeshesAreNotWelded) {
+  // The same flat-shaded soup without attributes keeps its vertices (and its
+  // bytes: no split stream, the topology mode's weld bit clear).
+  Mesh m = flat_shaded(icosphere(1));
+  m.attributes.clear();
+  EncodeOptions eo;
+  std::string bytes;
+  ASSERT_TRUE(encode(m, eo, bytes).ok());
+  Mesh back;
+  ASSERT_TRUE(decode(bytes, back).ok());
+  EXPECT_EQ(back.vertex_count(), m.vertex_count());
+  EXPECT_TRUE(compare_meshes(m, back, eo.quantization_bits).equal);
+}
+
+// Every glTF asset of the corpus: exact, canonical (through the library's
+// Mesh, whose vertex order the glTF writer would regroup by primitive).
+TEST(Welding, CorpusAssets) {
+  if (!have_corpus()) {
+    if (running_in_ci()) FAIL() << corpus_missing_message();
+    GTEST_SKIP() << corpus_missing_message();
+  }
+  for (const char* rel : {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf",
+                          "assets/MultiUVTest/MultiUVTest.gltf", "assets/VertexColorTest/VertexColorTest.gltf",
+                          "assets/2CylinderEngine.glb", "edge/cube_att.obj", "edge/Box.ply"}) {
+    Mesh m;
+    ASSERT_TRUE(read_mesh(corpus_file(rel), m).ok()) << rel;
+    expect_exact(m, rel, 11);
+  }
+}
