@@ -280,6 +280,27 @@ int main(int argc, char** argv) {
       "The Hausdorff distance is shown as the sampled maximum and a guaranteed upper bound; percentages are of A's\n"
       "bounding-box diagonal.");
 
+  SimplifyArgs sa;
+  CLI::App* sim = app.add_subcommand("simplify", "Reduce a mesh's triangles within a guaranteed maximum error");
+  sim->add_option("input", sa.input, "The mesh (any format tsm reads, or .tsm)")->required();
+  sim->add_option("-o,--output", sa.output, "The result: .ply, .obj, .stl, .off, .gltf, .glb or .tsm")->required();
+  sim->add_option("--max-error", sa.max_error,
+                  "Largest distance allowed between the input and the result (symmetric Hausdorff): model units, or "
+                  "E% of the bounding-box diagonal");
+  sim->add_option("--faces", sa.faces, "Stop at this many triangles (with --max-error: or where the bound stops it)")
+      ->check(CLI::PositiveNumber);
+  sim->add_option("--ratio", sa.ratio, "Stop at this fraction of the triangles, 0..1")->check(CLI::Range(0.0, 1.0));
+  sim->add_flag("--json", sa.json, "Print one JSON object instead of the text report");
+  sim->add_flag("--quiet", sa.quiet, "Print nothing on success");
+  sim->add_flag("-f,--force", sa.force, "Replace an existing output file");
+  sim->footer(
+      "Examples:\n"
+      "  tsm simplify bunny.ply -o bunny_small.ply --max-error 0.5%\n"
+      "  tsm simplify dragon.ply -o dragon.tsm --max-error 0.001 --faces 50000\n"
+      "  tsm compare bunny.ply bunny_small.ply     # measure the result\n"
+      "With --max-error the result is guaranteed within that distance of the input (every point of either\n"
+      "surface); --faces / --ratio alone stop at a count with no bound.");
+
   if (refuse_unknown_words(app, argc, argv)) return kExitUsage;
   try {
     app.parse(argc, argv);
@@ -292,6 +313,7 @@ int main(int argc, char** argv) {
     if (*dec) return cmd_decode(da);
     if (*inf) return cmd_info(ia);
     if (*cmp) return cmd_compare(ca);
+    if (*sim) return cmd_simplify(sa);
     if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "tsm: error: out of memory\n");
