@@ -197,6 +197,9 @@ int main(int argc, char** argv) {
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));
+  enc->add_option("--max-error", ea.max_error,
+                  "Simplify first (tsm simplify): the result stays within this distance of the input, in model units "
+                  "or E% of the bounding-box diagonal");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--allow-nonfinite", ea.allow_nonfinite,
                 "Let the readers accept NaN/inf values (the encoder refuses them all the same, so this only moves the "

@@ -36,8 +36,9 @@ bool parse_max_error(const std::string& text, double& value, bool& percent);
 double bbox_diagonal(const Mesh& m);
 // Simplifies `in` as the command line asks: --max-error text (units or %),
 // --faces, --ratio (the larger face target wins); a progress line on a
-// terminal when `progress`. error_units gets the bound in model units (0: none).
+// terminal when `progress`. error_units gets the bound in model units (0: none);
+// the simplifier gets it less `reserve` (what quantization adds afterwards).
 Status simplify_for_cli(const Mesh& in, const std::string& max_error, uint64_t faces, double ratio, bool progress,
-                        Mesh& out, SimplifyReport& report, double& error_units);
+                        Mesh& out, SimplifyReport& report, double& error_units, double reserve = 0);
 
 }  // namespace tsm::cli

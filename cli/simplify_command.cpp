@@ -53,7 +53,7 @@ void draw_progress(uint64_t now, uint64_t in, void* user) {
 }  // namespace
 
 Status simplify_for_cli(const Mesh& in, const std::string& max_error, uint64_t faces, double ratio, bool progress,
-                        Mesh& out, SimplifyReport& report, double& error_units) {
+                        Mesh& out, SimplifyReport& report, double& error_units, double reserve) {
   SimplifyOptions o;
   error_units = 0;
   if (!max_error.empty()) {
@@ -63,7 +63,10 @@ Status simplify_for_cli(const Mesh& in, const std::string& max_error, uint64_t f
                                                      ": give a positive number in model units, or a percentage of the "
                                                      "bounding-box diagonal such as 0.5%");
     if (percent) error_units *= bbox_diagonal(in) / 100;
-    o.max_error = error_units;
+    if (!(error_units > reserve))
+      return Status(ErrorCode::invalid_argument, "--max-error " + max_error + " is below the error the quantization "
+                                                 "alone causes (" + strf("%.3g", reserve) + "): raise it or -q");
+    o.max_error = error_units - reserve;
   }
   uint64_t triangles = 0;
   for (size_t f = 0; f < in.face_count(); ++f) triangles += in.face_size(f) >= 3 ? in.face_size(f) - 2 : 0;
