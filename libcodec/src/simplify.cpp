@@ -18,7 +18,9 @@
 //    of one original triangle (convexity) or its corners' distances plus
 //    its covering radius are (the distance to a mesh is 1-Lipschitz).
 // A collapse that fails either, flips or degenerates a triangle, or changes
-// the topology is refused.
+// the topology is refused. Vertices of non-manifold edges and fans may move
+// but never go; vertices on attribute seams and degenerate input triangles
+// neither move nor go.
 #include "tsm/simplify.hpp"
 
 #include <algorithm>
@@ -83,7 +85,8 @@ struct Piece {
 
 constexpr uint32_t kMaxPieceDepth = 4;    // a piece is cut at most this many times (4^4 parts)
 constexpr uint32_t kMaxCheckDepth = 4;    // a new triangle is cut at most this many times
-constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4;
+// kLocked: the vertex never moves or goes; kKeep: it may move but never goes.
+constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4, kKeep = 8;
 
 struct Candidate {
   double cost;
@@ -102,11 +105,18 @@ class Simplifier {
   // ---- setup
   void build();
   void find_locked();
+  void find_components();
   void init_quadrics();
   void push_edges_of(uint32_t v);
   bool candidate_for(uint32_t u, uint32_t v, Candidate& c);
 
   // ---- one collapse
+  struct Place {
+    double cost;
+    uint32_t u, v;  // u goes, v stays (at x)
+    Vec3 x;
+  };
+  std::vector<Place> placements(uint32_t a, uint32_t b, const Quadric& q) const;
   bool try_collapse(uint32_t u, uint32_t v);
   bool topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris);
   bool attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris);
@@ -136,6 +146,8 @@ class Simplifier {
   std::vector<std::vector<uint32_t>> vtris_;
   std::vector<uint8_t> flags_;
   std::vector<uint8_t> had_faces_;  // the vertex is on a triangle of the input
+  std::vector<uint32_t> comp_;       // per triangle: its edge-connected component
+  std::vector<uint32_t> comp_live_;  // per component: live triangles
   std::vector<Quadric> quad_;
   std::vector<uint32_t> stamp_;
   std::vector<double> param_;  // per vertex: scratch
@@ -209,6 +221,7 @@ void Simplifier::build() {
     for (int k = 0; k < 3; ++k)
       if (k == 0 || (c[k] != c[0] && (k == 1 || c[k] != c[1]))) vtris_[c[k]].push_back(t);
   }
+  find_components();
   had_faces_.assign(nv, 0);
   for (uint32_t v = 0; v < nv; ++v) had_faces_[v] = !vtris_[v].empty();
   live_ = tri_.size();
@@ -217,6 +230,31 @@ void Simplifier::build() {
   for (uint32_t t = 0; t < tri_.size(); ++t) {
     for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
     tri_pieces_[t].push_back(t);
+  }
+}
+
+// Edge-connected components of the triangles (union-find over shared edges).
+void Simplifier::find_components() {
+  std::vector<uint32_t> parent(tri_.size());
+  for (uint32_t t = 0; t < tri_.size(); ++t) parent[t] = t;
+  auto find = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<std::array<uint32_t, 3>> edges;  // lo, hi, triangle
+  for (uint32_t t = 0; t < tri_.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = tri_[t][k], b = tri_[t][(k + 1) % 3];
+      if (a != b) edges.push_back({std::min(a, b), std::max(a, b), t});
+    }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) parent[find(edges[i][2])] = find(edges[i - 1][2]);
+  comp_.resize(tri_.size());
+  comp_live_.assign(tri_.size(), 0);
+  for (uint32_t t = 0; t < tri_.size(); ++t) {
+    comp_[t] = find(t);
+    ++comp_live_[comp_[t]];
   }
 }
 
@@ -275,7 +313,8 @@ void Simplifier::find_locked() {
     if (fans != 1 || (boundary != 0 && boundary != 2)) bad = true;
     if (boundary) flags_[v] |= kBoundary;
     // Seams: all corners of v agree on every corner attribute.
-    for (size_t a = 0; a < corner_attrs_.size() && !bad; ++a) {
+    bool seam = false;
+    for (size_t a = 0; a < corner_attrs_.size() && !seam; ++a) {
       const uint32_t comps = in_.attributes[corner_attrs_[a]].components;
       const float* first = nullptr;
       for (uint32_t t : vtris_[v])
@@ -283,12 +322,16 @@ void Simplifier::find_locked() {
           if (tri_[t][k] == v) {
             const float* val = &cvalues_[a][static_cast<size_t>(cindex_[a][t][k]) * comps];
             if (!first) first = val;
-            else if (std::memcmp(first, val, comps * sizeof(float)) != 0) bad = true;
+            else if (std::memcmp(first, val, comps * sizeof(float)) != 0) seam = true;
           }
     }
-    if (bad) flags_[v] |= kLocked;
+    // A non-manifold vertex may move (only geometry changes) but not go; a
+    // seam vertex neither (its values on each side would need their own
+    // interpolation).
+    if (bad) flags_[v] |= kKeep;
+    if (seam) flags_[v] |= kLocked;
   }
-  for (uint8_t f : flags_) locked_count_ += (f & kLocked) != 0;
+  for (uint8_t f : flags_) locked_count_ += (f & (kLocked | kKeep)) != 0;
 }
 
 void Simplifier::init_quadrics() {
@@ -326,19 +369,13 @@ void Simplifier::init_quadrics() {
 
 // The cheapest placement's cost; false when the edge cannot collapse at all.
 bool Simplifier::candidate_for(uint32_t u, uint32_t v, Candidate& c) {
-  if ((flags_[u] & kLocked) && (flags_[v] & kLocked)) return false;
   Quadric q = quad_[u];
   q.add(quad_[v]);
   double best = std::numeric_limits<double>::infinity();
-  if (flags_[u] & kLocked) best = q.eval(pos_[u]);
-  else if (flags_[v] & kLocked) best = q.eval(pos_[v]);
-  else {
-    Vec3 x;
-    if (q.optimum(x)) best = q.eval(x);
-    best = std::min({best, q.eval(pos_[u]), q.eval(pos_[v]), q.eval((pos_[u] + pos_[v]) * 0.5)});
-  }
+  bool any = false;
+  for (const Place& p : placements(u, v, q)) best = std::min(best, p.cost), any = true;
   c = {std::max(best, 0.0), u, v, stamp_[u], stamp_[v]};
-  return true;
+  return any;
 }
 
 void Simplifier::push_edges_of(uint32_t v) {
@@ -410,7 +447,15 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
   }
   for (uint32_t t : vtris_[v])
     if (std::find(edge_tris.begin(), edge_tris.end(), t) == edge_tris.end()) ++remaining;
-  return remaining > 0;
+  if (remaining == 0) return false;
+  // Every edge-connected piece of surface keeps a triangle (the fans of a
+  // non-manifold vertex are pieces of their own).
+  for (uint32_t t : edge_tris) {
+    uint32_t gone = 0;
+    for (uint32_t s : edge_tris) gone += comp_[s] == comp_[t];
+    if (comp_live_[comp_[t]] <= gone) return false;
+  }
+  return true;
 }
 
 // Pieces of the changed triangles onto the new triangles (or the unchanged
@@ -578,6 +623,7 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   for (uint32_t t : edge_tris) {
     tri_alive_[t] = 0;
     --live_;
+    --comp_live_[comp_[t]];
     for (uint32_t w : tri_[t]) {
       auto& l = vtris_[w];
       l.erase(std::remove(l.begin(), l.end(), t), l.end());
@@ -626,34 +672,37 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   for (uint32_t w : ring) push_edges_of(w);
 }
 
-bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
-  std::vector<uint32_t> edge_tris;
-  if (!topology_ok(a, b, edge_tris)) return false;
-  // Placements, cheapest first: the quadric optimum, the midpoint, the
-  // endpoints (a locked endpoint: only there).
-  Quadric q = quad_[a];
-  q.add(quad_[b]);
-  struct Place {
-    double cost;
-    uint32_t u, v;  // u goes, v stays (at x)
-    Vec3 x;
-  };
+// Where the edge (a, b) may collapse to, cheapest first: the quadric
+// optimum, the midpoint, the endpoints; only into a vertex that stays (not
+// kLocked / kKeep going), only at a vertex that cannot move.
+std::vector<Simplifier::Place> Simplifier::placements(uint32_t a, uint32_t b, const Quadric& q) const {
   std::vector<Place> places;
-  if (flags_[a] & kLocked) places.push_back({0, b, a, pos_[a]});
-  else if (flags_[b] & kLocked) places.push_back({0, a, b, pos_[b]});
-  else {
+  auto can_go = [&](uint32_t w) { return !(flags_[w] & (kLocked | kKeep)); };
+  auto can_move = [&](uint32_t w) { return !(flags_[w] & kLocked); };
+  uint32_t u = a, v = b;  // u goes
+  if (!can_go(u)) std::swap(u, v);
+  if (!can_go(u)) return places;
+  if (can_move(v)) {
     Vec3 x;
     if (q.optimum(x)) {
       // Only near the edge: a far optimum is a badly conditioned one.
       const Vec3 mid = (pos_[a] + pos_[b]) * 0.5;
-      if (geom::length(x - mid) <= 2 * geom::length(pos_[b] - pos_[a])) places.push_back({q.eval(x), a, b, x});
+      if (geom::length(x - mid) <= 2 * geom::length(pos_[b] - pos_[a])) places.push_back({q.eval(x), u, v, x});
     }
-    places.push_back({q.eval((pos_[a] + pos_[b]) * 0.5), a, b, (pos_[a] + pos_[b]) * 0.5});
-    places.push_back({q.eval(pos_[b]), a, b, pos_[b]});
-    places.push_back({q.eval(pos_[a]), b, a, pos_[a]});
-    std::stable_sort(places.begin(), places.end(), [](const Place& x1, const Place& x2) { return x1.cost < x2.cost; });
+    places.push_back({q.eval((pos_[a] + pos_[b]) * 0.5), u, v, (pos_[a] + pos_[b]) * 0.5});
+    if (can_go(v) && can_move(u)) places.push_back({q.eval(pos_[u]), v, u, pos_[u]});
   }
-  for (const Place& p : places)
+  places.push_back({q.eval(pos_[v]), u, v, pos_[v]});
+  std::stable_sort(places.begin(), places.end(), [](const Place& x1, const Place& x2) { return x1.cost < x2.cost; });
+  return places;
+}
+
+bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
+  std::vector<uint32_t> edge_tris;
+  if (!topology_ok(a, b, edge_tris)) return false;
+  Quadric q = quad_[a];
+  q.add(quad_[b]);
+  for (const Place& p : placements(a, b, q))
     if (attempt(p.u, p.v, p.x, edge_tris)) {
       commit(p.u, p.v);
       return true;

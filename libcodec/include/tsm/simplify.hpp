@@ -34,13 +34,13 @@ struct SimplifyReport {
   uint64_t vertices_in = 0, vertices_out = 0;
   uint64_t collapses = 0;  // accepted
   uint64_t rejected = 0;   // candidate collapses refused (topology, flips, the bound)
-  uint64_t locked_vertices = 0;  // never moved: non-manifold, on an attribute seam, on a degenerate face
+  uint64_t locked_vertices = 0;  // never removed: non-manifold, on an attribute seam, on a degenerate face
 };
 
 // Simplifies `in` into `out` (triangles; polygons are split as fans first).
 // Kept: boundaries (as boundaries, within the bound), non-manifold edges
-// and vertices (their vertices never move), attribute seams (their
-// vertices never move or go), components (none vanishes), face attributes
+// and vertices (their vertices may move, within the bound, but never go),
+// attribute seams (their vertices never move or go), components (none vanishes), face attributes
 // (per triangle), vertex and corner attributes (interpolated along the
 // collapsed edge). No triangle is flipped (normal turned by 90 degrees or
 // more) or made degenerate. Vertices no face uses are kept; metadata is
