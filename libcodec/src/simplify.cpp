@@ -125,7 +125,8 @@ class Simplifier {
   // ---- the bound
   bool assign_pieces(const std::vector<uint32_t>& changed);
   bool assign_piece(const Piece& pc);
-  bool within_original(Vec3 a, Vec3 b, Vec3 c);
+  bool within_original(uint32_t t);
+  bool nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint);
   bool within_original_rec(const Vec3 p[3], const double d[3], const int64_t t[3], uint32_t depth);
   Vec3 new_corner(uint32_t t, int k) const;
 
@@ -173,6 +174,12 @@ class Simplifier {
   std::vector<uint32_t> new_tris_;   // changed triangles that stay (with u or v replaced by the moved v)
   std::vector<uint32_t> near_tris_;  // unchanged live triangles around, also able to take pieces
   std::vector<std::pair<uint32_t, Piece>> placed_;  // triangle, piece (an attempt's assignments)
+  struct NearCache {
+    Vec3 p;
+    double d;
+    int64_t t;
+  };
+  std::vector<NearCache> near_cache_;  // nearest original triangles of points met in one try_collapse
 
   uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
 };
@@ -496,15 +503,32 @@ bool Simplifier::assign_piece(const Piece& pc) {
   return true;
 }
 
-bool Simplifier::within_original(Vec3 a, Vec3 b, Vec3 c) {
-  const Vec3 p[3] = {a, b, c};
+// The nearest original triangle to p and its distance (not squared); false
+// when it is beyond the bound. Points met before in this collapse attempt
+// (corners and edge midpoints shared by the new triangles, the ring's
+// vertices for every placement tried) come from a small cache.
+bool Simplifier::nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint) {
+  for (const NearCache& c : near_cache_)
+    if (c.p.x == p.x && c.p.y == p.y && c.p.z == p.z) {
+      d = c.d, t = c.t;
+      return d * d <= e2_;
+    }
+  double d2;
+  t = bvh_.nearest(p, d2, hint);
+  d = std::sqrt(d2);
+  near_cache_.push_back({p, d, t});
+  return d2 <= e2_;
+}
+
+bool Simplifier::within_original(uint32_t tri) {
+  Vec3 p[3];
   double d[3];
   int64_t t[3];
   int64_t hint = -1;
   for (int k = 0; k < 3; ++k) {
-    hint = t[k] = bvh_.nearest(p[k], d[k], hint);
-    if (d[k] > e2_) return false;
-    d[k] = std::sqrt(d[k]);
+    p[k] = new_corner(tri, k);
+    if (!nearest_original(p[k], d[k], t[k], hint)) return false;
+    hint = t[k];
   }
   return within_original_rec(p, d, t, 0);
 }
@@ -524,6 +548,11 @@ bool Simplifier::within_original_rec(const Vec3 p[3], const double d[3], const i
   double dm[3];
   int64_t tm[3];
   for (int k = 0; k < 3; ++k) {
+    if (depth == 0) {
+      // The new triangles' edge midpoints: shared between neighbours.
+      if (!nearest_original(m[k], dm[k], tm[k], t[k])) return false;
+      continue;
+    }
     tm[k] = bvh_.nearest(m[k], dm[k], t[k]);
     if (dm[k] > e2_) return false;
     dm[k] = std::sqrt(dm[k]);
@@ -568,7 +597,7 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
               std::find(near_tris_.begin(), near_tris_.end(), s) == near_tris_.end())
             near_tris_.push_back(s);
   for (uint32_t t : new_tris_)
-    if (!within_original(new_corner(t, 0), new_corner(t, 1), new_corner(t, 2))) return false;
+    if (!within_original(t)) return false;
   return assign_pieces(changed_);
 }
 
@@ -700,6 +729,7 @@ std::vector<Simplifier::Place> Simplifier::placements(uint32_t a, uint32_t b, co
 bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
   std::vector<uint32_t> edge_tris;
   if (!topology_ok(a, b, edge_tris)) return false;
+  near_cache_.clear();
   Quadric q = quad_[a];
   q.add(quad_[b]);
   for (const Place& p : placements(a, b, q))
