@@ -81,6 +81,7 @@ double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
 struct Piece {
   Vec3 p[3];
   uint32_t depth = 0;
+  uint32_t orig = 0;  // the original triangle it is part of
 };
 
 constexpr uint32_t kMaxPieceDepth = 4;    // a piece is cut at most this many times (4^4 parts)
@@ -179,7 +180,8 @@ class Simplifier {
     double d;
     int64_t t;
   };
-  std::vector<NearCache> near_cache_;  // nearest original triangles of points met in one try_collapse
+  std::vector<NearCache> near_cache_;
+  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original triangles of points met in one try_collapse
 
   uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
 };
@@ -236,6 +238,7 @@ void Simplifier::build() {
   tri_pieces_.assign(tri_.size(), {});
   for (uint32_t t = 0; t < tri_.size(); ++t) {
     for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
+    pieces_[t].orig = t;
     tri_pieces_[t].push_back(t);
   }
 }
@@ -498,6 +501,7 @@ bool Simplifier::assign_piece(const Piece& pc) {
     Piece child;
     child.p[0] = q[0], child.p[1] = q[1], child.p[2] = q[2];
     child.depth = pc.depth + 1;
+    child.orig = pc.orig;
     if (!assign_piece(child)) return false;
   }
   return true;
@@ -596,8 +600,23 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
           if (std::find(changed_.begin(), changed_.end(), s) == changed_.end() &&
               std::find(near_tris_.begin(), near_tris_.end(), s) == near_tris_.end())
             near_tris_.push_back(s);
-  for (uint32_t t : new_tris_)
-    if (!within_original(t)) return false;
+  // First the original triangles whose pieces the changed triangles hold:
+  // a new triangle within E of one of them needs no search.
+  local_orig_.clear();
+  for (uint32_t t : changed_)
+    for (uint32_t pi : tri_pieces_[t])
+      if (local_orig_.size() < 64 && std::find(local_orig_.begin(), local_orig_.end(), pieces_[pi].orig) == local_orig_.end())
+        local_orig_.push_back(pieces_[pi].orig);
+  for (uint32_t t : new_tris_) {
+    const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
+    bool near = false;
+    for (size_t i = 0; i < local_orig_.size() && !near; ++i) {
+      const Vec3 oa = orig_.corner(local_orig_[i], 0), ob = orig_.corner(local_orig_[i], 1), oc = orig_.corner(local_orig_[i], 2);
+      near = geom::point_triangle_dist2(a, oa, ob, oc) <= e2_ && geom::point_triangle_dist2(b, oa, ob, oc) <= e2_ &&
+             geom::point_triangle_dist2(c, oa, ob, oc) <= e2_;
+    }
+    if (!near && !within_original(t)) return false;
+  }
   return assign_pieces(changed_);
 }
 
