@@ -38,12 +38,16 @@ namespace {
 
 struct ProgressState {
   Stopwatch sw;
+  double last_ms = 0;
   bool shown = false;
 };
 
+// After half a second, at most ten times a second.
 void draw_progress(uint64_t now, uint64_t in, void* user) {
   auto* p = static_cast<ProgressState*>(user);
-  if (p->sw.ms() < 500) return;
+  const double ms = p->sw.ms();
+  if (ms < 500 || ms - p->last_ms < 100) return;
+  p->last_ms = ms;
   std::fprintf(stderr, "\rsimplifying: %s of %s triangles  %.1f s\x1b[K", thousands(now).c_str(), thousands(in).c_str(),
                p->sw.ms() / 1000.0);
   std::fflush(stderr);

@@ -830,7 +830,7 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
     if ((flags_[c.u] | flags_[c.v]) & kRemoved) continue;
     if (stamp_[c.u] != c.stamp_u || stamp_[c.v] != c.stamp_v) continue;
     if (!try_collapse(c.u, c.v)) ++rejected_;
-    if (o_.progress && ++since >= 4096) {
+    if (o_.progress && ++since >= 256) {
       since = 0;
       o_.progress(live_faces(), report.faces_in, o_.progress_user);
     }
