@@ -112,7 +112,10 @@ int cmd_simplify(const SimplifyArgs& a) {
   SimplifyReport r;
   double err = 0;
   Stopwatch sw;
-  s = simplify_for_cli(in, a.max_error, a.faces, a.ratio, !a.quiet && !a.json, out, r, err);
+  // A .tsm output is quantized (default grid): its share comes off the bound.
+  const double reserve =
+      to_tsm ? bounding_box(in).largest_extent() / (std::ldexp(1.0, kDefaultQuantizationBits) - 1) * std::sqrt(3.0) / 2 : 0;
+  s = simplify_for_cli(in, a.max_error, a.faces, a.ratio, !a.quiet && !a.json, out, r, err, reserve);
   const double ms = sw.ms();
   if (!s.ok()) {
     std::fprintf(stderr, "tsm: error: %s: %s\n", printable(a.input).c_str(), s.message().c_str());
