@@ -114,7 +114,7 @@ Mesh simplify_checked(const Mesh& in, double fraction, double max_kept = 1.0) {
   EXPECT_EQ(r.faces_out, out.face_count());
   EXPECT_FALSE(has_degenerate(out));
   tsm::DistanceOptions d;
-  d.target_samples = 300000;
+  d.target_samples = 150000;
   tsm::DistanceReport dr;
   EXPECT_TRUE(tsm::measure_distance(in, out, d, dr).ok());
   EXPECT_LE(dr.hausdorff, e * (1 + 1e-9)) << "faces " << out.face_count();
