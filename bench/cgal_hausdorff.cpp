@@ -40,8 +40,9 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   const double h = tsm_oracle::symmetric_hausdorff(a, b, rel * diag);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("{\"a\": \"%s\", \"b\": \"%s\", \"hausdorff\": %.9g, \"hausdorff_percent\": %.6f, \"error_bound\": %.3g, "
-              "\"diagonal\": %.9g, \"ms\": %.1f}\n",
-              argv[1], argv[2], h, 100 * h / diag, rel * diag, diag, ms);
+  std::printf(
+      "{\"a\": \"%s\", \"b\": \"%s\", \"hausdorff\": %.9g, \"hausdorff_percent\": %.6f, \"error_bound\": %.3g, "
+      "\"diagonal\": %.9g, \"ms\": %.1f}\n",
+      argv[1], argv[2], h, 100 * h / diag, rel * diag, diag, ms);
   return 0;
 }

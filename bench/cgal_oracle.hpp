@@ -40,8 +40,8 @@ inline SurfaceMesh to_cgal(const tsm::Mesh& m) {
 // the true value (CGAL's bounded_error_symmetric_Hausdorff_distance).
 inline double symmetric_hausdorff(const tsm::Mesh& a, const tsm::Mesh& b, double error_bound) {
   const SurfaceMesh ca = to_cgal(a), cb = to_cgal(b);
-  return CGAL::Polygon_mesh_processing::bounded_error_symmetric_Hausdorff_distance<CGAL::Sequential_tag>(
-      ca, cb, error_bound);
+  return CGAL::Polygon_mesh_processing::bounded_error_symmetric_Hausdorff_distance<CGAL::Sequential_tag>(ca, cb,
+                                                                                                         error_bound);
 }
 
 }  // namespace tsm_oracle

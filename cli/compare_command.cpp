@@ -83,8 +83,9 @@ int cmd_compare(const CompareArgs& a) {
     return kExitOk;
   }
   std::string t;
-  t += strf("A: %s (%s)\nB: %s (%s)\n", printable(a.a).c_str(), count_of(r.triangles_a, "triangle", "triangles").c_str(),
-            printable(a.b).c_str(), count_of(r.triangles_b, "triangle", "triangles").c_str());
+  t +=
+      strf("A: %s (%s)\nB: %s (%s)\n", printable(a.a).c_str(), count_of(r.triangles_a, "triangle", "triangles").c_str(),
+           printable(a.b).c_str(), count_of(r.triangles_b, "triangle", "triangles").c_str());
   t += strf("bounding-box diagonal of A: %.6g; sampling spacing %.3g (%s + %s samples)\n", diag, r.spacing,
             thousands(r.a_to_b.samples).c_str(), thousands(r.b_to_a.samples).c_str());
   t += distance_line("Hausdorff (symmetric)", r.hausdorff, diag);

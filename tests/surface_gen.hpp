@@ -31,7 +31,8 @@ inline tsm::Mesh flat_grid(int n, float z = 0) {
   tsm::Mesh out;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x)
-      out.add_vertex(static_cast<float>(x) / static_cast<float>(n - 1), static_cast<float>(y) / static_cast<float>(n - 1), z);
+      out.add_vertex(static_cast<float>(x) / static_cast<float>(n - 1),
+                     static_cast<float>(y) / static_cast<float>(n - 1), z);
   for (int y = 0; y + 1 < n; ++y)
     for (int x = 0; x + 1 < n; ++x) {
       const uint32_t a = static_cast<uint32_t>(y * n + x), b = a + 1, c = a + static_cast<uint32_t>(n), d = c + 1;

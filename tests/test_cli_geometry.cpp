@@ -2,8 +2,8 @@
 // separate process (TSM_CLI_PATH): the bound holds end to end, as measured
 // by `tsm compare`, and bad command lines are refused with the right code.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdlib>
 #include <fstream>
@@ -33,7 +33,8 @@ class CliGeometry : public ::testing::Test {
  protected:
   ToolRun tsm(const std::string& args) {
     const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
-    const std::string cmd = std::string("'") + TSM_CLI_PATH + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+    const std::string cmd =
+        std::string("'") + TSM_CLI_PATH + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
     const int status = std::system(cmd.c_str());
     ToolRun r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;

@@ -42,8 +42,7 @@ uint32_t segments(const geom::TriangleSet& s, size_t t, double spacing) {
 double auto_spacing(const geom::TriangleSet& s, uint64_t target) {
   // A grid of n segments has (n+1)(n+2)/2 points; search the spacing.
   double lo = 1e-12, hi = 0;
-  for (size_t t = 0; t < s.size(); ++t)
-    hi = std::max(hi, longest_edge(s.corner(t, 0), s.corner(t, 1), s.corner(t, 2)));
+  for (size_t t = 0; t < s.size(); ++t) hi = std::max(hi, longest_edge(s.corner(t, 0), s.corner(t, 1), s.corner(t, 2)));
   if (!(hi > 0)) return 1;
   hi *= 2;
   lo = hi * 1e-6;
@@ -54,7 +53,10 @@ double auto_spacing(const geom::TriangleSet& s, uint64_t target) {
       const uint64_t n = segments(s, t, mid);
       count += (n + 1) * (n + 2) / 2;
     }
-    if (count > target) lo = mid; else hi = mid;
+    if (count > target)
+      lo = mid;
+    else
+      hi = mid;
   }
   return hi;
 }
@@ -112,14 +114,15 @@ Side measure_side(const geom::TriangleSet& x, const geom::TriangleSet& y, const 
       const double lip = std::max({dist[p], dist[q], dist[r]}) + cover;
       double best = lip, d2;
       const int64_t mid = bvh.nearest((pts[p] + pts[q] + pts[r]) * (1.0 / 3), d2, near[p]);
-      const double ang = angle_deg(normal, geom::cross(y.corner(mid, 1) - y.corner(mid, 0), y.corner(mid, 2) - y.corner(mid, 0)));
+      const double ang =
+          angle_deg(normal, geom::cross(y.corner(mid, 1) - y.corner(mid, 0), y.corner(mid, 2) - y.corner(mid, 0)));
       side.weighted_normal_angle += sub_weight * ang;
       side.max_normal_angle = std::max(side.max_normal_angle, ang);
       for (int64_t tri : {mid, near[p], near[q], near[r]}) {
         const Vec3 ta = y.corner(tri, 0), tb = y.corner(tri, 1), tc = y.corner(tri, 2);
-        const double m = std::max({geom::point_triangle_dist2(pts[p], ta, tb, tc),
-                                   geom::point_triangle_dist2(pts[q], ta, tb, tc),
-                                   geom::point_triangle_dist2(pts[r], ta, tb, tc)});
+        const double m =
+            std::max({geom::point_triangle_dist2(pts[p], ta, tb, tc), geom::point_triangle_dist2(pts[q], ta, tb, tc),
+                      geom::point_triangle_dist2(pts[r], ta, tb, tc)});
         best = std::min(best, std::sqrt(m));
       }
       side.d.bound = std::max(side.d.bound, best);

@@ -69,9 +69,7 @@ struct Quadric {
   }
 };
 
-Vec3 to_float(Vec3 p) {
-  return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
-}
+Vec3 to_float(Vec3 p) { return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)}; }
 
 double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
   return std::max({geom::length(b - a), geom::length(c - b), geom::length(a - c)});
@@ -84,8 +82,8 @@ struct Piece {
   uint32_t orig = 0;  // the original triangle it is part of
 };
 
-constexpr uint32_t kMaxPieceDepth = 4;    // a piece is cut at most this many times (4^4 parts)
-constexpr uint32_t kMaxCheckDepth = 4;    // a new triangle is cut at most this many times
+constexpr uint32_t kMaxPieceDepth = 4;  // a piece is cut at most this many times (4^4 parts)
+constexpr uint32_t kMaxCheckDepth = 4;  // a new triangle is cut at most this many times
 // kLocked: the vertex never moves or goes; kKeep: it may move but never goes.
 constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4, kKeep = 8;
 
@@ -147,7 +145,7 @@ class Simplifier {
   std::vector<uint8_t> tri_alive_;
   std::vector<std::vector<uint32_t>> vtris_;
   std::vector<uint8_t> flags_;
-  std::vector<uint8_t> had_faces_;  // the vertex is on a triangle of the input
+  std::vector<uint8_t> had_faces_;   // the vertex is on a triangle of the input
   std::vector<uint32_t> comp_;       // per triangle: its edge-connected component
   std::vector<uint32_t> comp_live_;  // per component: live triangles
   std::vector<Quadric> quad_;
@@ -159,9 +157,9 @@ class Simplifier {
   // Attributes: vertex ones interpolated per vertex, corner ones through a
   // value index per triangle corner (values appended as they are made).
   std::vector<size_t> vertex_attrs_, corner_attrs_;
-  std::vector<std::vector<float>> vvalues_;                     // per vertex attribute
-  std::vector<std::vector<float>> cvalues_;                     // per corner attribute
-  std::vector<std::vector<std::array<uint32_t, 3>>> cindex_;    // per corner attribute, per triangle
+  std::vector<std::vector<float>> vvalues_;                   // per vertex attribute
+  std::vector<std::vector<float>> cvalues_;                   // per corner attribute
+  std::vector<std::vector<std::array<uint32_t, 3>>> cindex_;  // per corner attribute, per triangle
 
   // The bound's state: pieces and which triangle holds each.
   std::vector<Piece> pieces_;
@@ -171,9 +169,9 @@ class Simplifier {
   // Scratch of one attempt: the collapse u -> v at x.
   uint32_t cu_ = 0, cv_ = 0;
   Vec3 cx_;
-  std::vector<uint32_t> changed_;    // triangles whose corners move or that go
-  std::vector<uint32_t> new_tris_;   // changed triangles that stay (with u or v replaced by the moved v)
-  std::vector<uint32_t> near_tris_;  // unchanged live triangles around, also able to take pieces
+  std::vector<uint32_t> changed_;                   // triangles whose corners move or that go
+  std::vector<uint32_t> new_tris_;                  // changed triangles that stay (with u or v replaced by the moved v)
+  std::vector<uint32_t> near_tris_;                 // unchanged live triangles around, also able to take pieces
   std::vector<std::pair<uint32_t, Piece>> placed_;  // triangle, piece (an attempt's assignments)
   struct NearCache {
     Vec3 p;
@@ -181,7 +179,8 @@ class Simplifier {
     int64_t t;
   };
   std::vector<NearCache> near_cache_;
-  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original triangles of points met in one try_collapse
+  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original
+                                      // triangles of points met in one try_collapse
 
   uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
 };
@@ -259,7 +258,8 @@ void Simplifier::find_components() {
     }
   std::sort(edges.begin(), edges.end());
   for (size_t i = 1; i < edges.size(); ++i)
-    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) parent[find(edges[i][2])] = find(edges[i - 1][2]);
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1])
+      parent[find(edges[i][2])] = find(edges[i - 1][2]);
   comp_.resize(tri_.size());
   comp_live_.assign(tri_.size(), 0);
   for (uint32_t t = 0; t < tri_.size(); ++t) {
@@ -331,8 +331,10 @@ void Simplifier::find_locked() {
         for (int k = 0; k < 3; ++k)
           if (tri_[t][k] == v) {
             const float* val = &cvalues_[a][static_cast<size_t>(cindex_[a][t][k]) * comps];
-            if (!first) first = val;
-            else if (std::memcmp(first, val, comps * sizeof(float)) != 0) seam = true;
+            if (!first)
+              first = val;
+            else if (std::memcmp(first, val, comps * sizeof(float)) != 0)
+              seam = true;
           }
     }
     // A non-manifold vertex may move (only geometry changes) but not go; a
@@ -437,7 +439,8 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
   }
   std::vector<uint32_t> common;
   std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
-  common.erase(std::remove_if(common.begin(), common.end(), [&](uint32_t w) { return w == u || w == v; }), common.end());
+  common.erase(std::remove_if(common.begin(), common.end(), [&](uint32_t w) { return w == u || w == v; }),
+               common.end());
   if (common != opposite) return false;
   // No triangle may come to repeat another (a tetrahedron's last collapse),
   // and v keeps at least one triangle (no component vanishes).
@@ -561,7 +564,8 @@ bool Simplifier::within_original_rec(const Vec3 p[3], const double d[3], const i
     if (dm[k] > e2_) return false;
     dm[k] = std::sqrt(dm[k]);
   }
-  const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]}, c3[3] = {m[0], m[1], m[2]};
+  const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
+             c3[3] = {m[0], m[1], m[2]};
   const double d0[3] = {d[0], dm[0], dm[2]}, d1[3] = {dm[0], d[1], dm[1]}, d2[3] = {dm[2], dm[1], d[2]},
                d3[3] = {dm[0], dm[1], dm[2]};
   const int64_t t0[3] = {t[0], tm[0], tm[2]}, t1[3] = {tm[0], t[1], tm[1]}, t2[3] = {tm[2], tm[1], t[2]},
@@ -605,13 +609,15 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
   local_orig_.clear();
   for (uint32_t t : changed_)
     for (uint32_t pi : tri_pieces_[t])
-      if (local_orig_.size() < 64 && std::find(local_orig_.begin(), local_orig_.end(), pieces_[pi].orig) == local_orig_.end())
+      if (local_orig_.size() < 64 &&
+          std::find(local_orig_.begin(), local_orig_.end(), pieces_[pi].orig) == local_orig_.end())
         local_orig_.push_back(pieces_[pi].orig);
   for (uint32_t t : new_tris_) {
     const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
     bool near = false;
     for (size_t i = 0; i < local_orig_.size() && !near; ++i) {
-      const Vec3 oa = orig_.corner(local_orig_[i], 0), ob = orig_.corner(local_orig_[i], 1), oc = orig_.corner(local_orig_[i], 2);
+      const Vec3 oa = orig_.corner(local_orig_[i], 0), ob = orig_.corner(local_orig_[i], 1),
+                 oc = orig_.corner(local_orig_[i], 2);
       near = geom::point_triangle_dist2(a, oa, ob, oc) <= e2_ && geom::point_triangle_dist2(b, oa, ob, oc) <= e2_ &&
              geom::point_triangle_dist2(c, oa, ob, oc) <= e2_;
     }
@@ -656,7 +662,8 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
     if (moved) {
       target = static_cast<uint32_t>(cvalues_[a].size() / n);
       for (uint32_t k = 0; k < n; ++k) {
-        const float fu = cvalues_[a][static_cast<size_t>(val_u) * n + k], fv = cvalues_[a][static_cast<size_t>(val_v) * n + k];
+        const float fu = cvalues_[a][static_cast<size_t>(val_u) * n + k],
+                    fv = cvalues_[a][static_cast<size_t>(val_v) * n + k];
         cvalues_[a].push_back(static_cast<float>(fu + (fv - fu) * s));
       }
       for (uint32_t t : vtris_[v])
@@ -793,7 +800,8 @@ void Simplifier::write(Mesh& out) const {
       for (uint32_t v = 0; v < pos_.size(); ++v)
         if (remap[v] != UINT32_MAX) r.values.insert(r.values.end(), vals.begin() + v * n, vals.begin() + (v + 1) * n);
     } else if (a.domain == AttributeDomain::face) {
-      for (uint32_t t : live) r.values.insert(r.values.end(), a.values.begin() + face_of[t] * n, a.values.begin() + (face_of[t] + 1) * n);
+      for (uint32_t t : live)
+        r.values.insert(r.values.end(), a.values.begin() + face_of[t] * n, a.values.begin() + (face_of[t] + 1) * n);
     } else {
       // Corner values: only those still used, in order of first use.
       const std::vector<float>& vals = cvalues_[ci];

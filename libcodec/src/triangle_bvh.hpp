@@ -26,8 +26,8 @@ double point_triangle_dist2(Vec3 p, Vec3 a, Vec3 b, Vec3 c);
 // The triangles of a mesh: polygons split as fans, faces with fewer than
 // three corners left out. face_of[t] is the mesh face triangle t came from.
 struct TriangleSet {
-  std::vector<Vec3> points;           // the mesh's positions
-  std::vector<uint32_t> corners;      // 3 per triangle
+  std::vector<Vec3> points;       // the mesh's positions
+  std::vector<uint32_t> corners;  // 3 per triangle
   std::vector<uint32_t> face_of;
   size_t size() const { return corners.size() / 3; }
   Vec3 corner(size_t t, int k) const { return points[corners[3 * t + k]]; }

@@ -37,7 +37,9 @@ void expect_within_bound(const Mesh& in, double fraction) {
 TEST(CgalSimplify, Sphere) { expect_within_bound(tsm_test::icosphere(4), 0.005); }
 TEST(CgalSimplify, Torus) { expect_within_bound(tsm_test::torus(64, 32), 0.002); }
 TEST(CgalSimplify, NoisyTorus) { expect_within_bound(tsm_test::jittered(tsm_test::torus(48, 24), 0.01f, 9), 0.01); }
-TEST(CgalSimplify, GridWithHoles) { expect_within_bound(tsm_test::jittered(tsm_test::grid_with_holes(40, 4), 0.05f, 2), 0.003); }
+TEST(CgalSimplify, GridWithHoles) {
+  expect_within_bound(tsm_test::jittered(tsm_test::grid_with_holes(40, 4), 0.05f, 2), 0.003);
+}
 TEST(CgalSimplify, NonManifoldFinsAndStitches) { expect_within_bound(tsm_test::irregular_grid(30, 5), 0.01); }
 TEST(CgalSimplify, UvSeamSphere) { expect_within_bound(tsm_test::uv_sphere_with_seam(48, 24), 0.01); }
 

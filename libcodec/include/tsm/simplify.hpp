@@ -32,8 +32,8 @@ struct SimplifyOptions {
 struct SimplifyReport {
   uint64_t faces_in = 0, faces_out = 0;  // triangles (polygons count as their fans)
   uint64_t vertices_in = 0, vertices_out = 0;
-  uint64_t collapses = 0;  // accepted
-  uint64_t rejected = 0;   // candidate collapses refused (topology, flips, the bound)
+  uint64_t collapses = 0;        // accepted
+  uint64_t rejected = 0;         // candidate collapses refused (topology, flips, the bound)
   uint64_t locked_vertices = 0;  // never removed: non-manifold, on an attribute seam, on a degenerate face
 };
 
