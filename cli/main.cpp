@@ -1,4 +1,4 @@
-// The tsm command-line tool: encode, decode, info, bench.
+// The tsm command-line tool: encode, decode, info, bench, compare, simplify.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -165,6 +165,8 @@ int main(int argc, char** argv) {
       "  tsm encode - --input-format obj < a.obj | tsm decode - --format ply > a.ply\n"
       "  tsm info bunny.tsm --json\n"
       "  tsm bench                                   # the corpus beside the project, else the default mesh\n"
+      "  tsm simplify bunny.ply -o small.ply --max-error 0.5%\n"
+      "  tsm compare bunny.ply small.ply             # Hausdorff, mean, RMS distances\n"
       "Exit codes: 0 ok, 2 bad command line, 3 bad input file, 4 I/O failure (an input missing,\n"
       "a folder or unreadable; an output not writable), 5 internal error;\n"
       "for several files, the worst of them. `tsm COMMAND --help` shows each command's options.");
