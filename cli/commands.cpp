@@ -2,6 +2,7 @@
 // keep files safe (never the input, never an existing file without -f, never
 // a partial file), stdin/stdout, and the per-file jobs run by run_batch.
 #include "commands.hpp"
+#include "mesh_commands.hpp"
 
 #include <sys/stat.h>
 
@@ -436,6 +437,20 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   std::string().swap(in_bytes);
   read_ms = sw.ms();
 
+  if (!a.max_error.empty()) {
+    phase.set("simplifying");
+    Mesh small;
+    SimplifyReport sr;
+    double units = 0;
+    // Quantization then moves each vertex by at most half a step per axis,
+    // so every point of a triangle by at most sqrt(3)/2 steps: the
+    // simplifier gets the bound less that.
+    const double step = bounding_box(mesh).largest_extent() / (std::ldexp(1.0, a.qbits) - 1);
+    s = simplify_for_cli(mesh, a.max_error, 0, 0, false, small, sr, units, step * std::sqrt(3.0) / 2);
+    if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
+    mesh = std::move(small);
+  }
+
   phase.set("encoding");
   sw.reset();
   EncodeOptions eo;
@@ -790,6 +805,12 @@ std::string output_formats_text() {
 
 int cmd_encode(const EncodeArgs& a) {
   install_signal_guard();
+  double max_error = 0;
+  bool percent = false;
+  if (!a.max_error.empty() && !parse_max_error(a.max_error, max_error, percent))
+    return usage_error("--max-error " + a.max_error +
+                       ": give a positive number in model units, or a percentage of the bounding-box diagonal such "
+                       "as 0.5%");
   // encode writes .tsm data: a mesh file name for it would be a lie.
   if (single_file_output(a.inputs, a.output)) {
     const MeshFormat f = format_from_extension(a.output);

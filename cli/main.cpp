@@ -1,4 +1,4 @@
-// The tsm command-line tool: encode, decode, info, bench.
+// The tsm command-line tool: encode, decode, info, bench, compare, simplify.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -8,6 +8,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "mesh_commands.hpp"
 #include "tsm/tsm.hpp"
 
 using namespace tsm;
@@ -164,6 +165,8 @@ int main(int argc, char** argv) {
       "  tsm encode - --input-format obj < a.obj | tsm decode - --format ply > a.ply\n"
       "  tsm info bunny.tsm --json\n"
       "  tsm bench                                   # the corpus beside the project, else the default mesh\n"
+      "  tsm simplify bunny.ply -o small.ply --max-error 0.5%\n"
+      "  tsm compare bunny.ply small.ply             # Hausdorff, mean, RMS distances\n"
       "Exit codes: 0 ok, 2 bad command line, 3 bad input file, 4 I/O failure (an input missing,\n"
       "a folder or unreadable; an output not writable), 5 internal error;\n"
       "for several files, the worst of them. `tsm COMMAND --help` shows each command's options.");
@@ -196,6 +199,9 @@ int main(int argc, char** argv) {
   enc->add_option("--input-format", ea.input_format,
                   "Read the inputs as this format instead of guessing from content and extension (needed for OBJ on stdin)")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off", "gltf", "glb"}, CLI::ignore_case));
+  enc->add_option("--max-error", ea.max_error,
+                  "Simplify first (tsm simplify): the result stays within this distance of the input, in model units "
+                  "or E% of the bounding-box diagonal");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--allow-nonfinite", ea.allow_nonfinite,
                 "Let the readers accept NaN/inf values (the encoder refuses them all the same, so this only moves the "
@@ -263,6 +269,43 @@ int main(int argc, char** argv) {
       "  tsm bench ../shared/corpus/bun_zipper.ply -q 11 -q 14 --runs 5\n"
       "  tsm bench --json --quiet > bench.json");
 
+  CompareArgs ca;
+  CLI::App* cmp = app.add_subcommand("compare", "Measure the distance between two meshes (Hausdorff, mean, RMS, area, volume, normals)");
+  cmp->add_option("a", ca.a, "The reference mesh (any format tsm reads, or .tsm)")->required();
+  cmp->add_option("b", ca.b, "The mesh measured against it")->required();
+  cmp->add_flag("--json", ca.json, "Print one JSON object instead of the text report");
+  cmp->add_option("--samples", ca.samples, "About this many samples on each surface (ignored with --spacing)")
+      ->check(CLI::Range(uint64_t{1000}, uint64_t{1000000000}))->capture_default_str();
+  cmp->add_option("--spacing", ca.spacing, "Sample grid edge length in model units (default: from --samples)")
+      ->check(CLI::PositiveNumber);
+  cmp->footer(
+      "Examples:\n"
+      "  tsm compare bunny.ply bunny_small.ply\n"
+      "  tsm compare bunny.ply bunny.tsm --json | jq .hausdorff_percent\n"
+      "The Hausdorff distance is shown as the sampled maximum and a guaranteed upper bound; percentages are of A's\n"
+      "bounding-box diagonal.");
+
+  SimplifyArgs sa;
+  CLI::App* sim = app.add_subcommand("simplify", "Reduce a mesh's triangles within a guaranteed maximum error");
+  sim->add_option("input", sa.input, "The mesh (any format tsm reads, or .tsm)")->required();
+  sim->add_option("-o,--output", sa.output, "The result: .ply, .obj, .stl, .off, .gltf, .glb or .tsm")->required();
+  sim->add_option("--max-error", sa.max_error,
+                  "Largest distance allowed between the input and the result (symmetric Hausdorff): model units, or "
+                  "E% of the bounding-box diagonal");
+  sim->add_option("--faces", sa.faces, "Stop at this many triangles (with --max-error: or where the bound stops it)")
+      ->check(CLI::PositiveNumber);
+  sim->add_option("--ratio", sa.ratio, "Stop at this fraction of the triangles, 0..1")->check(CLI::Range(0.0, 1.0));
+  sim->add_flag("--json", sa.json, "Print one JSON object instead of the text report");
+  sim->add_flag("--quiet", sa.quiet, "Print nothing on success");
+  sim->add_flag("-f,--force", sa.force, "Replace an existing output file");
+  sim->footer(
+      "Examples:\n"
+      "  tsm simplify bunny.ply -o bunny_small.ply --max-error 0.5%\n"
+      "  tsm simplify dragon.ply -o dragon.tsm --max-error 0.001 --faces 50000\n"
+      "  tsm compare bunny.ply bunny_small.ply     # measure the result\n"
+      "With --max-error the result is guaranteed within that distance of the input (every point of either\n"
+      "surface); --faces / --ratio alone stop at a count with no bound.");
+
   if (refuse_unknown_words(app, argc, argv)) return kExitUsage;
   try {
     app.parse(argc, argv);
@@ -274,6 +317,8 @@ int main(int argc, char** argv) {
     if (*enc) return cmd_encode(ea);
     if (*dec) return cmd_decode(da);
     if (*inf) return cmd_info(ia);
+    if (*cmp) return cmd_compare(ca);
+    if (*sim) return cmd_simplify(sa);
     if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "tsm: error: out of memory\n");

@@ -20,6 +20,10 @@ PACKAGES=(
   pybind11-dev python3-numpy python3-pytest
   # comparison (optional at build time; the bench shows its columns when present)
   libdraco-dev draco
+  # comparison/oracles: CGAL's bounded-error Hausdorff distance checks `tsm
+  # compare` and `tsm simplify` (tests/cgal, bench); meshoptimizer's simplifier
+  # is the simplification benchmark's reference (header-only / optional)
+  libcgal-dev libmeshoptimizer-dev
   # fuzzers (clang's libFuzzer)
   clang libclang-rt-14-dev
 )

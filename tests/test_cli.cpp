@@ -1125,7 +1125,7 @@ TEST_F(CliBatch, EveryHintLeadsSomewhere) {
   EXPECT_NE(r.err.find("did you mean 'tsm encode'?"), std::string::npos) << r.err;
   r = tsm("");
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("encode, decode, info or bench"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("encode, decode, info, bench, compare or simplify"), std::string::npos) << r.err;
 }
 
 TEST_F(CliBatch, ReportsSpeakPlainly) {

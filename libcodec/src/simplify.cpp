@@ -1,0 +1,872 @@
+// Simplification with a guaranteed maximum error: edge collapses ordered by
+// quadric error (Garland & Heckbert 1997), each accepted only when a
+// conservative bound of the symmetric Hausdorff distance between the
+// original mesh and the result stays within the limit (after Wendt's
+// guaranteed-deviation reduction).
+//
+// The bound rests on one fact: the distance from a point to ONE triangle is
+// a convex function, so a (sub-)triangle whose three corners are within E
+// of a triangle t lies wholly within E of t.
+//  - original -> result: every original triangle is cut into pieces (at
+//    first one piece, itself), each assigned to a result triangle within E
+//    of its three corners. A collapse re-assigns the pieces of the triangles
+//    it changes to the new triangles around the kept vertex (or the
+//    unchanged ones next to them), cutting a piece in four where no single
+//    triangle takes it.
+//  - result -> original: every new triangle is checked against the original
+//    through the BVH, cut in four recursively until each part is within E
+//    of one original triangle (convexity) or its corners' distances plus
+//    its covering radius are (the distance to a mesh is 1-Lipschitz).
+// A collapse that fails either, flips or degenerates a triangle, or changes
+// the topology is refused. Vertices of non-manifold edges and fans may move
+// but never go; vertices on attribute seams and degenerate input triangles
+// neither move nor go.
+#include "tsm/simplify.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <queue>
+
+#include "triangle_bvh.hpp"
+
+namespace tsm {
+namespace {
+
+using geom::Vec3;
+
+// Plane quadric: sum of w (n.x + d)^2, stored as the symmetric 4x4 upper half.
+struct Quadric {
+  double a[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};  // xx xy xz xw yy yz yw zz zw ww
+  void add_plane(Vec3 n, double d, double w) {
+    const double v[4] = {n.x, n.y, n.z, d};
+    int k = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j) a[k++] += w * v[i] * v[j];
+  }
+  void add(const Quadric& o) {
+    for (int i = 0; i < 10; ++i) a[i] += o.a[i];
+  }
+  double eval(Vec3 p) const {
+    const double x = p.x, y = p.y, z = p.z;
+    return a[0] * x * x + 2 * a[1] * x * y + 2 * a[2] * x * z + 2 * a[3] * x + a[4] * y * y + 2 * a[5] * y * z +
+           2 * a[6] * y + a[7] * z * z + 2 * a[8] * z + a[9];
+  }
+  // The minimising point, when the 3x3 system is well conditioned.
+  bool optimum(Vec3& p) const {
+    const double m00 = a[0], m01 = a[1], m02 = a[2], m11 = a[4], m12 = a[5], m22 = a[7];
+    const double b0 = -a[3], b1 = -a[6], b2 = -a[8];
+    const double c00 = m11 * m22 - m12 * m12, c01 = m02 * m12 - m01 * m22, c02 = m01 * m12 - m02 * m11;
+    const double det = m00 * c00 + m01 * c01 + m02 * c02;
+    const double scale = std::fabs(m00) + std::fabs(m11) + std::fabs(m22);
+    if (!(std::fabs(det) > 1e-9 * scale * scale * scale)) return false;
+    const double c11 = m00 * m22 - m02 * m02, c12 = m01 * m02 - m00 * m12, c22 = m00 * m11 - m01 * m01;
+    p = {(c00 * b0 + c01 * b1 + c02 * b2) / det, (c01 * b0 + c11 * b1 + c12 * b2) / det,
+         (c02 * b0 + c12 * b1 + c22 * b2) / det};
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  }
+};
+
+Vec3 to_float(Vec3 p) { return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)}; }
+
+double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
+  return std::max({geom::length(b - a), geom::length(c - b), geom::length(a - c)});
+}
+
+// A part of an original triangle (its corners), assigned to a result triangle.
+struct Piece {
+  Vec3 p[3];
+  uint32_t depth = 0;
+  uint32_t orig = 0;  // the original triangle it is part of
+};
+
+constexpr uint32_t kMaxPieceDepth = 4;  // a piece is cut at most this many times (4^4 parts)
+constexpr uint32_t kMaxCheckDepth = 4;  // a new triangle is cut at most this many times
+// kLocked: the vertex never moves or goes; kKeep: it may move but never goes.
+constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4, kKeep = 8;
+
+struct Candidate {
+  double cost;
+  uint32_t u, v;
+  uint32_t stamp_u, stamp_v;
+  bool operator<(const Candidate& o) const { return cost > o.cost; }  // min-heap
+};
+
+class Simplifier {
+ public:
+  Simplifier(const Mesh& in, const SimplifyOptions& o) : in_(in), o_(o), orig_(geom::triangles_of(in)), bvh_(orig_) {}
+
+  Status run(Mesh& out, SimplifyReport& report);
+
+ private:
+  // ---- setup
+  void build();
+  void find_locked();
+  void find_components();
+  void init_quadrics();
+  void push_edges_of(uint32_t v);
+  bool candidate_for(uint32_t u, uint32_t v, Candidate& c);
+
+  // ---- one collapse
+  struct Place {
+    double cost;
+    uint32_t u, v;  // u goes, v stays (at x)
+    Vec3 x;
+  };
+  std::vector<Place> placements(uint32_t a, uint32_t b, const Quadric& q) const;
+  bool try_collapse(uint32_t u, uint32_t v);
+  bool topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris);
+  bool attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris);
+  void commit(uint32_t u, uint32_t v);
+
+  // ---- the bound
+  bool assign_pieces(const std::vector<uint32_t>& changed);
+  bool assign_piece(const Piece& pc);
+  bool within_original(uint32_t t);
+  bool nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint);
+  bool within_original_rec(const Vec3 p[3], const double d[3], const int64_t t[3], uint32_t depth);
+  Vec3 new_corner(uint32_t t, int k) const;
+
+  // ---- output
+  void write(Mesh& out) const;
+  uint64_t live_faces() const { return live_; }
+
+  const Mesh& in_;
+  const SimplifyOptions& o_;
+  geom::TriangleSet orig_;
+  geom::TriangleBvh bvh_;
+  double e2_ = 0;  // max_error squared
+  bool bounded_ = false;
+
+  std::vector<Vec3> pos_;
+  std::vector<std::array<uint32_t, 3>> tri_;
+  std::vector<uint8_t> tri_alive_;
+  std::vector<std::vector<uint32_t>> vtris_;
+  std::vector<uint8_t> flags_;
+  std::vector<uint8_t> had_faces_;   // the vertex is on a triangle of the input
+  std::vector<uint32_t> comp_;       // per triangle: its edge-connected component
+  std::vector<uint32_t> comp_live_;  // per component: live triangles
+  std::vector<Quadric> quad_;
+  std::vector<uint32_t> stamp_;
+  std::vector<double> param_;  // per vertex: scratch
+  uint64_t live_ = 0;
+  std::priority_queue<Candidate> heap_;
+
+  // Attributes: vertex ones interpolated per vertex, corner ones through a
+  // value index per triangle corner (values appended as they are made).
+  std::vector<size_t> vertex_attrs_, corner_attrs_;
+  std::vector<std::vector<float>> vvalues_;                   // per vertex attribute
+  std::vector<std::vector<float>> cvalues_;                   // per corner attribute
+  std::vector<std::vector<std::array<uint32_t, 3>>> cindex_;  // per corner attribute, per triangle
+
+  // The bound's state: pieces and which triangle holds each.
+  std::vector<Piece> pieces_;
+  std::vector<std::vector<uint32_t>> tri_pieces_;
+  std::vector<uint32_t> free_pieces_;
+
+  // Scratch of one attempt: the collapse u -> v at x.
+  uint32_t cu_ = 0, cv_ = 0;
+  Vec3 cx_;
+  std::vector<uint32_t> changed_;                   // triangles whose corners move or that go
+  std::vector<uint32_t> new_tris_;                  // changed triangles that stay (with u or v replaced by the moved v)
+  std::vector<uint32_t> near_tris_;                 // unchanged live triangles around, also able to take pieces
+  std::vector<std::pair<uint32_t, Piece>> placed_;  // triangle, piece (an attempt's assignments)
+  struct NearCache {
+    Vec3 p;
+    double d;
+    int64_t t;
+  };
+  std::vector<NearCache> near_cache_;
+  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original
+                                      // triangles of points met in one try_collapse
+
+  uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
+};
+
+Vec3 Simplifier::new_corner(uint32_t t, int k) const {
+  const uint32_t w = tri_[t][k];
+  return (w == cu_ || w == cv_) ? cx_ : pos_[w];
+}
+
+void Simplifier::build() {
+  const size_t nv = in_.vertex_count();
+  pos_ = orig_.points;
+  vtris_.assign(nv, {});
+  flags_.assign(nv, 0);
+  stamp_.assign(nv, 0);
+  for (size_t i = 0; i < in_.attributes.size(); ++i) {
+    const Attribute& a = in_.attributes[i];
+    if (a.domain == AttributeDomain::vertex) {
+      vertex_attrs_.push_back(i);
+      vvalues_.push_back(a.values);
+    } else if (a.domain == AttributeDomain::corner) {
+      corner_attrs_.push_back(i);
+      cvalues_.push_back(a.values);
+      cindex_.push_back({});
+    }
+  }
+  for (size_t f = 0; f < in_.face_count(); ++f) {
+    const uint32_t n = in_.face_size(f);
+    const uint32_t* c = in_.face(f);
+    const uint32_t base = in_.face_offsets[f];
+    for (uint32_t k = 2; k < n; ++k) {
+      tri_.push_back({c[0], c[k - 1], c[k]});
+      for (size_t a = 0; a < corner_attrs_.size(); ++a) {
+        const std::vector<uint32_t>& idx = in_.attributes[corner_attrs_[a]].indices;
+        cindex_[a].push_back({idx[base], idx[base + k - 1], idx[base + k]});
+      }
+    }
+  }
+  tri_alive_.assign(tri_.size(), 1);
+  for (uint32_t t = 0; t < tri_.size(); ++t) {
+    const auto& c = tri_[t];
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      // A degenerate input triangle stays as it is: its vertices never move.
+      for (uint32_t w : c) flags_[w] |= kLocked;
+    }
+    for (int k = 0; k < 3; ++k)
+      if (k == 0 || (c[k] != c[0] && (k == 1 || c[k] != c[1]))) vtris_[c[k]].push_back(t);
+  }
+  find_components();
+  had_faces_.assign(nv, 0);
+  for (uint32_t v = 0; v < nv; ++v) had_faces_[v] = !vtris_[v].empty();
+  live_ = tri_.size();
+  pieces_.resize(tri_.size());
+  tri_pieces_.assign(tri_.size(), {});
+  for (uint32_t t = 0; t < tri_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
+    pieces_[t].orig = t;
+    tri_pieces_[t].push_back(t);
+  }
+}
+
+// Edge-connected components of the triangles (union-find over shared edges).
+void Simplifier::find_components() {
+  std::vector<uint32_t> parent(tri_.size());
+  for (uint32_t t = 0; t < tri_.size(); ++t) parent[t] = t;
+  auto find = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<std::array<uint32_t, 3>> edges;  // lo, hi, triangle
+  for (uint32_t t = 0; t < tri_.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = tri_[t][k], b = tri_[t][(k + 1) % 3];
+      if (a != b) edges.push_back({std::min(a, b), std::max(a, b), t});
+    }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1])
+      parent[find(edges[i][2])] = find(edges[i - 1][2]);
+  comp_.resize(tri_.size());
+  comp_live_.assign(tri_.size(), 0);
+  for (uint32_t t = 0; t < tri_.size(); ++t) {
+    comp_[t] = find(t);
+    ++comp_live_[comp_[t]];
+  }
+}
+
+// Vertices that never move or go: on an edge of more than two triangles or
+// of two that disagree on its direction, with more than one fan of
+// triangles, or where a corner attribute has different values (a seam).
+void Simplifier::find_locked() {
+  std::vector<uint32_t> ring;
+  for (uint32_t v = 0; v < vtris_.size(); ++v) {
+    if (vtris_[v].empty()) continue;
+    // Edges (v, w): how many triangles, and in which direction.
+    ring.clear();
+    for (uint32_t t : vtris_[v])
+      for (int k = 0; k < 3; ++k)
+        if (tri_[t][k] == v) ring.push_back(tri_[t][(k + 1) % 3]), ring.push_back(tri_[t][(k + 2) % 3]);
+    std::vector<uint32_t> sorted = ring;
+    std::sort(sorted.begin(), sorted.end());
+    uint32_t boundary = 0;
+    bool bad = false;
+    for (size_t i = 0; i < sorted.size();) {
+      size_t j = i;
+      while (j < sorted.size() && sorted[j] == sorted[i]) ++j;
+      const size_t count = j - i;
+      if (count == 1) ++boundary;
+      if (count > 2) bad = true;
+      i = j;
+    }
+    // Direction: w after v in one triangle and before v in the other.
+    for (uint32_t t : vtris_[v])
+      for (int k = 0; k < 3; ++k)
+        if (tri_[t][k] == v) {
+          const uint32_t next = tri_[t][(k + 1) % 3];
+          for (uint32_t s : vtris_[v])
+            if (s != t)
+              for (int q = 0; q < 3; ++q)
+                if (tri_[s][q] == v && tri_[s][(q + 1) % 3] == next) bad = true;
+        }
+    // One fan: the triangles around v connected through their edges at v.
+    const size_t n = vtris_[v].size();
+    std::vector<uint32_t> comp(n);
+    for (size_t i = 0; i < n; ++i) comp[i] = static_cast<uint32_t>(i);
+    auto find = [&](uint32_t i) {
+      while (comp[i] != i) i = comp[i] = comp[comp[i]];
+      return i;
+    };
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = i + 1; j < n; ++j) {
+        int shared = 0;
+        for (uint32_t a : tri_[vtris_[v][i]])
+          for (uint32_t b : tri_[vtris_[v][j]])
+            if (a == b && a != v) ++shared;
+        if (shared > 0) comp[find(static_cast<uint32_t>(i))] = find(static_cast<uint32_t>(j));
+      }
+    size_t fans = 0;
+    for (size_t i = 0; i < n; ++i) fans += find(static_cast<uint32_t>(i)) == i;
+    if (fans != 1 || (boundary != 0 && boundary != 2)) bad = true;
+    if (boundary) flags_[v] |= kBoundary;
+    // Seams: all corners of v agree on every corner attribute.
+    bool seam = false;
+    for (size_t a = 0; a < corner_attrs_.size() && !seam; ++a) {
+      const uint32_t comps = in_.attributes[corner_attrs_[a]].components;
+      const float* first = nullptr;
+      for (uint32_t t : vtris_[v])
+        for (int k = 0; k < 3; ++k)
+          if (tri_[t][k] == v) {
+            const float* val = &cvalues_[a][static_cast<size_t>(cindex_[a][t][k]) * comps];
+            if (!first)
+              first = val;
+            else if (std::memcmp(first, val, comps * sizeof(float)) != 0)
+              seam = true;
+          }
+    }
+    // A non-manifold vertex may move (only geometry changes) but not go; a
+    // seam vertex neither (its values on each side would need their own
+    // interpolation).
+    if (bad) flags_[v] |= kKeep;
+    if (seam) flags_[v] |= kLocked;
+  }
+  for (uint8_t f : flags_) locked_count_ += (f & (kLocked | kKeep)) != 0;
+}
+
+void Simplifier::init_quadrics() {
+  quad_.assign(pos_.size(), {});
+  for (uint32_t t = 0; t < tri_.size(); ++t) {
+    const auto& c = tri_[t];
+    const Vec3 a = pos_[c[0]], b = pos_[c[1]], d = pos_[c[2]];
+    Vec3 n = geom::cross(b - a, d - a);
+    const double len = geom::length(n);
+    if (!(len > 0)) continue;
+    n = n * (1 / len);
+    Quadric q;
+    q.add_plane(n, -geom::dot(n, a), len / 2);
+    for (uint32_t w : c) quad_[w].add(q);
+    // Boundary edges: a plane through the edge, perpendicular to the triangle.
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t p = c[k], r = c[(k + 1) % 3];
+      int count = 0;
+      for (uint32_t s : vtris_[p])
+        for (int j = 0; j < 3; ++j)
+          if ((tri_[s][j] == p && tri_[s][(j + 1) % 3] == r) || (tri_[s][j] == r && tri_[s][(j + 1) % 3] == p)) ++count;
+      if (count != 1) continue;
+      const Vec3 e = pos_[r] - pos_[p];
+      Vec3 m = geom::cross(e, n);
+      const double ml = geom::length(m);
+      if (!(ml > 0)) continue;
+      m = m * (1 / ml);
+      Quadric qb;
+      qb.add_plane(m, -geom::dot(m, pos_[p]), 4 * geom::dot(e, e));
+      quad_[p].add(qb);
+      quad_[r].add(qb);
+    }
+  }
+}
+
+// The cheapest placement's cost; false when the edge cannot collapse at all.
+bool Simplifier::candidate_for(uint32_t u, uint32_t v, Candidate& c) {
+  Quadric q = quad_[u];
+  q.add(quad_[v]);
+  double best = std::numeric_limits<double>::infinity();
+  bool any = false;
+  for (const Place& p : placements(u, v, q)) best = std::min(best, p.cost), any = true;
+  c = {std::max(best, 0.0), u, v, stamp_[u], stamp_[v]};
+  return any;
+}
+
+void Simplifier::push_edges_of(uint32_t v) {
+  for (uint32_t t : vtris_[v])
+    for (uint32_t w : tri_[t])
+      if (w != v && v < w) {
+        Candidate c;
+        if (candidate_for(v, w, c)) heap_.push(c);
+      } else if (w != v) {
+        Candidate c;
+        if (candidate_for(w, v, c)) heap_.push(c);
+      }
+}
+
+// Link condition, boundary and component rules; `edge_tris` gets the
+// triangles on the edge.
+bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris) {
+  edge_tris.clear();
+  for (uint32_t t : vtris_[u])
+    if (tri_[t][0] == v || tri_[t][1] == v || tri_[t][2] == v) edge_tris.push_back(t);
+  if (edge_tris.empty() || edge_tris.size() > 2) return false;
+  if ((flags_[u] & kBoundary) && (flags_[v] & kBoundary) && edge_tris.size() == 2) return false;
+  // A corner attribute must have one value at each end on both sides of the
+  // edge (else the edge ends a seam, which the collapse would move).
+  if (edge_tris.size() == 2)
+    for (size_t a = 0; a < corner_attrs_.size(); ++a) {
+      const uint32_t n = in_.attributes[corner_attrs_[a]].components;
+      for (uint32_t w : {u, v}) {
+        const float* val[2];
+        for (int i = 0; i < 2; ++i)
+          for (int k = 0; k < 3; ++k)
+            if (tri_[edge_tris[i]][k] == w) val[i] = &cvalues_[a][static_cast<size_t>(cindex_[a][edge_tris[i]][k]) * n];
+        if (std::memcmp(val[0], val[1], n * sizeof(float)) != 0) return false;
+      }
+    }
+  std::vector<uint32_t> nu, nv, opposite;
+  for (uint32_t t : vtris_[u])
+    for (uint32_t w : tri_[t])
+      if (w != u) nu.push_back(w);
+  for (uint32_t t : vtris_[v])
+    for (uint32_t w : tri_[t])
+      if (w != v) nv.push_back(w);
+  for (uint32_t t : edge_tris)
+    for (uint32_t w : tri_[t])
+      if (w != u && w != v) opposite.push_back(w);
+  for (auto* s : {&nu, &nv, &opposite}) {
+    std::sort(s->begin(), s->end());
+    s->erase(std::unique(s->begin(), s->end()), s->end());
+  }
+  std::vector<uint32_t> common;
+  std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
+  common.erase(std::remove_if(common.begin(), common.end(), [&](uint32_t w) { return w == u || w == v; }),
+               common.end());
+  if (common != opposite) return false;
+  // No triangle may come to repeat another (a tetrahedron's last collapse),
+  // and v keeps at least one triangle (no component vanishes).
+  size_t remaining = 0;
+  for (uint32_t t : vtris_[u]) {
+    if (std::find(edge_tris.begin(), edge_tris.end(), t) != edge_tris.end()) continue;
+    ++remaining;
+    uint32_t a = 0, b = 0;
+    int k = 0;
+    for (uint32_t w : tri_[t])
+      if (w != u) (k++ == 0 ? a : b) = w;
+    for (uint32_t s : vtris_[v]) {
+      const auto& c = tri_[s];
+      const bool has_a = c[0] == a || c[1] == a || c[2] == a, has_b = c[0] == b || c[1] == b || c[2] == b;
+      if (has_a && has_b) return false;
+    }
+  }
+  for (uint32_t t : vtris_[v])
+    if (std::find(edge_tris.begin(), edge_tris.end(), t) == edge_tris.end()) ++remaining;
+  if (remaining == 0) return false;
+  // Every edge-connected piece of surface keeps a triangle (the fans of a
+  // non-manifold vertex are pieces of their own).
+  for (uint32_t t : edge_tris) {
+    uint32_t gone = 0;
+    for (uint32_t s : edge_tris) gone += comp_[s] == comp_[t];
+    if (comp_live_[comp_[t]] <= gone) return false;
+  }
+  return true;
+}
+
+// Pieces of the changed triangles onto the new triangles (or the unchanged
+// ones around); the assignments go to placed_.
+bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
+  placed_.clear();
+  for (uint32_t t : changed)
+    for (uint32_t pi : tri_pieces_[t])
+      if (!assign_piece(pieces_[pi])) return false;
+  return true;
+}
+
+bool Simplifier::assign_piece(const Piece& pc) {
+  auto fits = [&](Vec3 a, Vec3 b, Vec3 c) {
+    for (const Vec3& p : pc.p)
+      if (geom::point_triangle_dist2(p, a, b, c) > e2_) return false;
+    return true;
+  };
+  for (uint32_t t : new_tris_)
+    if (fits(new_corner(t, 0), new_corner(t, 1), new_corner(t, 2))) {
+      placed_.push_back({t, pc});
+      return true;
+    }
+  for (uint32_t t : near_tris_)
+    if (fits(pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]])) {
+      placed_.push_back({t, pc});
+      return true;
+    }
+  if (pc.depth >= kMaxPieceDepth) return false;
+  const Vec3 m01 = (pc.p[0] + pc.p[1]) * 0.5, m12 = (pc.p[1] + pc.p[2]) * 0.5, m20 = (pc.p[2] + pc.p[0]) * 0.5;
+  const Vec3 parts[4][3] = {{pc.p[0], m01, m20}, {m01, pc.p[1], m12}, {m20, m12, pc.p[2]}, {m01, m12, m20}};
+  for (const auto& q : parts) {
+    Piece child;
+    child.p[0] = q[0], child.p[1] = q[1], child.p[2] = q[2];
+    child.depth = pc.depth + 1;
+    child.orig = pc.orig;
+    if (!assign_piece(child)) return false;
+  }
+  return true;
+}
+
+// The nearest original triangle to p and its distance (not squared); false
+// when it is beyond the bound. Points met before in this collapse attempt
+// (corners and edge midpoints shared by the new triangles, the ring's
+// vertices for every placement tried) come from a small cache.
+bool Simplifier::nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint) {
+  for (const NearCache& c : near_cache_)
+    if (c.p.x == p.x && c.p.y == p.y && c.p.z == p.z) {
+      d = c.d, t = c.t;
+      return d * d <= e2_;
+    }
+  double d2;
+  t = bvh_.nearest(p, d2, hint);
+  d = std::sqrt(d2);
+  near_cache_.push_back({p, d, t});
+  return d2 <= e2_;
+}
+
+bool Simplifier::within_original(uint32_t tri) {
+  Vec3 p[3];
+  double d[3];
+  int64_t t[3];
+  int64_t hint = -1;
+  for (int k = 0; k < 3; ++k) {
+    p[k] = new_corner(tri, k);
+    if (!nearest_original(p[k], d[k], t[k], hint)) return false;
+    hint = t[k];
+  }
+  return within_original_rec(p, d, t, 0);
+}
+
+// p: corners, d: their distances to the original, t: their nearest triangles.
+bool Simplifier::within_original_rec(const Vec3 p[3], const double d[3], const int64_t t[3], uint32_t depth) {
+  const double e = std::sqrt(e2_);
+  if (std::max({d[0], d[1], d[2]}) + longest_edge(p[0], p[1], p[2]) / std::sqrt(3.0) <= e) return true;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 a = orig_.corner(t[k], 0), b = orig_.corner(t[k], 1), c = orig_.corner(t[k], 2);
+    if (geom::point_triangle_dist2(p[0], a, b, c) <= e2_ && geom::point_triangle_dist2(p[1], a, b, c) <= e2_ &&
+        geom::point_triangle_dist2(p[2], a, b, c) <= e2_)
+      return true;
+  }
+  if (depth >= kMaxCheckDepth) return false;
+  const Vec3 m[3] = {(p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5, (p[2] + p[0]) * 0.5};
+  double dm[3];
+  int64_t tm[3];
+  for (int k = 0; k < 3; ++k) {
+    if (depth == 0) {
+      // The new triangles' edge midpoints: shared between neighbours.
+      if (!nearest_original(m[k], dm[k], tm[k], t[k])) return false;
+      continue;
+    }
+    tm[k] = bvh_.nearest(m[k], dm[k], t[k]);
+    if (dm[k] > e2_) return false;
+    dm[k] = std::sqrt(dm[k]);
+  }
+  const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
+             c3[3] = {m[0], m[1], m[2]};
+  const double d0[3] = {d[0], dm[0], dm[2]}, d1[3] = {dm[0], d[1], dm[1]}, d2[3] = {dm[2], dm[1], d[2]},
+               d3[3] = {dm[0], dm[1], dm[2]};
+  const int64_t t0[3] = {t[0], tm[0], tm[2]}, t1[3] = {tm[0], t[1], tm[1]}, t2[3] = {tm[2], tm[1], t[2]},
+                t3[3] = {tm[0], tm[1], tm[2]};
+  return within_original_rec(c3, d3, t3, depth + 1) && within_original_rec(c0, d0, t0, depth + 1) &&
+         within_original_rec(c1, d1, t1, depth + 1) && within_original_rec(c2, d2, t2, depth + 1);
+}
+
+// Collapse u into v placed at x: flips, degeneracy and the bound.
+bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris) {
+  cu_ = u, cv_ = v, cx_ = to_float(x);
+  const bool moved = !(cx_.x == pos_[v].x && cx_.y == pos_[v].y && cx_.z == pos_[v].z);
+  changed_.clear();
+  new_tris_.clear();
+  for (uint32_t t : vtris_[u]) changed_.push_back(t);
+  if (moved)
+    for (uint32_t t : vtris_[v])
+      if (std::find(edge_tris.begin(), edge_tris.end(), t) == edge_tris.end()) changed_.push_back(t);
+  for (uint32_t t : changed_) {
+    if (std::find(edge_tris.begin(), edge_tris.end(), t) != edge_tris.end()) continue;
+    new_tris_.push_back(t);
+    const Vec3 a = pos_[tri_[t][0]], b = pos_[tri_[t][1]], c = pos_[tri_[t][2]];
+    const Vec3 na = new_corner(t, 0), nb = new_corner(t, 1), nc = new_corner(t, 2);
+    const Vec3 n_old = geom::cross(b - a, c - a), n_new = geom::cross(nb - na, nc - na);
+    const double l = longest_edge(na, nb, nc);
+    if (!(geom::length(n_new) > 1e-6 * l * l)) return false;  // degenerate
+    if (!(geom::dot(n_old, n_new) > 0)) return false;         // flipped (90 degrees or more)
+  }
+  if (!bounded_) return true;
+  // Unchanged triangles around the new ring may take pieces too.
+  near_tris_.clear();
+  for (uint32_t t : new_tris_)
+    for (uint32_t w : tri_[t])
+      if (w != u && w != v)
+        for (uint32_t s : vtris_[w])
+          if (std::find(changed_.begin(), changed_.end(), s) == changed_.end() &&
+              std::find(near_tris_.begin(), near_tris_.end(), s) == near_tris_.end())
+            near_tris_.push_back(s);
+  // First the original triangles whose pieces the changed triangles hold:
+  // a new triangle within E of one of them needs no search.
+  local_orig_.clear();
+  for (uint32_t t : changed_)
+    for (uint32_t pi : tri_pieces_[t])
+      if (local_orig_.size() < 64 &&
+          std::find(local_orig_.begin(), local_orig_.end(), pieces_[pi].orig) == local_orig_.end())
+        local_orig_.push_back(pieces_[pi].orig);
+  for (uint32_t t : new_tris_) {
+    const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
+    bool near = false;
+    for (size_t i = 0; i < local_orig_.size() && !near; ++i) {
+      const Vec3 oa = orig_.corner(local_orig_[i], 0), ob = orig_.corner(local_orig_[i], 1),
+                 oc = orig_.corner(local_orig_[i], 2);
+      near = geom::point_triangle_dist2(a, oa, ob, oc) <= e2_ && geom::point_triangle_dist2(b, oa, ob, oc) <= e2_ &&
+             geom::point_triangle_dist2(c, oa, ob, oc) <= e2_;
+    }
+    if (!near && !within_original(t)) return false;
+  }
+  return assign_pieces(changed_);
+}
+
+void Simplifier::commit(uint32_t u, uint32_t v) {
+  // Interpolation parameter of the new position along u -> v (0 at u, 1 at v).
+  const Vec3 e = pos_[v] - pos_[u];
+  const double ee = geom::dot(e, e);
+  const double s = ee > 0 ? std::clamp(geom::dot(cx_ - pos_[u], e) / ee, 0.0, 1.0) : 1.0;
+  for (size_t a = 0; a < vertex_attrs_.size(); ++a) {
+    const Attribute& at = in_.attributes[vertex_attrs_[a]];
+    const uint32_t n = at.components;
+    float* pv = &vvalues_[a][static_cast<size_t>(v) * n];
+    const float* pu = &vvalues_[a][static_cast<size_t>(u) * n];
+    for (uint32_t k = 0; k < n; ++k) pv[k] = static_cast<float>(pu[k] + (pv[k] - pu[k]) * s);
+    if (at.kind == AttributeKind::normal && n == 3) {
+      const double l = std::sqrt(double(pv[0]) * pv[0] + double(pv[1]) * pv[1] + double(pv[2]) * pv[2]);
+      if (l > 0)
+        for (uint32_t k = 0; k < 3; ++k) pv[k] = static_cast<float>(pv[k] / l);
+    }
+  }
+  // Corner attributes: u is not on a seam (it is not locked), so its corners
+  // share one value. The corners that come to v take v's value on the edge
+  // (v's value there is the same on both sides); when v moves (then v is not
+  // on a seam either) every corner of v takes the interpolated value.
+  std::vector<uint32_t> edge_tris;
+  for (uint32_t t : vtris_[u])
+    if (tri_[t][0] == v || tri_[t][1] == v || tri_[t][2] == v) edge_tris.push_back(t);
+  const bool moved = !(cx_.x == pos_[v].x && cx_.y == pos_[v].y && cx_.z == pos_[v].z);
+  for (size_t a = 0; a < corner_attrs_.size(); ++a) {
+    const uint32_t n = in_.attributes[corner_attrs_[a]].components;
+    uint32_t val_u = 0, val_v = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (tri_[edge_tris[0]][k] == u) val_u = cindex_[a][edge_tris[0]][k];
+      if (tri_[edge_tris[0]][k] == v) val_v = cindex_[a][edge_tris[0]][k];
+    }
+    uint32_t target = val_v;
+    if (moved) {
+      target = static_cast<uint32_t>(cvalues_[a].size() / n);
+      for (uint32_t k = 0; k < n; ++k) {
+        const float fu = cvalues_[a][static_cast<size_t>(val_u) * n + k],
+                    fv = cvalues_[a][static_cast<size_t>(val_v) * n + k];
+        cvalues_[a].push_back(static_cast<float>(fu + (fv - fu) * s));
+      }
+      for (uint32_t t : vtris_[v])
+        for (int k = 0; k < 3; ++k)
+          if (tri_[t][k] == v) cindex_[a][t][k] = target;
+    }
+    for (uint32_t t : vtris_[u])
+      for (int k = 0; k < 3; ++k)
+        if (tri_[t][k] == u) cindex_[a][t][k] = target;
+  }
+  // Topology: the edge's triangles go, u's others take v.
+  for (uint32_t t : edge_tris) {
+    tri_alive_[t] = 0;
+    --live_;
+    --comp_live_[comp_[t]];
+    for (uint32_t w : tri_[t]) {
+      auto& l = vtris_[w];
+      l.erase(std::remove(l.begin(), l.end(), t), l.end());
+    }
+  }
+  for (uint32_t t : vtris_[u]) {
+    for (uint32_t& w : tri_[t])
+      if (w == u) w = v;
+    vtris_[v].push_back(t);
+  }
+  vtris_[u].clear();
+  pos_[v] = cx_;
+  flags_[v] = static_cast<uint8_t>(flags_[v] | (flags_[u] & kBoundary));
+  flags_[u] |= kRemoved;
+  quad_[v].add(quad_[u]);
+  // The pieces: the changed triangles' lists are rebuilt from placed_.
+  if (bounded_) {
+    for (uint32_t t : changed_) {
+      for (uint32_t pi : tri_pieces_[t]) free_pieces_.push_back(pi);
+      tri_pieces_[t].clear();
+    }
+    for (const auto& [t, pc] : placed_) {
+      uint32_t pi;
+      if (!free_pieces_.empty()) {
+        pi = free_pieces_.back();
+        free_pieces_.pop_back();
+        pieces_[pi] = pc;
+      } else {
+        pi = static_cast<uint32_t>(pieces_.size());
+        pieces_.push_back(pc);
+      }
+      tri_pieces_[t].push_back(pi);
+    }
+  }
+  ++collapses_;
+  // New candidates around v.
+  ++stamp_[v];
+  std::vector<uint32_t> ring;
+  for (uint32_t t : vtris_[v])
+    for (uint32_t w : tri_[t])
+      if (w != v) ring.push_back(w);
+  std::sort(ring.begin(), ring.end());
+  ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+  for (uint32_t w : ring) ++stamp_[w];
+  push_edges_of(v);
+  for (uint32_t w : ring) push_edges_of(w);
+}
+
+// Where the edge (a, b) may collapse to, cheapest first: the quadric
+// optimum, the midpoint, the endpoints; only into a vertex that stays (not
+// kLocked / kKeep going), only at a vertex that cannot move.
+std::vector<Simplifier::Place> Simplifier::placements(uint32_t a, uint32_t b, const Quadric& q) const {
+  std::vector<Place> places;
+  auto can_go = [&](uint32_t w) { return !(flags_[w] & (kLocked | kKeep)); };
+  auto can_move = [&](uint32_t w) { return !(flags_[w] & kLocked); };
+  uint32_t u = a, v = b;  // u goes
+  if (!can_go(u)) std::swap(u, v);
+  if (!can_go(u)) return places;
+  if (can_move(v)) {
+    Vec3 x;
+    if (q.optimum(x)) {
+      // Only near the edge: a far optimum is a badly conditioned one.
+      const Vec3 mid = (pos_[a] + pos_[b]) * 0.5;
+      if (geom::length(x - mid) <= 2 * geom::length(pos_[b] - pos_[a])) places.push_back({q.eval(x), u, v, x});
+    }
+    places.push_back({q.eval((pos_[a] + pos_[b]) * 0.5), u, v, (pos_[a] + pos_[b]) * 0.5});
+    if (can_go(v) && can_move(u)) places.push_back({q.eval(pos_[u]), v, u, pos_[u]});
+  }
+  places.push_back({q.eval(pos_[v]), u, v, pos_[v]});
+  std::stable_sort(places.begin(), places.end(), [](const Place& x1, const Place& x2) { return x1.cost < x2.cost; });
+  return places;
+}
+
+bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
+  std::vector<uint32_t> edge_tris;
+  if (!topology_ok(a, b, edge_tris)) return false;
+  near_cache_.clear();
+  Quadric q = quad_[a];
+  q.add(quad_[b]);
+  for (const Place& p : placements(a, b, q))
+    if (attempt(p.u, p.v, p.x, edge_tris)) {
+      commit(p.u, p.v);
+      return true;
+    }
+  return false;
+}
+
+void Simplifier::write(Mesh& out) const {
+  out.clear();
+  // Vertices: those not removed and still on a triangle (or on none in the
+  // input), in order. (A collapse can take the last triangle of a vertex
+  // next to it: an ear on a boundary.)
+  std::vector<uint8_t> used(pos_.size(), 0);
+  for (uint32_t t = 0; t < tri_.size(); ++t)
+    if (tri_alive_[t])
+      for (uint32_t w : tri_[t]) used[w] = 1;
+  std::vector<uint32_t> remap(pos_.size(), UINT32_MAX);
+  uint32_t nv = 0;
+  for (uint32_t v = 0; v < pos_.size(); ++v)
+    if (!(flags_[v] & kRemoved) && (used[v] || !had_faces_[v])) remap[v] = nv++;
+  out.positions.reserve(3 * nv);
+  for (uint32_t v = 0; v < pos_.size(); ++v)
+    if (remap[v] != UINT32_MAX)
+      out.add_vertex(static_cast<float>(pos_[v].x), static_cast<float>(pos_[v].y), static_cast<float>(pos_[v].z));
+  std::vector<uint32_t> live;
+  for (uint32_t t = 0; t < tri_.size(); ++t)
+    if (tri_alive_[t]) live.push_back(t);
+  for (uint32_t t : live) out.add_triangle(remap[tri_[t][0]], remap[tri_[t][1]], remap[tri_[t][2]]);
+  // The triangles' source faces, for face attributes.
+  std::vector<uint32_t> face_of = orig_.face_of;
+  size_t vi = 0, ci = 0;
+  for (size_t i = 0; i < in_.attributes.size(); ++i) {
+    const Attribute& a = in_.attributes[i];
+    Attribute r;
+    r.name = a.name, r.kind = a.kind, r.domain = a.domain, r.type = a.type, r.components = a.components;
+    const uint32_t n = a.components;
+    if (a.domain == AttributeDomain::vertex) {
+      const std::vector<float>& vals = vvalues_[vi++];
+      for (uint32_t v = 0; v < pos_.size(); ++v)
+        if (remap[v] != UINT32_MAX) r.values.insert(r.values.end(), vals.begin() + v * n, vals.begin() + (v + 1) * n);
+    } else if (a.domain == AttributeDomain::face) {
+      for (uint32_t t : live)
+        r.values.insert(r.values.end(), a.values.begin() + face_of[t] * n, a.values.begin() + (face_of[t] + 1) * n);
+    } else {
+      // Corner values: only those still used, in order of first use.
+      const std::vector<float>& vals = cvalues_[ci];
+      const auto& idx = cindex_[ci++];
+      std::vector<uint32_t> vmap(vals.size() / n, UINT32_MAX);
+      for (uint32_t t : live)
+        for (int k = 0; k < 3; ++k) {
+          uint32_t& m = vmap[idx[t][k]];
+          if (m == UINT32_MAX) {
+            m = static_cast<uint32_t>(r.values.size() / n);
+            r.values.insert(r.values.end(), vals.begin() + idx[t][k] * n, vals.begin() + (idx[t][k] + 1) * n);
+          }
+          r.indices.push_back(m);
+        }
+    }
+    out.attributes.push_back(std::move(r));
+  }
+  out.metadata = in_.metadata;
+}
+
+Status Simplifier::run(Mesh& out, SimplifyReport& report) {
+  bounded_ = o_.max_error > 0;
+  e2_ = bounded_ ? o_.max_error * o_.max_error : std::numeric_limits<double>::infinity();
+  build();
+  find_locked();
+  init_quadrics();
+  report.faces_in = tri_.size();
+  report.vertices_in = pos_.size();
+  for (uint32_t v = 0; v < pos_.size(); ++v) push_edges_of(v);
+  uint64_t since = 0;
+  while (!heap_.empty() && live_faces() > o_.target_faces) {
+    const Candidate c = heap_.top();
+    heap_.pop();
+    if ((flags_[c.u] | flags_[c.v]) & kRemoved) continue;
+    if (stamp_[c.u] != c.stamp_u || stamp_[c.v] != c.stamp_v) continue;
+    if (!try_collapse(c.u, c.v)) ++rejected_;
+    if (o_.progress && ++since >= 256) {
+      since = 0;
+      o_.progress(live_faces(), report.faces_in, o_.progress_user);
+    }
+  }
+  write(out);
+  report.faces_out = out.face_count();
+  report.vertices_out = out.vertex_count();
+  report.collapses = collapses_;
+  report.rejected = rejected_;
+  report.locked_vertices = locked_count_;
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status simplify(const Mesh& in, const SimplifyOptions& options, Mesh& out, SimplifyReport* report) {
+  std::string why;
+  if (!in.valid(&why)) return Status(ErrorCode::invalid_argument, "simplify: the mesh is not consistent: " + why);
+  if (!(options.max_error >= 0) || !std::isfinite(options.max_error))
+    return Status(ErrorCode::invalid_argument, "simplify: the maximum error must be a finite number >= 0");
+  if (options.max_error == 0 && options.target_faces == 0)
+    return Status(ErrorCode::invalid_argument,
+                  "simplify: give a maximum error, a target face count, or both (with neither nothing would change)");
+  for (float v : in.positions)
+    if (!std::isfinite(v)) return Status(ErrorCode::invalid_argument, "simplify: a position is NaN or infinite");
+  SimplifyReport local;
+  Simplifier s(in, options);
+  return s.run(out, report ? *report : local);
+}
+
+}  // namespace tsm
