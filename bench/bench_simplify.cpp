@@ -30,13 +30,6 @@ double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-double diagonal(const tsm::Mesh& m) {
-  const tsm::BoundingBox b = tsm::bounding_box(m);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) d2 += (double(b.max[k]) - b.min[k]) * (double(b.max[k]) - b.min[k]);
-  return std::sqrt(d2);
-}
-
 double measured(const tsm::Mesh& a, const tsm::Mesh& b, uint64_t samples, double* bound = nullptr) {
   tsm::DistanceOptions o;
   o.target_samples = samples;
@@ -104,7 +97,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: cannot read, or not all triangles\n", path.c_str());
       continue;
     }
-    const double diag = diagonal(in);
+    const double diag = tsm::bounding_box(in).diagonal();
     const std::string name = path.substr(path.find_last_of('/') + 1);
     for (double pct : errors) {
       const double e = pct / 100 * diag;

@@ -33,7 +33,6 @@ int cmd_simplify(const SimplifyArgs& a);
 
 // "0.5%" -> 0.5, percent; "0.002" -> 0.002. False unless a positive number.
 bool parse_max_error(const std::string& text, double& value, bool& percent);
-double bbox_diagonal(const Mesh& m);
 // Simplifies `in` as the command line asks: --max-error text (units or %),
 // --faces, --ratio (the larger face target wins); a progress line on a
 // terminal when `progress`. error_units gets the bound in model units (0: none);

@@ -15,16 +15,6 @@
 
 namespace tsm::cli {
 
-double bbox_diagonal(const Mesh& m) {
-  const BoundingBox b = bounding_box(m);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double e = static_cast<double>(b.max[k]) - b.min[k];
-    d2 += e * e;
-  }
-  return std::sqrt(d2);
-}
-
 bool parse_max_error(const std::string& text, double& value, bool& percent) {
   if (text.empty()) return false;
   percent = text.back() == '%';
@@ -66,7 +56,7 @@ Status simplify_for_cli(const Mesh& in, const std::string& max_error, uint64_t f
       return Status(ErrorCode::invalid_argument, "--max-error " + max_error +
                                                      ": give a positive number in model units, or a percentage of the "
                                                      "bounding-box diagonal such as 0.5%");
-    if (percent) error_units *= bbox_diagonal(in) / 100;
+    if (percent) error_units *= bounding_box(in).diagonal() / 100;
     if (!(error_units > reserve))
       return Status(ErrorCode::invalid_argument, "--max-error " + max_error +
                                                      " is below the error the quantization "
@@ -141,7 +131,7 @@ int cmd_simplify(const SimplifyArgs& a) {
     std::fprintf(stderr, "tsm: error: %s\n", printable(s.message()).c_str());
     return exit_code_for(s);
   }
-  const double diag = bbox_diagonal(in);
+  const double diag = bounding_box(in).diagonal();
   if (a.json) {
     JsonObject j;
     j.str("input", a.input).str("output", a.output);

@@ -19,13 +19,6 @@ namespace {
 
 using tsm::Mesh;
 
-double diagonal(const Mesh& m) {
-  const tsm::BoundingBox b = tsm::bounding_box(m);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) d2 += (double(b.max[k]) - b.min[k]) * (double(b.max[k]) - b.min[k]);
-  return std::sqrt(d2);
-}
-
 struct EdgeStats {
   size_t boundary = 0, non_manifold = 0, edges = 0, loops = 0;
 };
@@ -103,7 +96,7 @@ bool has_degenerate(const Mesh& m) {
 // the input with the sampled distance (a sampled distance above the limit
 // would be a proof that the bound failed).
 Mesh simplify_checked(const Mesh& in, double fraction, double max_kept = 1.0) {
-  const double e = fraction * diagonal(in);
+  const double e = fraction * tsm::bounding_box(in).diagonal();
   tsm::SimplifyOptions o;
   o.max_error = e;
   Mesh out;

@@ -172,13 +172,7 @@ Status measure_distance(const Mesh& a, const Mesh& b, const DistanceOptions& opt
   report.hausdorff = std::max(ab.d.max, ba.d.max);
   report.hausdorff_bound = std::max(ab.d.bound, ba.d.bound);
   report.spacing = std::max(spacing_a, spacing_b);
-  const BoundingBox box = bounding_box(a);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double e = static_cast<double>(box.max[k]) - box.min[k];
-    d2 += e * e;
-  }
-  report.diagonal = std::sqrt(d2);
+  report.diagonal = bounding_box(a).diagonal();
   report.area_a = ab.area;
   report.area_b = ba.area;
   report.volume_a = signed_volume(sa);

@@ -145,6 +145,15 @@ double BoundingBox::largest_extent() const {
   return e;
 }
 
+double BoundingBox::diagonal() const {
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double e = static_cast<double>(max[a]) - static_cast<double>(min[a]);
+    d2 += e * e;
+  }
+  return std::sqrt(d2);
+}
+
 BoundingBox bounding_box(const Mesh& mesh) {
   BoundingBox box;
   const size_t n = mesh.vertex_count();

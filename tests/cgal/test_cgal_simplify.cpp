@@ -14,15 +14,8 @@ namespace {
 
 using tsm::Mesh;
 
-double diagonal(const Mesh& m) {
-  const tsm::BoundingBox b = tsm::bounding_box(m);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) d2 += (double(b.max[k]) - b.min[k]) * (double(b.max[k]) - b.min[k]);
-  return std::sqrt(d2);
-}
-
 void expect_within_bound(const Mesh& in, double fraction) {
-  const double diag = diagonal(in), e = fraction * diag;
+  const double diag = tsm::bounding_box(in).diagonal(), e = fraction * diag;
   tsm::SimplifyOptions o;
   o.max_error = e;
   Mesh out;

@@ -100,6 +100,8 @@ struct BoundingBox {
   float max[3] = {0, 0, 0};
   // max - min per axis computed in double (exact for floats), largest of three.
   double largest_extent() const;
+  // Length of the box's diagonal, in double.
+  double diagonal() const;
 };
 
 // Bounding box of all vertices (referenced or not). An empty mesh gives zeros.
