@@ -72,9 +72,12 @@ void check(std::string_view bytes) {
       info.corner_count != mesh.corner_count())
     fail("inspect's counts differ from the decoded mesh", s);
   if (mesh.vertex_count() > (1u << 14) || mesh.corner_count() > (1u << 16)) return;  // keep executions fast
+  // At level 0: the connectivity coder (the same at every level) sees the
+  // hostile mesh; the higher levels' geometry trials are fuzz_roundtrip's,
+  // and here they took three quarters of the time of an execution.
   std::string again;
   const int bits = info.quantization_bits;
-  tsm::Status se = tsm::encode(mesh, tsm::EncodeOptions{bits, tsm::kDefaultLevel}, again);
+  tsm::Status se = tsm::encode(mesh, tsm::EncodeOptions{bits, 0}, again);
   if (!se.ok()) fail("the encoder refuses a mesh the decoder produced", se);
   tsm::Mesh back;
   tsm::Status sd = tsm::decode(again, back);

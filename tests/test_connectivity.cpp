@@ -323,7 +323,7 @@ TEST(Connectivity, RandomSoups) {
 // Property test: thousands of random meshes of mixed structure.
 TEST(Connectivity, PropertyThousandsOfRandomMeshes) {
   std::mt19937 rng(12345);
-  for (int iter = 0; iter < 2000; ++iter) {
+  for (int iter = 0; iter < tsm_test::property_runs(2000); ++iter) {
     int kind;
     const Mesh m = random_base_mesh(rng, kind);
     // Random damage: drop, flip, duplicate faces; add polygons and strays.
@@ -383,7 +383,8 @@ TEST(Connectivity, TangleSettlingAfterManyRoundsReencodesCanonically) {
 TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
   std::mt19937 rng(777);
   int checked = 0;
-  for (int iter = 0; iter < 400; ++iter) {
+  const int runs = tsm_test::property_runs(400);
+  for (int iter = 0; iter < runs; ++iter) {
     int kind;
     const Mesh m = random_base_mesh(rng, kind);
     std::vector<std::vector<uint32_t>> faces;
@@ -412,7 +413,7 @@ TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
                                 << " faces): re-encoding the decoded mesh gives other bytes";
     ++checked;
   }
-  EXPECT_EQ(checked, 400);
+  EXPECT_EQ(checked, runs);
 }
 
 // Vertices on no face with several sharing their nearest surface vertex (the
@@ -423,7 +424,8 @@ TEST(Connectivity, PropertyDamagedMeshesReencodeCanonically) {
 TEST(Connectivity, VerticesOnNoFaceReencodeCanonicallyUnderTheRootSearch) {
   std::mt19937 rng(99);
   int checked = 0;
-  for (int iter = 0; iter < 24; ++iter) {
+  const int runs = tsm_test::property_runs(24);
+  for (int iter = 0; iter < runs; ++iter) {
     // A flat grid, and vertices on no face halfway between its vertices:
     // equally near to two or four, so their anchor is the one of lowest
     // output id, which differs from tree to tree.
@@ -460,7 +462,7 @@ TEST(Connectivity, VerticesOnNoFaceReencodeCanonicallyUnderTheRootSearch) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 72);
+  EXPECT_EQ(checked, 3 * runs);
 }
 
 TEST(Connectivity, CorpusRoundTrips) {
@@ -471,8 +473,11 @@ TEST(Connectivity, CorpusRoundTrips) {
     expect_round_trip(m, entry.path().filename().string(), 14);
   }
   // The low-resolution dragons are non-manifold (split and stitched):
-  // re-encoding them is canonical too.
-  for (const char* name : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply"}) {
+  // re-encoding them is canonical too. The two largest scans only in the
+  // plain build (under the sanitizers they take minutes and add no new code).
+  std::vector<const char*> scans = {"bun_zipper.ply", "dragon_vrip_res4.ply"};
+  if (!tsm_test::kSanitized) scans.insert(scans.end(), {"dragon_vrip_res3.ply", "dragon_vrip_res2.ply"});
+  for (const char* name : scans) {
     Mesh m;
     ASSERT_TRUE(read_mesh(corpus_file(name), m).ok()) << name;
     expect_round_trip(m, name, 11);

@@ -131,7 +131,7 @@ TEST(Segments, UnreferencedVerticesAndDegenerateFaces) {
 
 TEST(Segments, RandomMeshesProperty) {
   std::mt19937 rng(20261122u);
-  for (int i = 0; i < 60; ++i) {
+  for (int i = 0; i < tsm_test::property_runs(60); ++i) {
     Mesh m;
     switch (i % 4) {
       case 0: m = random_soup(20 + static_cast<int>(rng() % 200), 10 + static_cast<int>(rng() % 300), static_cast<uint32_t>(rng())); break;

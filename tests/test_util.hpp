@@ -16,6 +16,17 @@
 
 namespace tsm_test {
 
+// Built with ASan+UBSan (tests/CMakeLists.txt defines TSM_TEST_SANITIZED).
+#ifdef TSM_TEST_SANITIZED
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+// The number of random cases a property test runs: all of them in the plain
+// build, a quarter under the sanitizers, which run about ten times slower and
+// look for memory errors that the first quarter reaches as well.
+inline constexpr int property_runs(int full) { return kSanitized ? (full + 3) / 4 : full; }
+
 // ../shared/corpus beside the project (TSM_CORPUS env overrides it).
 inline std::string corpus_dir() {
   if (const char* env = std::getenv("TSM_CORPUS")) return env;
