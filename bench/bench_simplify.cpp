@@ -56,7 +56,13 @@ struct Meshopt {
 
 Meshopt run_meshopt(const tsm::Mesh& in, size_t target_triangles, unsigned options) {
   Meshopt r;
-  std::vector<unsigned> idx(in.indices.begin(), in.indices.end()), out(idx.size());
+  const std::vector<unsigned> given(in.indices.begin(), in.indices.end());
+  std::vector<unsigned> idx(given.size()), out(given.size());
+  // The scans repeat positions (split vertices, doubled faces), which
+  // meshoptimizer would keep as seams: it gets an index buffer in which equal
+  // positions are one vertex, as its documentation advises.
+  meshopt_generateShadowIndexBuffer(idx.data(), given.data(), given.size(), in.positions.data(), in.vertex_count(),
+                                    3 * sizeof(float), 3 * sizeof(float));
   const double t0 = now_ms();
   float err = 0;
   const size_t n = meshopt_simplify(out.data(), idx.data(), idx.size(), in.positions.data(), in.vertex_count(),
