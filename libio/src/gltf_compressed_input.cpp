@@ -263,7 +263,8 @@ Status fill_accessor(Document& doc, size_t acc, const std::vector<double>& raw, 
   const size_t count = raw.size() / components;
   if (count == 0) return doc.error("accessors[" + std::to_string(acc) + "]: the decoded data is empty");
   size_t stride = 0;
-  const size_t view = add_buffer_view(doc, pack_values(raw, ct, components, target, &stride), target, stride);
+  std::string bytes = pack_values(raw, ct, components, target, &stride);  // sets stride first
+  const size_t view = add_buffer_view(doc, std::move(bytes), target, stride);
   a["bufferView"] = view;
   a.erase("byteOffset");
   a.erase("sparse");
