@@ -178,7 +178,8 @@ Status decode_meshopt(Document& doc) {
     ojson& view = doc.json["bufferViews"][i];
     if (!view.is_object() || !view.contains("extensions") || !view["extensions"].is_object()) continue;
     for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-      if (!view["extensions"].contains(name)) continue;
+      // (decoding one removes an emptied "extensions": never recreate it here)
+      if (!view.contains("extensions") || !view["extensions"].contains(name)) continue;
       found = true;
 #ifdef TSM_IO_HAVE_MESHOPT
       TSM_RETURN_IF_ERROR(decode_meshopt_view(doc, i, name));
