@@ -813,13 +813,15 @@ int cmd_encode(const EncodeArgs& a) {
                        "as 0.5%");
   if (a.fallback && format_from_extension(a.output) != MeshFormat::gltf &&
       format_from_extension(a.output) != MeshFormat::glb)
-    return usage_error("--fallback keeps an uncompressed copy inside a glTF output; give -o NAME.glb or NAME.gltf, "
-                       "or drop it");
+    return usage_error(
+        "--fallback keeps an uncompressed copy inside a glTF output; give -o NAME.glb or NAME.gltf, "
+        "or drop it");
   // A glTF name: a glTF with TSM_mesh_compression, from one input file.
   const MeshFormat output_format = format_from_extension(a.output);
   if (output_format == MeshFormat::gltf || output_format == MeshFormat::glb) {
     if (gltf_output(a, a.output)) return gltf_encode(a);
-    return usage_error(a.output + ": a glTF output (TSM_mesh_compression) takes one input file (not stdin); run "
+    return usage_error(a.output +
+                       ": a glTF output (TSM_mesh_compression) takes one input file (not stdin); run "
                        "once per file, or give -o DIR/ for .tsm files");
   }
   // encode writes .tsm data: a mesh file name for it would be a lie.
