@@ -562,3 +562,20 @@ TEST(GltfExtensionCorpus, MeshoptInputFromGltfpackTranscodes) {
   EXPECT_FALSE(primitive_counts(a).empty());
   fs::remove_all(tmp);
 }
+
+TEST(GltfExtensionCorpus, CompressedGltfEncodesToTsmThroughTheTool) {
+  TSM_REQUIRE_CORPUS();
+  const fs::path tmp = fs::temp_directory_path() / ("tsm_gltf_cli_" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  const std::string in = tsm_test::corpus_file("assets/2CylinderEngine_Draco/2CylinderEngine.gltf");
+  const std::string cmd = std::string("'") + TSM_CLI_PATH + "' encode '" + in + "' -o '" + (tmp / "d.tsm").string() +
+                          "' --quiet 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  tsm::Mesh m;
+  ASSERT_TRUE(tsm::decode(slurp(tmp / "d.tsm"), m).ok());
+  ASSERT_TRUE(transcode_file(in, tmp / "plain.glb", false).ok());
+  size_t triangles = 0;
+  for (const auto& vt : primitive_counts(split_glb(slurp(tmp / "plain.glb")))) triangles += vt.second / 3;
+  EXPECT_EQ(m.face_count(), triangles);
+  fs::remove_all(tmp);
+}
