@@ -26,6 +26,7 @@ Usage:
 
 Exit status: 0 decoded (and equal, with --compare), 1 differs, 2 corrupt/unsupported.
 """
+import copy
 import math
 import struct
 import sys
@@ -1689,7 +1690,10 @@ MAX_ATTRIBUTES = 64
 
 class AttrHeader:
     """One attribute header (§8.12): name (bytes), kind, domain, type, components,
-    quant (0 exact, 1 grid, 2 octahedral), bits, and for quant 1 origin[] and extent."""
+    quant (0 exact, 1 grid, 2 octahedral), bits, and for quant 1 origin[] and extent;
+    per_vertex: a corner attribute coded per vertex (its predictor byte's bit 4)."""
+
+    per_vertex = False
 
     def description(self):
         return (self.name, self.kind, self.domain, self.type, self.components)
@@ -2082,6 +2086,13 @@ def predictor_allowed(h, pr):
     return False
 
 
+def as_vertex(h):
+    """The header a corner attribute coded per vertex is decoded with (§8.12)."""
+    c = copy.copy(h)
+    c.domain = 0
+    return c
+
+
 def decode_attributes(payload, faces, glob, q, segmented=False):
     """§8.12 for one part. faces: the part's faces (part-local ids); glob: per part
     vertex NONE (own) or a reference; q: the own vertices' grid indices;
@@ -2108,7 +2119,12 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
         t = pr & 0x08 != 0                                   # §8.12.1: table-coded residuals
         if t:
             pr &= ~0x08
-        if not predictor_allowed(h, pr):
+        h.per_vertex = pr & 0x10 != 0                        # §8.12: a corner attribute coded per vertex
+        if h.per_vertex:
+            if h.domain != 2 or segmented:
+                reject('attributes: per-vertex coding of an attribute that is not a corner attribute of a whole mesh')
+            pr &= ~0x10
+        if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
         tabled.append(t)
@@ -2131,9 +2147,11 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
         m.last_import = 0
         if tabled[i]:                                        # §8.12.1: this attribute's contexts
             m.table = (tables, bits, 24 * i)
-        walk = AttrWalk(h, pr, faces, rank, q, around)
+        walk = AttrWalk(as_vertex(h) if h.per_vertex else h, pr, faces, rank, q, around)
         indices = alias = None
-        if h.domain == 0:                                    # vertex: own vertices in output order
+        if h.per_vertex:                                     # each corner uses its vertex's value
+            indices = [rank[c] for f in faces for c in f]
+        if h.domain == 0 or h.per_vertex:                    # vertex: own vertices in output order
             for r in range(own):
                 x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
                 if pr == 2:                                  # faces this vertex completes: sigma
@@ -2344,7 +2362,9 @@ def decode_part(streams, counts, bits, earlier, trace):
     for w in range(vc):
         out_q[walk_out[w]] = q[walk_point[w]]
     for a in attrs:
-        if a['header'].domain == 0:
+        if a['header'].per_vertex:                           # §8.13: the corners use their output vertices
+            a['indices'] = [walk_out[x] for f in wfaces for x in f]
+        if a['header'].domain == 0 or a['header'].per_vertex:
             for key in ('ints', 'values'):
                 vals = [None] * vc
                 for w in range(vc):

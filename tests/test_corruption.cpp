@@ -858,3 +858,29 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   }
 }
 
+// FORMAT.md §8.12: bit 4 of a predictor byte (coded per vertex) is for
+// corner attributes only.
+TEST(Corruption, PerVertexCodingOfAVertexAttributeRefused) {
+  Mesh m = tsm_test::icosphere(1);
+  tsm::Attribute temp;
+  temp.name = "temp";
+  for (size_t v = 0; v < m.vertex_count(); ++v) temp.values.push_back(0.25f * static_cast<float>(v));
+  m.attributes = {temp};
+  const Container good = parse(encode_ok(m, 12));
+  ASSERT_EQ(guarded_decode(build(good)).status.code(), ErrorCode::ok);
+  size_t at = good.sections.size();
+  for (size_t i = 0; i < good.sections.size(); ++i)
+    if (good.sections[i].id == 10) at = i;
+  ASSERT_LT(at, good.sections.size()) << "no mesh section";
+  ASSERT_EQ(good.sections[at].codec, 0);
+  // Header: name, kind, domain, type, components, quant, bits, origin (f32), extent (f64); then the predictor byte.
+  const size_t t_at = good.sections[at].stored.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
+  ASSERT_NE(t_at, std::string::npos) << "temp header not found";
+  Container c = good;
+  c.sections[at].stored[t_at + 23] = static_cast<char>(c.sections[at].stored[t_at + 23] | 0x10);
+  const DecodeResult r = guarded_decode(build(c));
+  expect_clean(r, "per-vertex bit on a vertex attribute");
+  EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << describe(r);
+  EXPECT_TRUE(tsm_test::contains(r.status.message(), "is coded per vertex but is not a corner attribute"))
+      << describe(r);
+}

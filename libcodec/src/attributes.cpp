@@ -37,6 +37,18 @@ constexpr int kMaxAttributes = 64;
 // prefix codes, one per residual model res[cls][c][z], at context
 // 24 i + 8 cls + 2 c + z of attribute i (bit 3 of its predictor byte).
 constexpr uint8_t kAttributeTableFlag = 0x08;
+// Predictor bit 4: a corner attribute coded as a vertex attribute, one value
+// per own vertex, each corner using its vertex's value (an OBJ/PLY export of
+// per-vertex values keeps one list entry per vertex).
+constexpr uint8_t kAttributePerVertexFlag = 0x10;
+
+// The header an attribute is coded with: a corner attribute coded per vertex
+// as a vertex attribute.
+AttributeHeader coded_header(const AttributeHeader& h, bool per_vertex) {
+  AttributeHeader c = h;
+  if (per_vertex) c.domain = AttributeDomain::vertex;
+  return c;
+}
 constexpr int kAttributeTableContexts = 24;  // per attribute
 int table_context(int cls, uint32_t c, int zero) { return 8 * cls + 2 * static_cast<int>(c) + zero; }
 
@@ -840,12 +852,13 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   std::vector<uint8_t> ghas;
   VertexFaces around;
   bool need_around = false;
-  for (const AttributeHeader& h : headers) need_around = need_around || predictors_for(h) & 4;
+  for (size_t i = 0; i < headers.size(); ++i)
+    need_around = need_around || predictors_for(coded_header(headers[i], in.per_vertex >> i & 1)) & 4;
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
   auto code = [&](Enc& enc, size_t i, int predictor) {
-    const AttributeHeader& h = headers[i];
+    const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
     ValueCoder<Enc> vc{enc, {}};
@@ -896,7 +909,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   std::vector<CodeLengths> table_lengths;  // every attribute's contexts once one has tables
   if (in.own_values) in.own_values->assign(headers.size(), {});
   for (size_t i = 0; i < headers.size(); ++i) {
-    const AttributeHeader& h = headers[i];
+    const bool per_vertex = in.per_vertex >> i & 1;
+    const AttributeHeader h = coded_header(headers[i], per_vertex);
     if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
     const unsigned choices = predictors_for(h);
     int predictor = 0;
@@ -933,7 +947,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
         tables = trial.e.finish().size() + residuals.tables.coded_bytes() <= best + best / 8;
       }
     }
-    w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0)));
+    w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
+                              (per_vertex ? kAttributePerVertexFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -965,6 +980,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
+  uint64_t per_vertex = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -972,9 +988,17 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       tabled[i] = 1;
       p = static_cast<uint8_t>(p & ~kAttributeTableFlag);
     }
+    if (p & kAttributePerVertexFlag) {
+      if (headers[i].domain != AttributeDomain::corner || in.segmented)
+        return corrupt("'" + headers[i].name + "' is coded per vertex but is not a corner attribute of a whole mesh");
+      per_vertex |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributePerVertexFlag);
+      headers[i] = coded_header(headers[i], true);
+    }
     if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
+  if (in.per_vertex) *in.per_vertex = per_vertex;
   // §8.12.1: with a table-coded attribute, the bit stream's
   // length, the tables of every attribute's contexts, the bit stream.
   Dec dec;
@@ -1015,13 +1039,17 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     Attribute a;
     a.name = h.name;
     a.kind = h.kind;
-    a.domain = h.domain;
+    a.domain = per_vertex >> i & 1 ? AttributeDomain::corner : h.domain;
     a.type = h.type;
     a.components = h.components;
     std::vector<int32_t> x;
     if (h.domain == AttributeDomain::vertex) {
       x.assign(n * static_cast<size_t>(own), 0);
       if (!walk.vertices(predictor[i], x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (per_vertex >> i & 1) {  // each corner uses its vertex's value
+        a.indices.resize(faces.indices.size());
+        for (size_t k = 0; k < faces.indices.size(); ++k) a.indices[k] = rank[faces.indices[k]];
+      }
     } else if (h.domain == AttributeDomain::face) {
       x.assign(n * faces.face_count(), 0);
       if (!walk.face_values(x)) return corrupt("face values of '" + h.name + "' out of range");
@@ -1041,7 +1069,10 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (dec.d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("stream is truncated");
     if (dec.bad_code) return corrupt("a residual of '" + h.name + "' is a code word no table has");
     if (dec.bits.overrun()) return corrupt("the table-coded bit stream is truncated");
-    if (in.costs) in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
+    if (in.costs) {
+      in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
+      in.costs->back().header.domain = a.domain;
+    }
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));
     for (size_t j = 0; j < x.size() / n; ++j) from_ints(h, &x[n * j], &a.values[h.components * j]);
     out.push_back(std::move(a));
