@@ -1694,6 +1694,7 @@ class AttrHeader:
     per_vertex: a corner attribute coded per vertex (its predictor byte's bit 4)."""
 
     per_vertex = False
+    recent = False
 
     def description(self):
         return (self.name, self.kind, self.domain, self.type, self.components)
@@ -1838,6 +1839,8 @@ class AttrModels:
         self.unused = UIntModel(2)
         self.imported = [UIntModel(2), UIntModel(2)]     # [the corner's vertex is a reference]
         self.import_id = SIntModel(4)
+        self.recent_hit = [UIntModel(2), UIntModel(2)]   # [the previous vertex's value was a hit]
+        self.recent_index = UIntModel(2)
         self.last_zero = [1, 1, 1, 1]
         self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
@@ -2124,6 +2127,11 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             if h.domain != 2 or segmented:
                 reject('attributes: per-vertex coding of an attribute that is not a corner attribute of a whole mesh')
             pr &= ~0x10
+        h.recent = pr & 0x20 != 0                            # §8.12: recent values (vertex values only)
+        if h.recent:
+            if h.domain != 0 and not h.per_vertex:
+                reject('attributes: %r names recent values but is not coded per vertex' % h.name)
+            pr &= ~0x20
         if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
@@ -2152,8 +2160,28 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
         if h.per_vertex:                                     # each corner uses its vertex's value
             indices = [rank[c] for f in faces for c in f]
         if h.domain == 0 or h.per_vertex:                    # vertex: own vertices in output order
+            recent, hit_before = [], 0
             for r in range(own):
-                x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
+                if h.recent:                                 # a recent value, or decoded as usual
+                    hit = m.recent_hit[hit_before].decode(d)
+                    if hit > 1:
+                        reject('attributes: vertex values of %r out of range' % h.name)
+                    if hit == 1:
+                        j = m.recent_index.decode(d)
+                        if j >= len(recent):
+                            reject('attributes: vertex values of %r out of range' % h.name)
+                        x = list(recent[j])
+                        walk.prev = x
+                        walk.values.append(x)
+                    else:
+                        x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
+                    hit_before = hit
+                    if x in recent:
+                        recent.remove(x)
+                    recent.insert(0, list(x))
+                    del recent[64:]
+                else:
+                    x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
                 if pr == 2:                                  # faces this vertex completes: sigma
                     for f, _ in around[own_vertex[r]]:
                         fa = faces[f]

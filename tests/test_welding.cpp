@@ -265,6 +265,31 @@ TEST(Welding, PerVertexCornerAttributes) {
   }
 }
 
+// Values from a small palette in no order the predictors follow (a CAD
+// part's axis normals, skin joints): named among the recent values
+// (FORMAT.md §8.12, predictor bit 5) they cost about their index, where the
+// previous-value prediction costs a residual of the palette's spread.
+TEST(RecentValues, PaletteCostsItsIndex) {
+  Mesh m = icosphere(3);
+  Attribute t = vertex_attribute("temperature", AttributeKind::generic, 1);
+  std::mt19937 rng(36);
+  const float palette[5] = {-40.0f, 3.0f, 17.5f, 80.0f, 1000.0f};
+  for (size_t v = 0; v < m.vertex_count(); ++v) t.values.push_back(palette[rng() % 5]);
+  m.attributes = {t};
+  const size_t bytes = expect_exact(m, "palette").size();
+  const size_t attribute_bits = 8 * (bytes - size_without_attributes(m));
+  // log2(5) = 2.3 bits a vertex, the hit flags and the header (without the
+  // recent values: 11.7 bits a vertex).
+  EXPECT_LT(attribute_bits, 7 * m.vertex_count() / 2);
+  // Normals likewise, per vertex of a welded mesh through corner values.
+  Mesh f = flat_shaded(icosphere(2));
+  for (size_t k = 0; k < f.attributes[0].values.size(); k += 3) {
+    const uint32_t axis = static_cast<uint32_t>(rng() % 3);
+    for (uint32_t c = 0; c < 3; ++c) f.attributes[0].values[k + c] = c == axis ? 1.0f : 0.0f;
+  }
+  expect_exact(per_vertex_corners(f, true), "axis normals, corner values one per vertex");
+}
+
 // Every glTF asset of the corpus: exact, canonical (through the library's
 // Mesh, whose vertex order the glTF writer would regroup by primitive).
 TEST(Welding, CorpusAssets) {

@@ -17,6 +17,7 @@
 #include "attributes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -37,6 +38,12 @@ constexpr int kMaxAttributes = 64;
 // prefix codes, one per residual model res[cls][c][z], at context
 // 24 i + 8 cls + 2 c + z of attribute i (bit 3 of its predictor byte).
 constexpr uint8_t kAttributeTableFlag = 0x08;
+// Predictor bit 5: vertex values may name one of the last 64 distinct values
+// (values that repeat across a model, as a CAD part's axis normals do, where
+// the prediction misses them).
+constexpr uint8_t kAttributeRecentFlag = 0x20;
+constexpr size_t kRecentValues = 64;
+
 // Predictor bit 4: a corner attribute coded as a vertex attribute, one value
 // per own vertex, each corner using its vertex's value (an OBJ/PLY export of
 // per-vertex values keeps one list entry per vertex).
@@ -145,6 +152,8 @@ struct Models {
   UIntModel unused;
   UIntModel imported[2];    // [the corner's vertex is a reference]: is a new value one of an earlier segment
   SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
+  UIntModel recent_hit[2];  // [the previous vertex's was one]: the value is one of the recent values
+  UIntModel recent_index;   // which, most recent first
 };
 
 // Residual coding of one value against a prediction; contexts: the
@@ -475,11 +484,15 @@ struct AttributeWalk {
   }
 
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
-  bool vertices(int predictor, std::vector<int32_t>& x) {
+  // With `recent` (predictor bit 5), a value may instead name one of the
+  // last 64 distinct values (the encoder does when the prediction misses it).
+  bool vertices(int predictor, bool recent, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
     int32_t prev[4] = {0, 0, 0, 0};
     int sigma = 1;
     std::vector<const int32_t*> uv;
+    std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
+    uint32_t hit_before = 0;
     for (size_t v = 0; v < rank.size(); ++v) {
       const uint32_t r = rank[v];
       if (r == kNone) continue;
@@ -509,8 +522,13 @@ struct AttributeWalk {
         }
         cls = placed(sum, count, pred);
       }
-      if (!vc.value(h, pred, &x[n * static_cast<size_t>(r)], cls)) return false;
-      std::copy(&x[n * static_cast<size_t>(r)], &x[n * static_cast<size_t>(r)] + n, prev);
+      int32_t* xv = &x[n * static_cast<size_t>(r)];
+      if (!recent) {
+        if (!vc.value(h, pred, xv, cls)) return false;
+      } else if (!recent_value(list, hit_before, pred, cls, xv)) {
+        return false;
+      }
+      std::copy(xv, xv + n, prev);
       if (predictor == 2) {  // faces completed by this vertex give the chart's orientation
         for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
           const uint32_t f = around->face[j], k = faces.face_size(f);
@@ -527,6 +545,38 @@ struct AttributeWalk {
         }
       }
     }
+    return true;
+  }
+  // One vertex value with the recent values: a hit (and which) or the value
+  // coded against `pred`; then the value moves to the front of `list`.
+  bool recent_value(std::vector<std::array<int32_t, 4>>& list, uint32_t& hit_before, const int32_t* pred, int cls,
+                    int32_t* xv) {
+    const uint32_t n = int_components(h);
+    std::array<int32_t, 4> v{};
+    uint32_t hit = 0, j = 0;
+    if constexpr (Coder::kEncoder) {
+      std::copy(xv, xv + n, v.begin());
+      const auto at = std::find(list.begin(), list.end(), v);
+      if (at != list.end() && !std::equal(xv, xv + n, pred)) {
+        hit = 1;
+        j = static_cast<uint32_t>(at - list.begin());
+      }
+    }
+    hit = io.uint(vc.m.recent_hit[hit_before], hit);
+    if (hit > 1) return false;
+    if (hit) {
+      j = io.uint(vc.m.recent_index, j);
+      if (j >= list.size()) return false;
+      std::copy(list[j].begin(), list[j].begin() + n, xv);
+    } else if (!vc.value(h, pred, xv, cls)) {
+      return false;
+    }
+    hit_before = hit;
+    std::copy(xv, xv + n, v.begin());
+    const auto at = std::find(list.begin(), list.end(), v);
+    if (at != list.end()) list.erase(at);
+    list.insert(list.begin(), v);
+    if (list.size() > kRecentValues) list.pop_back();
     return true;
   }
   bool face_values(std::vector<int32_t>& x) {
@@ -857,7 +907,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
-  auto code = [&](Enc& enc, size_t i, int predictor) {
+  auto code = [&](Enc& enc, size_t i, int predictor, bool recent) {
     const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
@@ -868,7 +918,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
         if (rank[v] != kNone) to_ints(h, &a.values[h.components * static_cast<size_t>(order[v])], &x[n * rank[v]]);
-      return walk.vertices(predictor, x);
+      return walk.vertices(predictor, recent, x);
     }
     if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
@@ -916,9 +966,10 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     int predictor = 0;
     size_t best = SIZE_MAX;
     own_values = nullptr;
+    bool recent = false;
     auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
-      if (!code(trial, i, p)) return false;
+      if (!code(trial, i, p, recent)) return false;
       size = trial.e.finish().size();
       return true;
     };
@@ -931,12 +982,21 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
         predictor = p;
       }
     }
+    if (h.domain == AttributeDomain::vertex) {  // the recent values where they pay (predictor bit 5)
+      size_t with = 0;
+      if (best == SIZE_MAX && !adaptive_size(predictor, best))
+        return Status(ErrorCode::internal, "attributes: values out of range");
+      recent = true;
+      if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
+      recent = with < best;
+      best = std::min(best, with);
+    }
     TableResiduals residuals;
     bool tables = false;
     if (in.tables) {
       Enc trial;
       trial.tables = &residuals;
-      if (!code(trial, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+      if (!code(trial, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
       if (residuals.fits) {
         residuals.tables.build();
         if (best == SIZE_MAX && !adaptive_size(predictor, best))
@@ -948,7 +1008,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       }
     }
     w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
-                              (per_vertex ? kAttributePerVertexFlag : 0)));
+                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -957,7 +1017,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       const std::vector<CodeLengths>& lengths = residuals.tables.lengths();
       std::copy(lengths.begin(), lengths.end(), table_lengths.begin() + kAttributeTableContexts * i);
     }
-    if (!code(enc, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+    if (!code(enc, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
     enc.tables = nullptr;
   }
   if (!table_lengths.empty())  // §8.12.1: the bit stream's length, the tables, the bit stream
@@ -980,7 +1040,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
-  uint64_t per_vertex = 0;
+  uint64_t per_vertex = 0, recent = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -994,6 +1054,12 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       per_vertex |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributePerVertexFlag);
       headers[i] = coded_header(headers[i], true);
+    }
+    if (p & kAttributeRecentFlag) {
+      if (headers[i].domain != AttributeDomain::vertex)
+        return corrupt("'" + headers[i].name + "' names recent values but is not coded per vertex");
+      recent |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributeRecentFlag);
     }
     if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
@@ -1045,7 +1111,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     std::vector<int32_t> x;
     if (h.domain == AttributeDomain::vertex) {
       x.assign(n * static_cast<size_t>(own), 0);
-      if (!walk.vertices(predictor[i], x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (!walk.vertices(predictor[i], recent >> i & 1, x)) return corrupt("vertex values of '" + h.name + "' out of range");
       if (per_vertex >> i & 1) {  // each corner uses its vertex's value
         a.indices.resize(faces.indices.size());
         for (size_t k = 0; k < faces.indices.size(); ++k) a.indices[k] = rank[faces.indices[k]];
