@@ -1709,14 +1709,23 @@ class AttrHeader:
         return 0 <= x < (1 << self.bits)
 
 
+COMMON_NAMES = (b'normal', b'texcoord', b'color', b'texcoord0', b'texcoord1', b'TANGENT', b'JOINTS_0',
+                b'WEIGHTS_0', b'_gltf_group', b'_gltf_primitive')     # §8.12: name lengths 1025 + index
+
+
 def read_attribute_header(buf, p):
     end = len(buf)
     h = AttrHeader()
     n, p = read_varint(buf, p, end)
-    if n > 1024 or n > end - p:
-        reject('attributes: truncated attribute header')
-    h.name = bytes(buf[p:p + n])
-    p += n
+    if n > 1024:
+        if n - 1025 >= len(COMMON_NAMES):
+            reject('attributes: bad attribute name length')
+        h.name = COMMON_NAMES[n - 1025]
+    else:
+        if n > end - p:
+            reject('attributes: truncated attribute header')
+        h.name = bytes(buf[p:p + n])
+        p += n
     if end - p < 6:
         reject('attributes: truncated attribute header')
     h.kind, h.domain, h.type, h.components, h.quant, h.bits = buf[p:p + 6]

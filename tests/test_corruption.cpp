@@ -800,7 +800,7 @@ TEST(Corruption, ForgedMetadataRefused) {
 TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   Mesh m = tsm_test::icosphere(1);
   tsm::Attribute color;
-  color.name = "color";
+  color.name = "COLOR";  // not a common name (FORMAT.md §8.12): spelt out in the header
   color.kind = tsm::AttributeKind::color;
   color.type = tsm::AttributeType::u8;
   color.components = 3;
@@ -820,7 +820,7 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   ASSERT_EQ(good.sections[at].codec, 0);
   const std::string& payload = good.sections[at].stored;
   // Header: name, kind, domain, type, components, quant, bits[, origin f32 x components, extent f64].
-  const size_t c_at = payload.find(std::string("\x05" "color\x02\x00\x01\x03\x00", 10));
+  const size_t c_at = payload.find(std::string("\x05" "COLOR\x02\x00\x01\x03\x00", 10));
   const size_t t_at = payload.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
   ASSERT_NE(c_at, std::string::npos) << "colour header not found";
   ASSERT_NE(t_at, std::string::npos) << "temp header not found";

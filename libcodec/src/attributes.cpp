@@ -358,9 +358,24 @@ struct VertexFaces {
   }
 };
 
+// Names the readers give (FORMAT.md §8.12): a header names one of them by
+// its index (name length 1025 + index), two bytes where the name would take
+// up to twelve in a file of a few hundred.
+constexpr const char* kCommonNames[] = {"normal",   "texcoord",  "color",       "texcoord0",      "texcoord1",
+                                        "TANGENT",  "JOINTS_0",  "WEIGHTS_0",   "_gltf_group",    "_gltf_primitive"};
+constexpr uint64_t kCommonNameBase = kMaxAttributeNameBytes + 1;
+constexpr uint64_t kCommonNameCount = sizeof(kCommonNames) / sizeof(kCommonNames[0]);
+
 void write_header(ByteWriter& w, const AttributeHeader& h) {
-  w.varint(h.name.size());
-  w.bytes(h.name);
+  uint64_t common = kCommonNameCount;
+  for (uint64_t k = 0; k < kCommonNameCount; ++k)
+    if (h.name == kCommonNames[k]) common = k;
+  if (common < kCommonNameCount) {
+    w.varint(kCommonNameBase + common);
+  } else {
+    w.varint(h.name.size());
+    w.bytes(h.name);
+  }
   w.u8(static_cast<uint8_t>(h.kind));
   w.u8(static_cast<uint8_t>(h.domain));
   w.u8(static_cast<uint8_t>(h.type));
@@ -377,8 +392,14 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
   uint64_t len = 0;
   std::string_view name;
   uint8_t kind, domain, type, comps, quant, bits;
-  if (!r.varint(len) || len > kMaxAttributeNameBytes || !r.bytes(static_cast<size_t>(len), name) || !r.u8(kind) ||
-      !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
+  if (!r.varint(len)) return corrupt("truncated attribute header");
+  if (len >= kCommonNameBase) {
+    if (len - kCommonNameBase >= kCommonNameCount) return corrupt("bad attribute name length");
+    name = kCommonNames[len - kCommonNameBase];
+  } else if (!r.bytes(static_cast<size_t>(len), name)) {
+    return corrupt("truncated attribute header");
+  }
+  if (!r.u8(kind) || !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
     return corrupt("truncated attribute header");
   h.name.assign(name);
   if (kind > 3 || domain > 2 || type > 3 || comps < 1 || comps > 4 || quant > 2) return corrupt("bad attribute header");
