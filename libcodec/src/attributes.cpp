@@ -573,14 +573,13 @@ struct AttributeWalk {
   bool recent_value(std::vector<std::array<int32_t, 4>>& list, uint32_t& hit_before, const int32_t* pred, int cls,
                     int32_t* xv) {
     const uint32_t n = int_components(h);
-    std::array<int32_t, 4> v{};
+    size_t at = list.size();  // the value's place in the list, if there
     uint32_t hit = 0, j = 0;
     if constexpr (Coder::kEncoder) {
-      std::copy(xv, xv + n, v.begin());
-      const auto at = std::find(list.begin(), list.end(), v);
-      if (at != list.end() && !std::equal(xv, xv + n, pred)) {
+      at = find_recent(list, xv, n);
+      if (at < list.size() && !std::equal(xv, xv + n, pred)) {
         hit = 1;
-        j = static_cast<uint32_t>(at - list.begin());
+        j = static_cast<uint32_t>(at);
       }
     }
     hit = io.uint(vc.m.recent_hit[hit_before], hit);
@@ -589,16 +588,31 @@ struct AttributeWalk {
       j = io.uint(vc.m.recent_index, j);
       if (j >= list.size()) return false;
       std::copy(list[j].begin(), list[j].begin() + n, xv);
-    } else if (!vc.value(h, pred, xv, cls)) {
-      return false;
+      at = j;
+    } else {
+      if (!vc.value(h, pred, xv, cls)) return false;
+      if constexpr (!Coder::kEncoder) at = find_recent(list, xv, n);
     }
     hit_before = hit;
+    std::array<int32_t, 4> v{};
     std::copy(xv, xv + n, v.begin());
-    const auto at = std::find(list.begin(), list.end(), v);
-    if (at != list.end()) list.erase(at);
+    if (at < list.size()) {
+      std::move_backward(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(at),
+                         list.begin() + static_cast<std::ptrdiff_t>(at) + 1);
+      list[0] = v;
+      return true;
+    }
     list.insert(list.begin(), v);
     if (list.size() > kRecentValues) list.pop_back();
     return true;
+  }
+  static size_t find_recent(const std::vector<std::array<int32_t, 4>>& list, const int32_t* x, uint32_t n) {
+    for (size_t k = 0; k < list.size(); ++k) {
+      bool same = true;
+      for (uint32_t c = 0; c < n && same; ++c) same = list[k][c] == x[c];
+      if (same) return k;
+    }
+    return list.size();
   }
   bool face_values(std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
