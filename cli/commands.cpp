@@ -701,6 +701,8 @@ FileResult info_one(const std::string& input) {
   t = strf("%s: tsm format version %u, %s bytes\n", name.c_str(), fi.format_version, thousands(fi.file_bytes).c_str());
   t += strf("  vertices %s, faces %s, corners %s, segments %u\n", thousands(fi.vertex_count).c_str(),
             thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
+  if (fi.welded_points)
+    t += strf("  welded: %s points (positions and connectivity coded on them)\n", thousands(fi.welded_points).c_str());
   t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
   if (fi.attributes.empty())
     t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,

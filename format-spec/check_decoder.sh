@@ -136,6 +136,18 @@ for l in 0 6 9; do acheck flat_l$l "$work/flat.ply" 12 $l; done
 for f in Fox/Fox.gltf CesiumMilkTruck/CesiumMilkTruck.gltf MultiUVTest/MultiUVTest.gltf VertexColorTest/VertexColorTest.gltf; do
   corpus_case acheck "$(basename "$f" .gltf)" "$corpus/assets/$f" 11 6
 done
+# OBJ exports (tsm decode) of welded meshes: per-vertex values as corner
+# attributes, one list entry per vertex (vn, vt), coded per vertex (§8.12
+# predictor bit 4); flat.ply's has a vertex on no face (an unused value)
+if encode flat_src "$work/flat.ply" 12 6 && "$tsm" decode "$work/flat_src.tsm" -o "$work/flat_export.obj" -f --quiet; then
+  for l in 0 6; do acheck flat_obj_l$l "$work/flat_export.obj" 12 $l; done
+else echo "flat_obj: tsm failed"; result flat_obj 1; fi
+for f in Fox/Fox.gltf CesiumMilkTruck/CesiumMilkTruck.gltf; do
+  n=$(basename "$f" .gltf)_obj
+  [ -f "$corpus/assets/$f" ] && encode "${n}_src" "$corpus/assets/$f" 11 6 &&
+    "$tsm" decode "$work/${n}_src.tsm" -o "$work/$n.obj" -f --quiet
+  corpus_case acheck "$n" "$work/$n.obj" 11 6
+done
 # predictor 2 (texture placement): vertex and corner domain, whole and segmented
 acheck uv_vertex "$work/uv_vertex.ply" 12 6
 acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150

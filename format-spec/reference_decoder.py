@@ -26,6 +26,7 @@ Usage:
 
 Exit status: 0 decoded (and equal, with --compare), 1 differs, 2 corrupt/unsupported.
 """
+import copy
 import math
 import struct
 import sys
@@ -1689,7 +1690,11 @@ MAX_ATTRIBUTES = 64
 
 class AttrHeader:
     """One attribute header (§8.12): name (bytes), kind, domain, type, components,
-    quant (0 exact, 1 grid, 2 octahedral), bits, and for quant 1 origin[] and extent."""
+    quant (0 exact, 1 grid, 2 octahedral), bits, and for quant 1 origin[] and extent;
+    per_vertex: a corner attribute coded per vertex (its predictor byte's bit 4)."""
+
+    per_vertex = False
+    recent = False
 
     def description(self):
         return (self.name, self.kind, self.domain, self.type, self.components)
@@ -1704,14 +1709,23 @@ class AttrHeader:
         return 0 <= x < (1 << self.bits)
 
 
+COMMON_NAMES = (b'normal', b'texcoord', b'color', b'texcoord0', b'texcoord1', b'TANGENT', b'JOINTS_0',
+                b'WEIGHTS_0', b'_gltf_group', b'_gltf_primitive')     # §8.12: name lengths 1025 + index
+
+
 def read_attribute_header(buf, p):
     end = len(buf)
     h = AttrHeader()
     n, p = read_varint(buf, p, end)
-    if n > 1024 or n > end - p:
-        reject('attributes: truncated attribute header')
-    h.name = bytes(buf[p:p + n])
-    p += n
+    if n > 1024:
+        if n - 1025 >= len(COMMON_NAMES):
+            reject('attributes: bad attribute name length')
+        h.name = COMMON_NAMES[n - 1025]
+    else:
+        if n > end - p:
+            reject('attributes: truncated attribute header')
+        h.name = bytes(buf[p:p + n])
+        p += n
     if end - p < 6:
         reject('attributes: truncated attribute header')
     h.kind, h.domain, h.type, h.components, h.quant, h.bits = buf[p:p + 6]
@@ -1834,6 +1848,8 @@ class AttrModels:
         self.unused = UIntModel(2)
         self.imported = [UIntModel(2), UIntModel(2)]     # [the corner's vertex is a reference]
         self.import_id = SIntModel(4)
+        self.recent_hit = [UIntModel(2), UIntModel(2)]   # [the previous vertex's value was a hit]
+        self.recent_index = UIntModel(2)
         self.last_zero = [1, 1, 1, 1]
         self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
@@ -2082,6 +2098,13 @@ def predictor_allowed(h, pr):
     return False
 
 
+def as_vertex(h):
+    """The header a corner attribute coded per vertex is decoded with (§8.12)."""
+    c = copy.copy(h)
+    c.domain = 0
+    return c
+
+
 def decode_attributes(payload, faces, glob, q, segmented=False):
     """§8.12 for one part. faces: the part's faces (part-local ids); glob: per part
     vertex NONE (own) or a reference; q: the own vertices' grid indices;
@@ -2108,7 +2131,17 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
         t = pr & 0x08 != 0                                   # §8.12.1: table-coded residuals
         if t:
             pr &= ~0x08
-        if not predictor_allowed(h, pr):
+        h.per_vertex = pr & 0x10 != 0                        # §8.12: a corner attribute coded per vertex
+        if h.per_vertex:
+            if h.domain != 2 or segmented:
+                reject('attributes: per-vertex coding of an attribute that is not a corner attribute of a whole mesh')
+            pr &= ~0x10
+        h.recent = pr & 0x20 != 0                            # §8.12: recent values (vertex values only)
+        if h.recent:
+            if h.domain != 0 and not h.per_vertex:
+                reject('attributes: %r names recent values but is not coded per vertex' % h.name)
+            pr &= ~0x20
+        if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
         tabled.append(t)
@@ -2131,11 +2164,33 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
         m.last_import = 0
         if tabled[i]:                                        # §8.12.1: this attribute's contexts
             m.table = (tables, bits, 24 * i)
-        walk = AttrWalk(h, pr, faces, rank, q, around)
+        walk = AttrWalk(as_vertex(h) if h.per_vertex else h, pr, faces, rank, q, around)
         indices = alias = None
-        if h.domain == 0:                                    # vertex: own vertices in output order
+        if h.per_vertex:                                     # each corner uses its vertex's value
+            indices = [rank[c] for f in faces for c in f]
+        if h.domain == 0 or h.per_vertex:                    # vertex: own vertices in output order
+            recent, hit_before = [], 0
             for r in range(own):
-                x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
+                if h.recent:                                 # a recent value, or decoded as usual
+                    hit = m.recent_hit[hit_before].decode(d)
+                    if hit > 1:
+                        reject('attributes: vertex values of %r out of range' % h.name)
+                    if hit == 1:
+                        j = m.recent_index.decode(d)
+                        if j >= len(recent):
+                            reject('attributes: vertex values of %r out of range' % h.name)
+                        x = list(recent[j])
+                        walk.prev = x
+                        walk.values.append(x)
+                    else:
+                        x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
+                    hit_before = hit
+                    if x in recent:
+                        recent.remove(x)
+                    recent.insert(0, list(x))
+                    del recent[64:]
+                else:
+                    x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
                 if pr == 2:                                  # faces this vertex completes: sigma
                     for f, _ in around[own_vertex[r]]:
                         fa = faces[f]
@@ -2344,7 +2399,9 @@ def decode_part(streams, counts, bits, earlier, trace):
     for w in range(vc):
         out_q[walk_out[w]] = q[walk_point[w]]
     for a in attrs:
-        if a['header'].domain == 0:
+        if a['header'].per_vertex:                           # §8.13: the corners use their output vertices
+            a['indices'] = [walk_out[x] for f in wfaces for x in f]
+        if a['header'].domain == 0 or a['header'].per_vertex:
             for key in ('ints', 'values'):
                 vals = [None] * vc
                 for w in range(vc):

@@ -389,3 +389,25 @@ TEST(Attributes, TextureCoordinatesPredictedFromTheGeometryAreSmall) {
   EXPECT_LT(segmented_bits, 8.0);
   EXPECT_LT(sphere_bits, 9.0);
 }
+
+// FORMAT.md §8.12: the names the readers give are coded by their index in
+// the common names (two bytes), any other name in full; both decode as
+// written.
+TEST(Attributes, CommonNamesTakeTwoBytes) {
+  size_t size[2] = {0, 0};
+  for (int spelt = 0; spelt < 2; ++spelt) {
+    Mesh m = icosphere(1);
+    Attribute a = make(spelt ? "JOINTS_1" : "JOINTS_0", AttributeKind::generic, AttributeDomain::vertex,
+                       AttributeType::u16, 1);
+    a.values.assign(m.vertex_count(), 3.0f);
+    m.attributes = {a};
+    std::string bytes;
+    ASSERT_TRUE(encode(m, EncodeOptions{}, bytes).ok());
+    Mesh back;
+    ASSERT_TRUE(decode(bytes, back).ok());
+    ASSERT_EQ(back.attributes.size(), 1u);
+    EXPECT_EQ(back.attributes[0].name, a.name);
+    size[spelt] = bytes.size();
+  }
+  EXPECT_EQ(size[0] + 7, size[1]) << "JOINTS_0 by its index (2 bytes), JOINTS_1 in full (9 bytes)";
+}

@@ -800,7 +800,7 @@ TEST(Corruption, ForgedMetadataRefused) {
 TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   Mesh m = tsm_test::icosphere(1);
   tsm::Attribute color;
-  color.name = "color";
+  color.name = "COLOR";  // not a common name (FORMAT.md §8.12): spelt out in the header
   color.kind = tsm::AttributeKind::color;
   color.type = tsm::AttributeType::u8;
   color.components = 3;
@@ -820,7 +820,7 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   ASSERT_EQ(good.sections[at].codec, 0);
   const std::string& payload = good.sections[at].stored;
   // Header: name, kind, domain, type, components, quant, bits[, origin f32 x components, extent f64].
-  const size_t c_at = payload.find(std::string("\x05" "color\x02\x00\x01\x03\x00", 10));
+  const size_t c_at = payload.find(std::string("\x05" "COLOR\x02\x00\x01\x03\x00", 10));
   const size_t t_at = payload.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
   ASSERT_NE(c_at, std::string::npos) << "colour header not found";
   ASSERT_NE(t_at, std::string::npos) << "temp header not found";
@@ -858,3 +858,29 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   }
 }
 
+// FORMAT.md §8.12: bit 4 of a predictor byte (coded per vertex) is for
+// corner attributes only.
+TEST(Corruption, PerVertexCodingOfAVertexAttributeRefused) {
+  Mesh m = tsm_test::icosphere(1);
+  tsm::Attribute temp;
+  temp.name = "temp";
+  for (size_t v = 0; v < m.vertex_count(); ++v) temp.values.push_back(0.25f * static_cast<float>(v));
+  m.attributes = {temp};
+  const Container good = parse(encode_ok(m, 12));
+  ASSERT_EQ(guarded_decode(build(good)).status.code(), ErrorCode::ok);
+  size_t at = good.sections.size();
+  for (size_t i = 0; i < good.sections.size(); ++i)
+    if (good.sections[i].id == 10) at = i;
+  ASSERT_LT(at, good.sections.size()) << "no mesh section";
+  ASSERT_EQ(good.sections[at].codec, 0);
+  // Header: name, kind, domain, type, components, quant, bits, origin (f32), extent (f64); then the predictor byte.
+  const size_t t_at = good.sections[at].stored.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
+  ASSERT_NE(t_at, std::string::npos) << "temp header not found";
+  Container c = good;
+  c.sections[at].stored[t_at + 23] = static_cast<char>(c.sections[at].stored[t_at + 23] | 0x10);
+  const DecodeResult r = guarded_decode(build(c));
+  expect_clean(r, "per-vertex bit on a vertex attribute");
+  EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << describe(r);
+  EXPECT_TRUE(tsm_test::contains(r.status.message(), "is coded per vertex but is not a corner attribute"))
+      << describe(r);
+}

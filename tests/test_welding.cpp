@@ -218,6 +218,78 @@ TEST(Welding, PositionsOnlyMeshesAreNotWelded) {
   EXPECT_TRUE(compare_meshes(m, back, eo.quantization_bits).equal);
 }
 
+namespace {
+
+// The vertex attributes of `m` as corner attributes with one value per
+// vertex (as an OBJ or PLY export has them), the values in vertex order or
+// in reverse.
+Mesh per_vertex_corners(Mesh m, bool reverse) {
+  const uint32_t V = static_cast<uint32_t>(m.vertex_count());
+  for (Attribute& a : m.attributes) {
+    std::vector<float> values;
+    for (uint32_t i = 0; i < V; ++i) {
+      const uint32_t v = reverse ? V - 1 - i : i;
+      values.insert(values.end(), &a.values[size_t{a.components} * v], &a.values[size_t{a.components} * (v + 1)]);
+    }
+    a.values = values;
+    a.domain = AttributeDomain::corner;
+    a.indices.clear();
+    for (uint32_t x : m.indices) a.indices.push_back(reverse ? V - 1 - x : x);
+  }
+  return m;
+}
+
+}  // namespace
+
+// An OBJ export of a flat-shaded or seamed mesh: vn/vt one per vertex, each
+// corner using its vertex's. Coded per vertex (FORMAT.md §8.12, predictor
+// bit 4): the split vertices that repeat a value are copies, so the file is
+// the size of the same mesh with vertex attributes.
+TEST(Welding, PerVertexCornerAttributes) {
+  for (const auto& [name, m] : {std::pair<std::string, Mesh>{"flat sphere", flat_shaded(icosphere(2))},
+                                {"uv seam sphere", uv_seam_sphere(3)}}) {
+    const std::string as_vertex = expect_exact(m, name);
+    // (The seam sphere has vertices on no face, whose values are unused
+    // ones: in reverse order they pair with those vertices otherwise.)
+    EXPECT_EQ(expect_exact(per_vertex_corners(m, false), name + " (corner)").size(), as_vertex.size()) << name;
+    const Mesh c = per_vertex_corners(m, true);
+    expect_exact(c, name + " (corner, reversed)");
+    Mesh lone = c;  // a vertex on no face: its value is one no corner uses
+    lone.add_vertex(0.25f, 0.5f, 0.75f);
+    for (Attribute& a : lone.attributes)
+      for (uint32_t k = 0; k < a.components; ++k) a.values.push_back(k == 0 ? 1.0f : 0.0f);
+    expect_exact(lone, name + " (corner, a vertex on no face)");
+    Mesh shared = c;  // two vertices using one value: corner coding
+    shared.attributes[0].indices[0] = shared.attributes[0].indices[1];
+    expect_exact(shared, name + " (corner, shared)");
+  }
+}
+
+// Values from a small palette in no order the predictors follow (a CAD
+// part's axis normals, skin joints): named among the recent values
+// (FORMAT.md §8.12, predictor bit 5) they cost about their index, where the
+// previous-value prediction costs a residual of the palette's spread.
+TEST(RecentValues, PaletteCostsItsIndex) {
+  Mesh m = icosphere(3);
+  Attribute t = vertex_attribute("temperature", AttributeKind::generic, 1);
+  std::mt19937 rng(36);
+  const float palette[5] = {-40.0f, 3.0f, 17.5f, 80.0f, 1000.0f};
+  for (size_t v = 0; v < m.vertex_count(); ++v) t.values.push_back(palette[rng() % 5]);
+  m.attributes = {t};
+  const size_t bytes = expect_exact(m, "palette").size();
+  const size_t attribute_bits = 8 * (bytes - size_without_attributes(m));
+  // log2(5) = 2.3 bits a vertex, the hit flags and the header (without the
+  // recent values: 11.7 bits a vertex).
+  EXPECT_LT(attribute_bits, 7 * m.vertex_count() / 2);
+  // Normals likewise, per vertex of a welded mesh through corner values.
+  Mesh f = flat_shaded(icosphere(2));
+  for (size_t k = 0; k < f.attributes[0].values.size(); k += 3) {
+    const uint32_t axis = static_cast<uint32_t>(rng() % 3);
+    for (uint32_t c = 0; c < 3; ++c) f.attributes[0].values[k + c] = c == axis ? 1.0f : 0.0f;
+  }
+  expect_exact(per_vertex_corners(f, true), "axis normals, corner values one per vertex");
+}
+
 // Every glTF asset of the corpus: exact, canonical (through the library's
 // Mesh, whose vertex order the glTF writer would regroup by primitive).
 TEST(Welding, CorpusAssets) {
@@ -231,5 +303,24 @@ TEST(Welding, CorpusAssets) {
     Mesh m;
     ASSERT_TRUE(read_mesh(corpus_file(rel), m).ok()) << rel;
     expect_exact(m, rel, 11);
+  }
+}
+
+// The OBJ route: the assets written as OBJ (vn/vt one per vertex), read
+// back as corner attributes, coded per vertex.
+TEST(Welding, CorpusAssetsThroughObj) {
+  if (!have_corpus()) {
+    if (running_in_ci()) FAIL() << corpus_missing_message();
+    GTEST_SKIP() << corpus_missing_message();
+  }
+  const std::string dir = ::testing::TempDir();
+  for (const char* rel : {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf",
+                          "assets/MultiUVTest/MultiUVTest.gltf", "assets/VertexColorTest/VertexColorTest.gltf"}) {
+    Mesh m, obj;
+    ASSERT_TRUE(read_mesh(corpus_file(rel), m).ok()) << rel;
+    const std::string path = dir + "/welding_" + std::filesystem::path(rel).stem().string() + ".obj";
+    ASSERT_TRUE(write_mesh(path, m).ok()) << rel;
+    ASSERT_TRUE(read_mesh(path, obj).ok()) << rel;
+    expect_exact(obj, std::string(rel) + " via OBJ", 11);
   }
 }

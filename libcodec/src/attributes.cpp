@@ -17,6 +17,7 @@
 #include "attributes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -37,6 +38,24 @@ constexpr int kMaxAttributes = 64;
 // prefix codes, one per residual model res[cls][c][z], at context
 // 24 i + 8 cls + 2 c + z of attribute i (bit 3 of its predictor byte).
 constexpr uint8_t kAttributeTableFlag = 0x08;
+// Predictor bit 5: vertex values may name one of the last 64 distinct values
+// (values that repeat across a model, as a CAD part's axis normals do, where
+// the prediction misses them).
+constexpr uint8_t kAttributeRecentFlag = 0x20;
+constexpr size_t kRecentValues = 64;
+
+// Predictor bit 4: a corner attribute coded as a vertex attribute, one value
+// per own vertex, each corner using its vertex's value (an OBJ/PLY export of
+// per-vertex values keeps one list entry per vertex).
+constexpr uint8_t kAttributePerVertexFlag = 0x10;
+
+// The header an attribute is coded with: a corner attribute coded per vertex
+// as a vertex attribute.
+AttributeHeader coded_header(const AttributeHeader& h, bool per_vertex) {
+  AttributeHeader c = h;
+  if (per_vertex) c.domain = AttributeDomain::vertex;
+  return c;
+}
 constexpr int kAttributeTableContexts = 24;  // per attribute
 int table_context(int cls, uint32_t c, int zero) { return 8 * cls + 2 * static_cast<int>(c) + zero; }
 
@@ -133,6 +152,8 @@ struct Models {
   UIntModel unused;
   UIntModel imported[2];    // [the corner's vertex is a reference]: is a new value one of an earlier segment
   SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
+  UIntModel recent_hit[2];  // [the previous vertex's was one]: the value is one of the recent values
+  UIntModel recent_index;   // which, most recent first
 };
 
 // Residual coding of one value against a prediction; contexts: the
@@ -337,9 +358,24 @@ struct VertexFaces {
   }
 };
 
+// Names the readers give (FORMAT.md §8.12): a header names one of them by
+// its index (name length 1025 + index), two bytes where the name would take
+// up to twelve in a file of a few hundred.
+constexpr const char* kCommonNames[] = {"normal",   "texcoord",  "color",       "texcoord0",      "texcoord1",
+                                        "TANGENT",  "JOINTS_0",  "WEIGHTS_0",   "_gltf_group",    "_gltf_primitive"};
+constexpr uint64_t kCommonNameBase = kMaxAttributeNameBytes + 1;
+constexpr uint64_t kCommonNameCount = sizeof(kCommonNames) / sizeof(kCommonNames[0]);
+
 void write_header(ByteWriter& w, const AttributeHeader& h) {
-  w.varint(h.name.size());
-  w.bytes(h.name);
+  uint64_t common = kCommonNameCount;
+  for (uint64_t k = 0; k < kCommonNameCount; ++k)
+    if (h.name == kCommonNames[k]) common = k;
+  if (common < kCommonNameCount) {
+    w.varint(kCommonNameBase + common);
+  } else {
+    w.varint(h.name.size());
+    w.bytes(h.name);
+  }
   w.u8(static_cast<uint8_t>(h.kind));
   w.u8(static_cast<uint8_t>(h.domain));
   w.u8(static_cast<uint8_t>(h.type));
@@ -356,8 +392,14 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
   uint64_t len = 0;
   std::string_view name;
   uint8_t kind, domain, type, comps, quant, bits;
-  if (!r.varint(len) || len > kMaxAttributeNameBytes || !r.bytes(static_cast<size_t>(len), name) || !r.u8(kind) ||
-      !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
+  if (!r.varint(len)) return corrupt("truncated attribute header");
+  if (len >= kCommonNameBase) {
+    if (len - kCommonNameBase >= kCommonNameCount) return corrupt("bad attribute name length");
+    name = kCommonNames[len - kCommonNameBase];
+  } else if (!r.bytes(static_cast<size_t>(len), name)) {
+    return corrupt("truncated attribute header");
+  }
+  if (!r.u8(kind) || !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
     return corrupt("truncated attribute header");
   h.name.assign(name);
   if (kind > 3 || domain > 2 || type > 3 || comps < 1 || comps > 4 || quant > 2) return corrupt("bad attribute header");
@@ -463,11 +505,15 @@ struct AttributeWalk {
   }
 
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
-  bool vertices(int predictor, std::vector<int32_t>& x) {
+  // With `recent` (predictor bit 5), a value may instead name one of the
+  // last 64 distinct values (the encoder does when the prediction misses it).
+  bool vertices(int predictor, bool recent, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
     int32_t prev[4] = {0, 0, 0, 0};
     int sigma = 1;
     std::vector<const int32_t*> uv;
+    std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
+    uint32_t hit_before = 0;
     for (size_t v = 0; v < rank.size(); ++v) {
       const uint32_t r = rank[v];
       if (r == kNone) continue;
@@ -497,8 +543,13 @@ struct AttributeWalk {
         }
         cls = placed(sum, count, pred);
       }
-      if (!vc.value(h, pred, &x[n * static_cast<size_t>(r)], cls)) return false;
-      std::copy(&x[n * static_cast<size_t>(r)], &x[n * static_cast<size_t>(r)] + n, prev);
+      int32_t* xv = &x[n * static_cast<size_t>(r)];
+      if (!recent) {
+        if (!vc.value(h, pred, xv, cls)) return false;
+      } else if (!recent_value(list, hit_before, pred, cls, xv)) {
+        return false;
+      }
+      std::copy(xv, xv + n, prev);
       if (predictor == 2) {  // faces completed by this vertex give the chart's orientation
         for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
           const uint32_t f = around->face[j], k = faces.face_size(f);
@@ -516,6 +567,52 @@ struct AttributeWalk {
       }
     }
     return true;
+  }
+  // One vertex value with the recent values: a hit (and which) or the value
+  // coded against `pred`; then the value moves to the front of `list`.
+  bool recent_value(std::vector<std::array<int32_t, 4>>& list, uint32_t& hit_before, const int32_t* pred, int cls,
+                    int32_t* xv) {
+    const uint32_t n = int_components(h);
+    size_t at = list.size();  // the value's place in the list, if there
+    uint32_t hit = 0, j = 0;
+    if constexpr (Coder::kEncoder) {
+      at = find_recent(list, xv, n);
+      if (at < list.size() && !std::equal(xv, xv + n, pred)) {
+        hit = 1;
+        j = static_cast<uint32_t>(at);
+      }
+    }
+    hit = io.uint(vc.m.recent_hit[hit_before], hit);
+    if (hit > 1) return false;
+    if (hit) {
+      j = io.uint(vc.m.recent_index, j);
+      if (j >= list.size()) return false;
+      std::copy(list[j].begin(), list[j].begin() + n, xv);
+      at = j;
+    } else {
+      if (!vc.value(h, pred, xv, cls)) return false;
+      if constexpr (!Coder::kEncoder) at = find_recent(list, xv, n);
+    }
+    hit_before = hit;
+    std::array<int32_t, 4> v{};
+    std::copy(xv, xv + n, v.begin());
+    if (at < list.size()) {
+      std::move_backward(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(at),
+                         list.begin() + static_cast<std::ptrdiff_t>(at) + 1);
+      list[0] = v;
+      return true;
+    }
+    list.insert(list.begin(), v);
+    if (list.size() > kRecentValues) list.pop_back();
+    return true;
+  }
+  static size_t find_recent(const std::vector<std::array<int32_t, 4>>& list, const int32_t* x, uint32_t n) {
+    for (size_t k = 0; k < list.size(); ++k) {
+      bool same = true;
+      for (uint32_t c = 0; c < n && same; ++c) same = list[k][c] == x[c];
+      if (same) return k;
+    }
+    return list.size();
   }
   bool face_values(std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
@@ -840,12 +937,13 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   std::vector<uint8_t> ghas;
   VertexFaces around;
   bool need_around = false;
-  for (const AttributeHeader& h : headers) need_around = need_around || predictors_for(h) & 4;
+  for (size_t i = 0; i < headers.size(); ++i)
+    need_around = need_around || predictors_for(coded_header(headers[i], in.per_vertex >> i & 1)) & 4;
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
-  auto code = [&](Enc& enc, size_t i, int predictor) {
-    const AttributeHeader& h = headers[i];
+  auto code = [&](Enc& enc, size_t i, int predictor, bool recent) {
+    const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
     ValueCoder<Enc> vc{enc, {}};
@@ -855,7 +953,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
         if (rank[v] != kNone) to_ints(h, &a.values[h.components * static_cast<size_t>(order[v])], &x[n * rank[v]]);
-      return walk.vertices(predictor, x);
+      return walk.vertices(predictor, recent, x);
     }
     if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
@@ -896,15 +994,17 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   std::vector<CodeLengths> table_lengths;  // every attribute's contexts once one has tables
   if (in.own_values) in.own_values->assign(headers.size(), {});
   for (size_t i = 0; i < headers.size(); ++i) {
-    const AttributeHeader& h = headers[i];
+    const bool per_vertex = in.per_vertex >> i & 1;
+    const AttributeHeader h = coded_header(headers[i], per_vertex);
     if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
     const unsigned choices = predictors_for(h);
     int predictor = 0;
     size_t best = SIZE_MAX;
     own_values = nullptr;
+    bool recent = false;
     auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
-      if (!code(trial, i, p)) return false;
+      if (!code(trial, i, p, recent)) return false;
       size = trial.e.finish().size();
       return true;
     };
@@ -917,12 +1017,21 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
         predictor = p;
       }
     }
+    if (h.domain == AttributeDomain::vertex) {  // the recent values where they pay (predictor bit 5)
+      size_t with = 0;
+      if (best == SIZE_MAX && !adaptive_size(predictor, best))
+        return Status(ErrorCode::internal, "attributes: values out of range");
+      recent = true;
+      if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
+      recent = with < best;
+      best = std::min(best, with);
+    }
     TableResiduals residuals;
     bool tables = false;
     if (in.tables) {
       Enc trial;
       trial.tables = &residuals;
-      if (!code(trial, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+      if (!code(trial, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
       if (residuals.fits) {
         residuals.tables.build();
         if (best == SIZE_MAX && !adaptive_size(predictor, best))
@@ -933,7 +1042,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
         tables = trial.e.finish().size() + residuals.tables.coded_bytes() <= best + best / 8;
       }
     }
-    w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0)));
+    w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
+                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -942,7 +1052,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       const std::vector<CodeLengths>& lengths = residuals.tables.lengths();
       std::copy(lengths.begin(), lengths.end(), table_lengths.begin() + kAttributeTableContexts * i);
     }
-    if (!code(enc, i, predictor)) return Status(ErrorCode::internal, "attributes: values out of range");
+    if (!code(enc, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
     enc.tables = nullptr;
   }
   if (!table_lengths.empty())  // §8.12.1: the bit stream's length, the tables, the bit stream
@@ -965,6 +1075,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
+  uint64_t per_vertex = 0, recent = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -972,9 +1083,23 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       tabled[i] = 1;
       p = static_cast<uint8_t>(p & ~kAttributeTableFlag);
     }
+    if (p & kAttributePerVertexFlag) {
+      if (headers[i].domain != AttributeDomain::corner || in.segmented)
+        return corrupt("'" + headers[i].name + "' is coded per vertex but is not a corner attribute of a whole mesh");
+      per_vertex |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributePerVertexFlag);
+      headers[i] = coded_header(headers[i], true);
+    }
+    if (p & kAttributeRecentFlag) {
+      if (headers[i].domain != AttributeDomain::vertex)
+        return corrupt("'" + headers[i].name + "' names recent values but is not coded per vertex");
+      recent |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributeRecentFlag);
+    }
     if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
+  if (in.per_vertex) *in.per_vertex = per_vertex;
   // §8.12.1: with a table-coded attribute, the bit stream's
   // length, the tables of every attribute's contexts, the bit stream.
   Dec dec;
@@ -1015,13 +1140,17 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     Attribute a;
     a.name = h.name;
     a.kind = h.kind;
-    a.domain = h.domain;
+    a.domain = per_vertex >> i & 1 ? AttributeDomain::corner : h.domain;
     a.type = h.type;
     a.components = h.components;
     std::vector<int32_t> x;
     if (h.domain == AttributeDomain::vertex) {
       x.assign(n * static_cast<size_t>(own), 0);
-      if (!walk.vertices(predictor[i], x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (!walk.vertices(predictor[i], recent >> i & 1, x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (per_vertex >> i & 1) {  // each corner uses its vertex's value
+        a.indices.resize(faces.indices.size());
+        for (size_t k = 0; k < faces.indices.size(); ++k) a.indices[k] = rank[faces.indices[k]];
+      }
     } else if (h.domain == AttributeDomain::face) {
       x.assign(n * faces.face_count(), 0);
       if (!walk.face_values(x)) return corrupt("face values of '" + h.name + "' out of range");
@@ -1041,7 +1170,10 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (dec.d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("stream is truncated");
     if (dec.bad_code) return corrupt("a residual of '" + h.name + "' is a code word no table has");
     if (dec.bits.overrun()) return corrupt("the table-coded bit stream is truncated");
-    if (in.costs) in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
+    if (in.costs) {
+      in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
+      in.costs->back().header.domain = a.domain;
+    }
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));
     for (size_t j = 0; j < x.size() / n; ++j) from_ints(h, &x[n * j], &a.values[h.components * j]);
     out.push_back(std::move(a));

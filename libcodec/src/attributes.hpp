@@ -60,6 +60,10 @@ struct AttributeInput {
   // The fast levels: residuals through static prefix codes where
   // they cost at most 9/8 of the adaptive models (FORMAT.md §8.12.1).
   bool tables = false;
+  // Bit i: corner attribute i has one value per vertex, every corner using
+  // its vertex's (FORMAT.md §8.12, predictor bit 4): `part` then holds it as
+  // a vertex attribute's values (no indices) and it is coded as one.
+  uint64_t per_vertex = 0;
 };
 Status encode_attributes(const std::vector<AttributeHeader>& headers, const AttributeInput& in, std::string& out);
 
@@ -87,6 +91,7 @@ struct AttributePart {
   uint32_t* table_coded = nullptr;                 // out (optional): attributes with table-coded residuals
   std::vector<AttributeCost>* costs = nullptr;     // out (optional): what each attribute cost, in file order
   uint64_t* header_bytes = nullptr;                // out (optional): bytes before the coded values
+  uint64_t* per_vertex = nullptr;                  // out (optional): bit i, corner attribute i coded per vertex
 };
 // `alias` (optional) gets per attribute, per value of the part's value list,
 // the id in the file's value list of an earlier segment's value it stands

@@ -108,6 +108,7 @@ struct DecodedPart {
   uint32_t table_coded_attributes = 0;  // attributes whose residuals are table-coded
   std::vector<AttributeCost> attribute_costs;  // filled for inspect() only
   std::vector<uint32_t> split_q, split_corners;  // welded: per output vertex, per corner (walk ids)
+  uint64_t per_vertex = 0;                       // bit i: corner attribute i coded per vertex (§8.12)
   bool want_costs = false;
   Status status;
 };
@@ -154,7 +155,8 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
 }
 
 // After a welded part's attributes: the output vertices (positions, the
-// faces' corners, every vertex attribute's values from its original's).
+// faces' corners, every vertex attribute's values from its original's, a
+// corner attribute coded per vertex likewise, each corner using its vertex's).
 void to_output(const std::vector<uint32_t>& walk_out, const std::vector<uint32_t>& walk_orig,
                const std::vector<uint32_t>& list, DecodedPart& out) {
   const size_t n = walk_out.size();
@@ -164,8 +166,11 @@ void to_output(const std::vector<uint32_t>& walk_out, const std::vector<uint32_t
   out.global.assign(n, kNone);
   out.faces.indices = std::move(out.split_corners);
   for (uint32_t& x : out.faces.indices) x = walk_out[x];
-  for (Attribute& at : out.faces.attributes) {
-    if (at.domain != AttributeDomain::vertex) continue;
+  for (size_t i = 0; i < out.faces.attributes.size(); ++i) {
+    Attribute& at = out.faces.attributes[i];
+    const bool per_vertex = out.per_vertex >> i & 1;
+    if (per_vertex) at.indices = out.faces.indices;
+    if (at.domain != AttributeDomain::vertex && !per_vertex) continue;
     const size_t k = at.components;
     if (at.values.size() != k * list.size()) continue;
     std::vector<float> values(k * n);
@@ -210,6 +215,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.segmented = s.segmented;
   ap.table_coded = &out.table_coded_attributes;
   if (out.want_costs) ap.costs = &out.attribute_costs;
+  ap.per_vertex = &out.per_vertex;
   TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
   if (out.cstats.welded) to_output(walk_out, walk_orig, list, out);
   return Status::Ok();

@@ -53,8 +53,10 @@ struct EncodedPart {
 // `own_values`: see AttributeInput; null for a whole mesh).
 Status encode_part_attributes(const Mesh& part, const std::vector<AttributeHeader>& headers,
                               const std::vector<std::vector<uint32_t>>* imported,
-                              std::vector<std::vector<uint32_t>>* own_values, bool tables, EncodedPart& p) {
+                              std::vector<std::vector<uint32_t>>* own_values, bool tables, EncodedPart& p,
+                              uint64_t per_vertex = 0) {
   AttributeInput ai;
+  ai.per_vertex = per_vertex;
   ai.part = &part;
   ai.order = &p.order;
   ai.is_ref = &p.ref_out;
@@ -742,20 +744,24 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   for (uint32_t o = 0; o < np; ++o)
     for (int a = 0; a < 3; ++a) q_out[3 * size_t{o} + a] = qw[3 * size_t{pw.order[o]} + a];
   // Value classes: vertices of one point whose vertex attributes are equal
-  // on their grids (a copy is coded as such, its values not again). Not
-  // with corner attributes, whose coding follows the vertices' sharing of
-  // corner values (on the originals alone they would cost more: the
-  // corpus's OBJ exports nearly twice).
+  // on their grids (a copy is coded as such, its values not again). Corner
+  // attributes with one value per vertex are coded as vertex attributes
+  // (§8.12, predictor bit 4) and take part; with other corner attributes,
+  // whose coding follows the vertices' sharing of corner values, there are
+  // no copies (on the originals alone those would cost more: the corpus's
+  // OBJ exports nearly twice).
   std::vector<uint32_t> value_class(V);
   std::iota(value_class.begin(), value_class.end(), 0u);
-  const bool corner_attributes = std::any_of(headers.begin(), headers.end(), [](const AttributeHeader& h) {
-    return h.domain == AttributeDomain::corner;
-  });
+  const uint64_t per_vertex = per_vertex_corner_attributes(mesh);
+  const Mesh on_vertices = corner_attributes_on_vertices(mesh, per_vertex);
+  bool corner_attributes = false;
+  for (size_t i = 0; i < headers.size(); ++i)
+    corner_attributes = corner_attributes || (headers[i].domain == AttributeDomain::corner && !(per_vertex >> i & 1));
   if (!corner_attributes) {
     std::vector<std::vector<int32_t>> key(V);
     for (size_t i = 0; i < headers.size(); ++i) {
-      if (headers[i].domain != AttributeDomain::vertex) continue;
-      const Attribute& at = mesh.attributes[i];
+      if (on_vertices.attributes[i].domain != AttributeDomain::vertex) continue;
+      const Attribute& at = on_vertices.attributes[i];
       std::vector<int32_t> k(attribute_key_size(headers[i]));
       for (uint32_t v = 0; v < V; ++v) {
         attribute_key(headers[i], &at.values[size_t{at.components} * v], k.data());
@@ -784,7 +790,7 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   // whichever is smaller; the corners name the originals.
   // The input with every corner on its vertex's original (what the
   // attribute coder matches the decoded faces against).
-  Mesh on_originals = mesh;
+  Mesh on_originals = on_vertices;
   {
     std::vector<uint32_t> walk_of(V);
     for (uint32_t w = 0; w < V; ++w) walk_of[walk_input[w]] = w;
@@ -810,7 +816,7 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
       for (int a = 0; a < 3; ++a) e.q[3 * size_t{k} + a] = qin[3 * size_t{e.order[k]} + a];
     }
     TSM_RETURN_IF_ERROR(
-        encode_part_attributes(on_originals, headers, nullptr, nullptr, attribute_tables(options), e));
+        encode_part_attributes(on_originals, headers, nullptr, nullptr, attribute_tables(options), e, per_vertex));
   }
   const bool point_order = by_point.attributes.size() < by_walk.attributes.size();
   EncodedPart& best = point_order ? by_point : by_walk;

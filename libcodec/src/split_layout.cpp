@@ -289,4 +289,55 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
   return Status::Ok();
 }
 
+uint64_t per_vertex_corner_attributes(const Mesh& mesh) {
+  const size_t V = mesh.vertex_count();
+  uint64_t mask = 0;
+  for (size_t i = 0; i < mesh.attributes.size() && i < 64; ++i) {
+    const Attribute& a = mesh.attributes[i];
+    if (a.domain != AttributeDomain::corner || a.value_count() != V) continue;
+    std::vector<uint32_t> value(V, kNoVertex);
+    std::vector<uint8_t> taken(V, 0);
+    bool ok = a.indices.size() == mesh.indices.size();
+    for (size_t k = 0; k < mesh.indices.size() && ok; ++k) {
+      const uint32_t v = mesh.indices[k], x = a.indices[k];
+      if (value[v] == kNoVertex) {
+        ok = !taken[x];
+        value[v] = x;
+        taken[x] = 1;
+      } else {
+        ok = value[v] == x;
+      }
+    }
+    if (ok) mask |= uint64_t{1} << i;
+  }
+  return mask;
+}
+
+Mesh corner_attributes_on_vertices(const Mesh& mesh, uint64_t mask) {
+  Mesh m = mesh;
+  for (size_t i = 0; i < m.attributes.size() && i < 64; ++i) {
+    if (!(mask >> i & 1)) continue;
+    Attribute& a = m.attributes[i];
+    const Attribute& from = mesh.attributes[i];
+    const size_t n = from.components, V = mesh.vertex_count();
+    std::vector<uint32_t> value(V, kNoVertex);
+    std::vector<uint8_t> taken(V, 0);
+    for (size_t k = 0; k < mesh.indices.size(); ++k) {
+      value[mesh.indices[k]] = from.indices[k];
+      taken[from.indices[k]] = 1;
+    }
+    uint32_t unused = 0;  // vertices on no face take the values no corner uses, in order
+    for (size_t v = 0; v < V; ++v) {
+      if (value[v] == kNoVertex) {
+        while (taken[unused]) ++unused;
+        value[v] = unused++;
+      }
+      std::copy_n(&from.values[n * value[v]], n, &a.values[n * v]);
+    }
+    a.domain = AttributeDomain::vertex;
+    a.indices.clear();
+  }
+  return m;
+}
+
 }  // namespace tsm

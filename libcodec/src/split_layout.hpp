@@ -38,4 +38,17 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
                            const std::vector<uint32_t>& q, Mesh& faces, std::vector<uint32_t>& walk_out,
                            std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig);
 
+// Corner attributes with one value per vertex (FORMAT.md §8.12, predictor
+// bit 4), bit i for attribute i: the attribute has as many values as the
+// mesh has vertices, each corner uses its vertex's value and no two vertices
+// use one (an OBJ or PLY export of per-vertex values). Such an attribute is
+// coded as a vertex attribute, so a vertex copying another's values (§8.13)
+// costs one decision.
+uint64_t per_vertex_corner_attributes(const Mesh& mesh);
+
+// The mesh with each attribute of `mask` turned into a vertex attribute:
+// vertex v gets the value its corners use; the vertices on no face take the
+// values no corner uses, both in order.
+Mesh corner_attributes_on_vertices(const Mesh& mesh, uint64_t mask);
+
 }  // namespace tsm
