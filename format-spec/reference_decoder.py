@@ -1257,6 +1257,89 @@ def table_residual(tables, bits, c, what='geometry'):
     return -mag if (sym - 7) & 1 else mag
 
 
+class RansResiduals:
+    """§8.5.11: the geometry residuals through static frequency tables and two
+    interleaved rANS states; the bits below a symbol in a bit stream of their own."""
+    def __init__(self, rans, raw):
+        if len(rans) < 8:
+            reject('geometry: rANS stream too short')
+        self.x = list(struct.unpack_from('<2I', rans, 0))
+        if min(self.x) < (1 << 16):
+            reject('geometry: rANS state below 2^16')
+        self.s = rans
+        self.pos = 8
+        self.turn = 0
+        self.bits = BitReader(raw, 'geometry')
+        self.tables = {}
+
+    def read_tables(self, d):
+        used, same = probs(1), probs(1)
+        count, top_model = UIntModel(2), UIntModel(2)
+        exponent = [[BitTree(4) for _ in range(13)] for _ in range(13)]
+        above = []
+        for c in range(210):
+            if d.bit(used, 0) == 0:
+                continue
+            if above and d.bit(same, 0) == 1:            # the previous table
+                self.tables[c] = above
+                continue
+            S = count.decode(d) + 1                      # INVALID + 1 is above 231 too
+            top = top_model.decode(d)
+            if S > 231 or top >= S:
+                reject('geometry: residual table symbol count or implied symbol')
+            f = [0] * S
+            prev = 0
+            for s in range(S):
+                if s == top:
+                    continue
+                up = min(above[s].bit_length(), 12) if s < len(above) else 0
+                e = exponent[prev][up].decode(d)
+                if e > 12:
+                    reject('geometry: residual table frequency')
+                if e >= 2:
+                    m = min(e - 1, 2)
+                    f[s] = ((1 << m) | d.direct(m)) << (e - 1 - m)
+                else:
+                    f[s] = e
+                prev = e
+            if sum(f) >= 4096:
+                reject('geometry: residual table frequencies sum above 4095')
+            if d.truncated():
+                reject('geometry: residual tables truncated')
+            f[top] = 4096 - sum(f)
+            self.tables[c] = f
+            above = f
+
+    def residual(self, c):
+        if c not in self.tables:
+            reject('geometry: residual in a context without a table')
+        f = self.tables[c]
+        x = self.x[self.turn]
+        slot = x & 4095
+        s, start = 0, 0
+        while start + f[s] <= slot:
+            start += f[s]
+            s += 1
+        x = f[s] * (x >> 12) + slot - start
+        if x < (1 << 16):
+            if self.pos + 2 > len(self.s):
+                reject('geometry: rANS stream is truncated')
+            x = (x << 16) | self.s[self.pos] | (self.s[self.pos + 1] << 8)
+            self.pos += 2
+        self.x[self.turn] = x
+        self.turn ^= 1
+        if s <= 14:
+            return s - 7
+        m = s - 15
+        n = m // 8 + 4                                   # bit length of |r|
+        mag = ((4 | (m & 3)) << (n - 3)) | self.bits.read(n - 3)
+        return -mag if (m >> 2) & 1 else mag
+
+    def finish(self):
+        if self.x != [1 << 16, 1 << 16]:
+            reject('geometry: rANS states do not end at 2^16')
+
+
 def decode_geometry(payload, layout, qbits, trace=None):
     vc = layout['vertex_count']
     tri, twin, ids, vparent = layout['tri'], layout['twin'], layout['id'], layout['vparent']
@@ -1270,7 +1353,7 @@ def decode_geometry(payload, layout, qbits, trace=None):
     tangent = False
     mix = False
     planes_from_top = False  # bit 4; `top` in code_vertex is the largest residual so far
-    tables = None            # bit 3: the prefix codes of §8.5.11
+    tables = None            # bit 3: the rANS-coded residuals of §8.5.11
     table_flag = False
     if predictor & 0x08:                                            # §8.5.1 bit 3: tables
         predictor &= 0xF7
@@ -1328,7 +1411,15 @@ def decode_geometry(payload, layout, qbits, trace=None):
             reject('geometry: tangent weight range')
         pos += 4
     if table_flag:                                                   # §8.5.11
-        tables, bits, pos = read_tables(payload, pos)
+        streams = []
+        for what in ('residual tables', 'rANS stream', 'residual bit stream'):
+            if len(payload) < pos + 4 or len(payload) < pos + 4 + struct.unpack_from('<I', payload, pos)[0]:
+                reject('geometry: %s cut off' % what)
+            n = struct.unpack_from('<I', payload, pos)[0]
+            streams.append(payload[pos + 4:pos + 4 + n])
+            pos += 4 + n
+        tables = RansResiduals(streams[1], streams[2])
+        tables.read_tables(RangeDecoder(streams[0]))
     d = RangeDecoder(payload[pos:])
     # §8.2 models
     residual = [[[SIntModel(6) for _ in range(14)] for _ in range(5)] for _ in range(3)]
@@ -1406,8 +1497,8 @@ def decode_geometry(payload, layout, qbits, trace=None):
                 if mix:                                      # §8.1.1: two models mixed
                     ctx2 = min(bit_length(top) if i else activity if spread is not None else st['prev_act'], 13)
                     r = decode_mixed_sint(d, residual[i][cls][ctx], residual2[i][cls][ctx2], mixw[i][min(ctx, 7)])
-                elif tables is not None:                     # §8.5.11: the context's prefix code
-                    r = table_residual(tables, bits, (i * 5 + cls) * 14 + ctx)
+                elif tables is not None:                     # §8.5.11: the context's table
+                    r = tables.residual((i * 5 + cls) * 14 + ctx)
                 else:
                     r = residual[i][cls][ctx].decode(d)      # by coding position i (= a without a normal)
                 x = p + r
@@ -1673,6 +1764,8 @@ def decode_geometry(payload, layout, qbits, trace=None):
                 reject('geometry: truncated')
     if d.truncated():                                        # §8.5.9
         reject('geometry: truncated')
+    if tables is not None:
+        tables.finish()
     ginfo = {'predictor': PREDICTOR_NAMES[predictor], 'K': K, 'lambda': lam, 'alpha': alpha,
              'tangent': tangent, 'beta': beta if tangent else None,
              'lattice_planes': [len(l) for l in lattice], 'overrun': d.overrun}

@@ -184,7 +184,7 @@ void for_each_model_coding(std::initializer_list<int> bit_list, F&& f) {
     }
 }
 
-// Table-coded residuals (FORMAT.md §8.5.11): on every predictor with
+// rANS-coded residuals (FORMAT.md §8.5.12): on every predictor with
 // residual models (with and without the tangent step and planes) the
 // positions come back, at 30 bits too (residuals of every bit length);
 // mixing and the raw predictor refuse the flag.
@@ -212,9 +212,10 @@ TEST(Geometry, TableResidualsRoundTripOnEveryFamily) {
   EXPECT_EQ(tsm::decode_geometry(mixed, p.ce.layout, 11, back).code(), tsm::ErrorCode::corrupt_data);
 }
 
-// A table-coded stream with its table block, bit stream length or bit
-// stream damaged is refused (or, for a damaged bit stream that still
-// parses, decodes to positions on the grid), never read out of bounds.
+// An rANS-coded stream (FORMAT.md §8.5.12) with its stream lengths,
+// states, words, low bits or tables damaged is refused (or, for damage
+// that still parses, decodes to positions on the grid), never read out of
+// bounds.
 TEST(Geometry, DamagedTablesAreRefused) {
   Prepared p = prepare(tsm_test::jittered(tsm_test::icosphere(3), 0.01f, 3), 12);
   const std::string good = tsm::encode_geometry_as(p.ce.layout, p.q, 12, tsm::Predictor::gate, 0, tsm::Lattice(),
@@ -222,9 +223,16 @@ TEST(Geometry, DamagedTablesAreRefused) {
   ASSERT_EQ(static_cast<uint8_t>(good[0]), tsm::kDefaultWeightsFlag | tsm::kTableFlag | 2);  // no weights stored
   std::vector<uint32_t> back;
   ASSERT_TRUE(tsm::decode_geometry(good, p.ce.layout, 12, back).ok());
-  const size_t map_at = 5, tables_at = map_at + tsm::kTableMapBytes;
-  uint32_t bit_bytes = 0;
-  for (int k = 0; k < 4; ++k) bit_bytes |= uint32_t{static_cast<uint8_t>(good[1 + k])} << (8 * k);
+  auto u32_at = [&](size_t at) {
+    uint32_t x = 0;
+    for (int k = 0; k < 4; ++k) x |= uint32_t{static_cast<uint8_t>(good[at + k])} << (8 * k);
+    return x;
+  };
+  // Byte 0 the predictor, then the tables, the rANS and the bit stream,
+  // each after its length, then the range-coded stream.
+  const size_t tables_at = 5, rans_len_at = tables_at + u32_at(1), rans_at = rans_len_at + 4;
+  const size_t bits_len_at = rans_at + u32_at(rans_len_at), range_at = bits_len_at + 4 + u32_at(bits_len_at);
+  ASSERT_LE(range_at, good.size());  // (the range-coded stream may be empty: no planes)
   auto code = [&](const std::string& bytes) { return tsm::decode_geometry(bytes, p.ce.layout, 12, back).code(); };
   auto with = [&](size_t at, uint8_t value) {
     std::string b = good;
@@ -233,29 +241,25 @@ TEST(Geometry, DamagedTablesAreRefused) {
   };
   // Every prefix is refused.
   for (size_t n = 0; n < good.size(); n += 7) EXPECT_EQ(code(good.substr(0, n)), tsm::ErrorCode::corrupt_data) << n;
-  // The bit stream's length: past the section, or shorter than its bits.
+  // Stream lengths past the section; a state below 2^16; the rANS stream
+  // without its last word; a stream too short for the states.
   EXPECT_EQ(code(with(4, 0x7F)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(rans_len_at + 3, 0x7F)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(bits_len_at + 3, 0x7F)), tsm::ErrorCode::corrupt_data);
+  EXPECT_EQ(code(with(rans_at + 2, 0).replace(rans_at + 3, 1, 1, '\0')), tsm::ErrorCode::corrupt_data);
   std::string shorter = good;
-  shorter[1] = static_cast<char>(static_cast<uint8_t>(good[1]) - 1);
+  shorter.erase(bits_len_at - 2, 2);
+  shorter[rans_len_at] = static_cast<char>(static_cast<uint8_t>(good[rans_len_at]) - 2);
   EXPECT_EQ(code(shorter), tsm::ErrorCode::corrupt_data);
-  // The first table: no symbols, too many, a length of 12, over-subscribed.
-  size_t first = map_at;
-  while (good[first] == 0) ++first;
-  EXPECT_EQ(code(with(tables_at, 0)), tsm::ErrorCode::corrupt_data);
-  EXPECT_EQ(code(with(tables_at, 64)), tsm::ErrorCode::corrupt_data);
-  EXPECT_EQ(code(with(tables_at + 1, 0xCC)), tsm::ErrorCode::corrupt_data);
-  std::string all_ones = good;
-  const size_t S = static_cast<uint8_t>(good[tables_at]);
-  for (size_t j = 0; j < (S + 1) / 2; ++j) all_ones[tables_at + 1 + j] = static_cast<char>(S % 2 && j == S / 2 ? 0x10 : 0x11);
-  EXPECT_EQ(code(all_ones), tsm::ErrorCode::corrupt_data);
-  // A used context's table left out of the map; a context that does not exist.
-  const uint8_t m = static_cast<uint8_t>(good[first]);
-  EXPECT_EQ(code(with(first, static_cast<uint8_t>(m & (m - 1)))), tsm::ErrorCode::corrupt_data);
-  EXPECT_EQ(code(with(map_at + 26, 0x04)), tsm::ErrorCode::corrupt_data);  // context 210
-  // Every byte of the table block and the first of the bit stream, changed:
+  std::string tiny = good.substr(0, rans_len_at) + std::string("\x04\0\0\0\0\0\1\0", 8) + good.substr(bits_len_at);
+  EXPECT_EQ(code(tiny), tsm::ErrorCode::corrupt_data);
+  // The tables replaced by zeros: no context has a table.
+  std::string no_tables = good;
+  std::fill(no_tables.begin() + tables_at, no_tables.begin() + rans_len_at, '\0');
+  EXPECT_EQ(code(no_tables), tsm::ErrorCode::corrupt_data);
+  // Every byte of the tables and lengths, and some of the streams, changed:
   // refused, or positions on the grid; never a crash (the sanitizer build).
-  const size_t end = tables_at + (good.size() - tables_at - bit_bytes) / 2 + 8;
-  for (size_t at = map_at; at < std::min(end, good.size()); ++at)
+  for (size_t at = 1; at < std::min(range_at + 32, good.size()); at += at < rans_at + 16 || at + 48 > range_at ? 1 : 7)
     for (uint8_t x : {uint8_t{0x00}, uint8_t{0x5A}, uint8_t{0xFF}}) {
       const tsm::Status s = tsm::decode_geometry(with(at, x), p.ce.layout, 12, back);
       if (s.ok()) {

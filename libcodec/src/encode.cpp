@@ -125,26 +125,36 @@ struct TreeChoice {
   bool midpoint = false;  // the midpoint-distance Kruskal tree instead of the layered spiral
 };
 
-// The connectivity of a part with the given tree, then, when vertices on no
-// triangle have a nearby surface vertex to predict them (their anchor), a
-// second pass that orders them by it.
-Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                         const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+CutHints part_hints(const Mesh& mesh, const std::vector<uint32_t>& qin, const EncodeOptions& options,
+                    TreeChoice tree) {
   CutHints hints;
   hints.qpos = &qin;
   hints.root_rule = tree.root_rule;
   hints.midpoint_tree = tree.midpoint;
   hints.runs = run_coding(mesh, options);
-  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
-  view = own_view(ce, qin, is_ref);
-  std::vector<uint32_t> anchor = find_anchors(view.layout, view.q, options.quantization_bits);
-  if (std::any_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) {
-    std::vector<uint32_t> own_to_output;
-    for (uint32_t v = 0; v < view.mark.size(); ++v)
-      if (view.mark[v] == kNone) own_to_output.push_back(v);
-    std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
-    for (size_t r = 0; r < anchor.size(); ++r)
-      if (anchor[r] != kNone) by_input[ce.vertex_order[own_to_output[r]]] = own_to_output[anchor[r]];
+  return hints;
+}
+
+// Per input vertex on no triangle, the output id of its anchor, a nearby
+// surface vertex that predicts it (kNone: none); empty when none has one.
+std::vector<uint32_t> anchor_keys(const Mesh& mesh, const ConnectivityEncoding& ce, const OwnView& view, int bits) {
+  std::vector<uint32_t> anchor = find_anchors(view.layout, view.q, bits);
+  if (std::none_of(anchor.begin(), anchor.end(), [](uint32_t x) { return x != kNone; })) return {};
+  std::vector<uint32_t> own_to_output;
+  for (uint32_t v = 0; v < view.mark.size(); ++v)
+    if (view.mark[v] == kNone) own_to_output.push_back(v);
+  std::vector<uint32_t> by_input(mesh.vertex_count(), kNone);
+  for (size_t r = 0; r < anchor.size(); ++r)
+    if (anchor[r] != kNone) by_input[ce.vertex_order[own_to_output[r]]] = own_to_output[anchor[r]];
+  return by_input;
+}
+
+// The anchor step of part_connectivity on its first pass `ce`: when vertices
+// on no triangle have an anchor, a second pass that orders them by it.
+Status anchor_step(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                   int bits, CutHints hints, ConnectivityEncoding& ce, OwnView& view) {
+  const std::vector<uint32_t> by_input = anchor_keys(mesh, ce, view, bits);
+  if (!by_input.empty()) {
     if (in_anchor_order(ce, by_input)) {
       // The cut would keep its order (a decoded mesh, in canonical rounds):
       // the second pass would code the same streams, so only hand the
@@ -159,6 +169,17 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
     view = own_view(ce, qin, is_ref);
   }
   return Status::Ok();
+}
+
+// The connectivity of a part with the given tree, then (with `anchors`)
+// the anchor step.
+Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                         const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view,
+                         bool anchors = true) {
+  const CutHints hints = part_hints(mesh, qin, options, tree);
+  TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
+  view = own_view(ce, qin, is_ref);
+  return anchors ? anchor_step(mesh, qin, is_ref, options.quantization_bits, hints, ce, view) : Status::Ok();
 }
 
 // Canonical re-encoding (issue 3): a decoded mesh must encode to the bytes
@@ -215,9 +236,9 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   std::vector<uint32_t> q;
   std::vector<uint8_t> ref;
   // Codes a mesh whose ids are the part's input ids through `base`.
-  auto code = [&](const Mesh& faces) -> Status {
+  auto code = [&](const Mesh& faces, bool anchors = true) -> Status {
     ce = ConnectivityEncoding();
-    if (base.empty()) return part_connectivity(faces, qin, is_ref, options, tree, ce, view);
+    if (base.empty()) return part_connectivity(faces, qin, is_ref, options, tree, ce, view, anchors);
     q.resize(3 * n);
     for (size_t v = 0; v < n; ++v)
       for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
@@ -227,9 +248,53 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     }
     return part_connectivity(faces, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view);
   };
-  TSM_RETURN_IF_ERROR(code(mesh));
-  if (tree.root_rule != 0) return Status::Ok();  // only tried on parts without stitches (encode_part)
-  if (ce.stats.stitches == 0) return Status::Ok();
+  // Round 0 without its anchor step first. That step only orders the
+  // vertices on no triangle (stably by anchor, then position), which no
+  // face names unless side faces do: a part with stitches whose decoded
+  // self is another mesh is coded again from that mesh, so for round 1 it
+  // is enough to put round 0's vertex order in the step's order (then
+  // round 1's step finds its order kept and codes once). Round 0 is coded
+  // whole when its decoded self is the mesh itself, when side faces name
+  // such vertices, and when round 0 is on a cycle (whose order compares
+  // round 0's streams).
+  TSM_RETURN_IF_ERROR(code(mesh, false));
+  if (tree.root_rule != 0 || ce.stats.stitches == 0)  // (root rules: only tried on parts without stitches)
+    return anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce,
+                       view);
+  Mesh decoded0;
+  {
+    GeometryLayout scratch;
+    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded0, scratch));
+  }
+  // (Vertices on no triangle that side faces name: the step changes those
+  // faces, so round 0 is coded whole as well.)
+  std::vector<uint8_t> on_triangle(n, 0);
+  for (uint32_t v : ce.layout.corners())
+    if (v != kNone) on_triangle[v] = 1;
+  const bool side_named = std::any_of(decoded0.indices.begin(), decoded0.indices.end(),
+                                      [&](uint32_t v) { return !on_triangle[v]; });
+  const bool full_round0 = side_named || same_faces(decoded0, mesh);
+  if (full_round0) {
+    TSM_RETURN_IF_ERROR(code(mesh));
+    if (ce.stats.stitches == 0) return Status::Ok();
+  } else {
+    // What the step would change for round 1: unless their anchors are in
+    // order already (then the step keeps them), the order of the output
+    // vertices on no triangle, sorted as its cut sorts them (stably by
+    // anchor, then grid position).
+    const std::vector<uint32_t> key = anchor_keys(mesh, ce, view, options.quantization_bits);
+    if (!key.empty() && !in_anchor_order(ce, key)) {
+      std::vector<uint32_t> at, ids;
+      for (uint32_t v = 0; v < n; ++v)
+        if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
+      std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+        if (key[a] != key[b]) return key[a] < key[b];
+        return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
+                                            &qin[3 * size_t{b}] + 3);
+      });
+      for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
+    }
+  }
   // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
   // streams and its base.
   std::vector<Mesh> coded_in;
@@ -240,7 +305,11 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   for (int round = 0; round < rounds; ++round) {
     Mesh decoded;
     GeometryLayout scratch;
-    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
+    if (round == 0 && !full_round0)
+      decoded = std::move(decoded0);
+    else
+      TSM_RETURN_IF_ERROR(
+          decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
     const Mesh& now = round == 0 ? mesh : coded;
     if (same_faces(decoded, now)) {
       // Output vertex v as `now`'s vertex v, when every vertex is on a face
@@ -260,6 +329,17 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     size_t i = 0;
     while (i <= static_cast<size_t>(round) && !same_faces(decoded, coded_by(i))) ++i;
     if (i <= static_cast<size_t>(round)) {
+      if (i == 0 && !full_round0) {  // round 0's streams with its anchor step, for the cycle's order
+        ConnectivityEncoding now_ce = std::move(ce);
+        OwnView now_view = std::move(view);
+        std::vector<uint32_t> now_base = std::move(base);
+        base.clear();
+        TSM_RETURN_IF_ERROR(code(mesh));
+        key_of[0] = cycle_key(ce);
+        ce = std::move(now_ce);
+        view = std::move(now_view);
+        base = std::move(now_base);
+      }
       size_t best = i;
       for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
         if (key_before(key_of[k], key_of[best])) best = k;

@@ -42,6 +42,7 @@
 #include "byte_io.hpp"
 #include "connectivity.hpp"
 #include "range_coder.hpp"
+#include "rans_coder.hpp"
 #include "table_coder.hpp"
 #include "tsm/quantization.hpp"
 
@@ -186,22 +187,16 @@ struct CollectSink {
   bool truncated() const { return false; }
 };
 
-// Tables (kTableFlag): the surface residuals through static prefix codes
-// per context, everything else through the range coder as before. The
-// encoder counts the symbols in a first pass, builds the codes, then codes.
-struct TableCountSink : CollectSink {
-  TableEncoder& tables;
-  explicit TableCountSink(TableEncoder& t) : tables(t) {}
+// Tables (kTableFlag): the surface residuals through static frequency
+// tables per context and rANS (rans_coder.hpp), everything else through the
+// range coder as before. One pass: the encoder counts and keeps the
+// residuals, then builds the tables and codes them (rANS runs backwards).
+struct TableEncodeSink : EncodeSink {
+  RansEncoder& tables;
+  BitWriter bits;
+  explicit TableEncodeSink(RansEncoder& t) : tables(t) {}
   int32_t residual(SurfaceModels*, int ctx, int64_t v) {
     tables.count(ctx, v);
-    return static_cast<int32_t>(v);
-  }
-};
-struct TableEncodeSink : EncodeSink {
-  const TableEncoder& tables;
-  BitWriter bits;
-  explicit TableEncodeSink(const TableEncoder& t) : tables(t) {}
-  int32_t residual(SurfaceModels*, int ctx, int64_t v) {
     tables.put(bits, ctx, v);
     return static_cast<int32_t>(v);
   }
@@ -224,18 +219,20 @@ struct DecodeSink {
 };
 
 struct TableDecodeSink : DecodeSink {
-  TableSet tables;
+  RansDecoder tables;
   BitReader bits;
-  bool bad_code = false;  // a code word no table assigns, or a context without a table
+  bool bad_code = false;  // a context without a table
   int32_t residual(SurfaceModels*, int ctx, int64_t) {
     int32_t r = 0;
     if (!tables.decode(bits, ctx, r)) bad_code = true;  // also a context without a table
     return r;
   }
-  bool truncated() const { return DecodeSink::truncated() || bits.overrun() || bad_code; }
+  bool truncated() const { return DecodeSink::truncated() || bits.overrun() || tables.overrun() || bad_code; }
   const char* truncation() const {
-    return bad_code ? "a residual's code word is in no table"
-                    : bits.overrun() ? "table-coded bit stream is truncated" : DecodeSink::truncation();
+    return bad_code           ? "a residual's context has no table"
+           : bits.overrun()   ? "residual bit stream is truncated"
+           : tables.overrun() ? "rANS stream is truncated"
+                              : DecodeSink::truncation();
   }
 };
 
@@ -624,7 +621,7 @@ struct SurfaceCoder {
 };
 
 // The fast levels' decoder: the gate predictor in march order without a
-// tangent step or mixing, residuals from tables (FORMAT.md §8.5.11). It is
+// tangent step or mixing, residuals from tables (FORMAT.md §8.5.12). It is
 // SurfaceCoder::code with multi false followed by Coder::vertex, written
 // out for that one case: the gate's three corners looked up once, the
 // averages of one or two values as sums and shifts, the table lookup
@@ -1257,15 +1254,21 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
     pass(s);
     return head + s.e.finish();
   }
-  // Tables (FORMAT.md §8.5.11): count, build the codes, code; then the
-  // bit stream's length, the table block, the bit stream, the range stream.
-  TableEncoder codes(kTableContexts);
-  TableCountSink counts(codes);
-  pass(counts);
-  codes.build();
+  // Tables (FORMAT.md §8.5.12): code (the residuals counted and kept),
+  // build the tables; then the tables' range-coded stream, the rANS stream
+  // and the bit stream, each after its length, and the range stream.
+  RansEncoder codes(kTableContexts);
   TableEncodeSink s(codes);
   pass(s);
-  return head + write_table_block(codes.lengths(), kTableMapBytes, s.bits.finish()) + s.e.finish();
+  codes.build();
+  RangeEncoder table_coder;
+  codes.write_tables(table_coder);
+  ByteWriter tail(head);
+  for (const std::string& part : {table_coder.finish(), codes.finish(), s.bits.finish()}) {
+    tail.u32(static_cast<uint32_t>(part.size()));
+    tail.bytes(part);
+  }
+  return head + s.e.finish();
 }
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
@@ -1358,8 +1361,12 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
 
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
                             const Lattice* candidate, GeometryStats* stats) {
-  // The fast levels: residuals through static prefix codes.
-  const bool tables = level <= kTableLevel;
+  // Levels 0-6: residuals through static tables and rANS; but the mixing
+  // levels, and at levels 3-6 a small mesh (where the tables may cost more
+  // than they save, and decoding takes no time), search with the adaptive
+  // models and try tables on the winner last.
+  const bool adaptive_search = level >= kMixLevel || (level >= 3 && g.vertex_count <= kSmallMesh);
+  bool tables = !adaptive_search;
   GeometryStats st;
   st.predictor = level <= 2 ? Predictor::gate : Predictor::parallelograms;
   st.tables = tables;
@@ -1461,6 +1468,10 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // Residual mixing on whatever won: smaller, slower to decode.
   if (level >= kMixLevel && st.predictor != Predictor::raw)
     consider(st.predictor, st.ancestors, st.lattice, weights, st.tangent ? beta : nullptr, true);
+  if (adaptive_search && st.predictor != Predictor::raw) {
+    tables = true;
+    consider(st.predictor, st.ancestors, st.lattice, weights, st.tangent ? beta : nullptr);
+  }
   for (int a = 0; a < 3; ++a) st.lattice_planes[a] = static_cast<uint32_t>(st.lattice.values[a].size());
   if (stats) *stats = st;
   return best;
@@ -1569,6 +1580,8 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
       ok = greedy_order(st.predictor) ? code_greedy(g, c, s, q)
                                       : code_march_order(g, st.predictor == Predictor::fan, c, s, q);
     if (!ok || s.truncated()) return corrupt(s.truncated() ? s.truncation() : "coordinate outside the grid");
+    if constexpr (std::is_same_v<std::decay_t<decltype(s)>, TableDecodeSink>)
+      if (!s.tables.finished()) return corrupt("rANS states do not end where they started");
     if (stats) *stats = st;
     return Status::Ok();
   };
@@ -1577,12 +1590,20 @@ Status decode_geometry(std::string_view bytes, const GeometryLayout& g, int bits
     s.d.init(bytes.substr(r.offset()));
     return run(s);
   }
-  // With tables (§8.5.11): the bit stream's length, the tables, the bit
-  // stream, then the range-coded stream.
+  // With tables (§8.5.12): the tables' range-coded stream, the rANS stream
+  // and the bit stream, each after its length, then the range-coded stream.
   auto s = std::make_unique<TableDecodeSink>();
-  std::string why;
-  if (!read_table_block(r, kTableContexts, kTableMapBytes, s->tables, s->bits, why)) return corrupt(why);
+  uint32_t n;
+  std::string_view table_bytes, rans, raw;
+  if (!r.u32(n) || !r.bytes(n, table_bytes)) return corrupt("residual tables are cut off");
+  if (!r.u32(n) || !r.bytes(n, rans)) return corrupt("rANS stream is cut off");
+  if (!s->tables.init(rans)) return corrupt("rANS stream too short or with a bad state");
+  if (!r.u32(n) || !r.bytes(n, raw)) return corrupt("residual bit stream is cut off");
+  s->bits.init(raw);
   s->d.init(bytes.substr(r.offset()));
+  RangeDecoder table_decoder(table_bytes);
+  std::string why;
+  if (!s->tables.read_tables(table_decoder, kTableContexts, why)) return corrupt(why);
   return run(*s);
 }
 

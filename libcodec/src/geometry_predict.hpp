@@ -54,11 +54,11 @@ constexpr uint8_t kMixFlag = 0x20;
 // minus it (a box's far corners: a few bits instead of ~20).
 constexpr uint8_t kTopFlag = 0x10;
 // The predictor byte of 0, 1, 2, 3 or 5 (any flag above but mixing) with
-// this bit set says the residuals are coded with static prefix codes per
-// context (table_coder.hpp), stored before the streams: the fast levels.
+// this bit set says the residuals are coded with static frequency tables
+// per context and rANS (rans_coder.hpp): every level without mixing.
 constexpr uint8_t kTableFlag = 0x08;
-// The highest encoder level that codes residuals (and the connectivity's
-// run values and attribute residuals, where they pay) with tables.
+// The highest encoder level that codes the connectivity's run values and
+// attribute residuals, where they pay, with static prefix codes.
 constexpr int kTableLevel = 2;
 // The lowest encoder level that tries residual mixing (slower to decode).
 constexpr int kMixLevel = 7;
@@ -75,7 +75,7 @@ struct GeometryStats {
   bool tangent = false;  // the tangent step
   bool mix = false;      // residual mixing
   bool top = false;      // lattice planes' last coded from the top
-  bool tables = false;   // residuals through static prefix codes
+  bool tables = false;   // residuals through static tables and rANS
   Lattice lattice;
   uint32_t lattice_planes[3] = {0, 0, 0};
 };
@@ -93,8 +93,8 @@ Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t vertex_count);
 
 // q: 3 quantized coordinates per output vertex. The encoder picks the
 // predictor by level, and the lattice (if a candidate is given) by size:
-// residual mixing at level kMixLevel and up, residuals through tables at
-// level kTableLevel and below, the fan predictor at levels 1-2, planes
+// residual mixing at level kMixLevel and up, residuals through tables and
+// rANS below it, the fan predictor at levels 1-2, planes
 // coded from the top and the tangent step where they pay.
 std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, int level,
                             const Lattice* candidate, GeometryStats* stats = nullptr);
@@ -103,7 +103,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
 // experiments). tangent: the tangent step's two weights (4.12, surface
 // vertices and vertices with an anchor), null for none. mix: residual
 // mixing (not with the raw predictor). top: the lattice planes' last coded
-// from the top. tables: residuals through static prefix codes (not with
+// from the top. tables: residuals through static tables and rANS (not with
 // mixing or the raw predictor).
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                int ancestors, const Lattice& lattice, const int32_t* weights = nullptr,
