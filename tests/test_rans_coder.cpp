@@ -103,7 +103,7 @@ TEST(RansCoder, SkewedResidualsCostNearTheirEntropy) {
   }
   double bits = 0;
   for (double n : count)
-    if (n) bits -= n * std::log2(n / 100000.0);
+    if (n > 0) bits -= n * std::log2(n / 100000.0);
   const Coded c = encode(values, 1);
   EXPECT_LE(static_cast<double>(c.rans.size() + c.tables.size()), bits / 8 * 1.01 + 32);
   EXPECT_TRUE(c.bits.empty());
