@@ -4,7 +4,9 @@
 # (web/prepare-data.sh), and runs the Chromium test (web/test/browser.mjs):
 # each mesh streamed through the decoder in headless Chromium, counts and
 # index/position checksums against the native decoder's, screenshots in
-# build/web/screenshots/.
+# build/web/screenshots/; then glTF with TSM_mesh_compression through three.js
+# and the Khronos validator (web/test/gltf.mjs), and the npm package, packed,
+# installed into a scratch project and imported (web/test/package.mjs).
 #
 #   web/test.sh            # the test
 #   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md)
@@ -55,6 +57,7 @@ apt_install chromium || skip "Chromium cannot be installed (apt-get install chro
 
 # ---- npm packages (web/package-lock.json) -----------------------------------------
 if [ ! -d "$HERE/node_modules/playwright-core" ] || [ ! -d "$HERE/node_modules/draco3d" ] ||
+   [ ! -d "$HERE/node_modules/three" ] || [ ! -d "$HERE/node_modules/gltf-validator" ] ||
    [ "$HERE/package-lock.json" -nt "$HERE/node_modules/.package-lock.json" ]; then
   (cd "$HERE" && npm ci --no-audit --no-fund >>"$LOG" 2>&1) || skip "npm ci in web/ failed (npm registry unreachable?; build/web/install.log)"
 fi
@@ -74,6 +77,8 @@ TSM="$TSM" bash "$HERE/prepare-data.sh" || fail "web/prepare-data.sh failed"
 
 # ---- test -------------------------------------------------------------------------
 node "$HERE/test/browser.mjs" || fail "the Chromium test failed (screenshots in build/web/screenshots/)"
+node "$HERE/test/gltf.mjs" || fail "the glTF / three.js test failed (screenshots in build/web/screenshots/gltf-*.png)"
+node "$HERE/test/package.mjs" || fail "the npm package test failed (scratch project in build/web/pack-test/)"
 if [ "$BENCH" = 1 ]; then
   node "$HERE/test/bench.mjs" || fail "the bench failed"
 fi

@@ -1,0 +1,221 @@
+// The glTF test: compressed glTF (TSM_mesh_compression) through three.js.
+// Makes the assets in build/web/data/gltf/ with the native `tsm encode`: a
+// generated sphere (normals, UVs, u8 colours) always, and the corpus's Fox,
+// CesiumMilkTruck and 2CylinderEngine when present; compressed with the
+// extension required and, when the encoder has --fallback, with an
+// uncompressed copy. Every file tsm writes passes the Khronos glTF validator
+// (npm gltf-validator) with no errors. Then in headless Chromium
+// (web/demo/gltf.html) each compressed file is loaded by three.js's
+// GLTFLoader with the tsm plugin, on the page's thread and in a worker, and
+// compared with the original asset: meshes, vertex and index counts,
+// attribute names, sizes and normalized flags, and the rendering with the
+// same camera (mean absolute difference and share of pixels off by more than
+// 32 levels, within MAX_MEAN_ABS / MAX_OVER32). A fallback file also loads
+// without the plugin, and a damaged stream is refused with an error.
+//   node web/test/gltf.mjs
+// Env: TSM (the native CLI, default build/release/cli/tsm), CORPUS
+// (../shared/corpus; in CI a missing corpus fails the test).
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import validator from 'gltf-validator';
+import { startServer } from '../serve.mjs';
+import { launch } from './chromium.mjs';
+import { readGlb } from './glb.mjs';
+import { sphereGlb } from './sphere-glb.mjs';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const root = path.resolve(here, '../..');
+const out = path.join(root, 'build/web/data/gltf');
+const shots = path.join(root, 'build/web/screenshots');
+const TSM = process.env.TSM || path.join(root, 'build/release/cli/tsm');
+const CORPUS = path.resolve(process.env.CORPUS || path.join(root, '../shared/corpus'));
+const inCI = !['', '0', 'false'].includes(String(process.env.CI || '').toLowerCase());
+// The rendering of a compressed asset against the original's (0..255 levels; share of pixels).
+const MAX_MEAN_ABS = 1.5;
+const MAX_OVER32 = 0.01;
+fs.mkdirSync(out, { recursive: true });
+fs.mkdirSync(shots, { recursive: true });
+
+let passed = 0, failed = 0;
+const ok = (msg) => { passed++; console.log(`ok   ${msg}`); };
+const fail = (msg) => { failed++; console.log(`FAIL ${msg}`); };
+
+// The .tsm container the encoder writes when it has no glTF writer, as a .glb
+// with the extension (web/test/fixture-glb.mjs), from the stream's decoded mesh.
+async function wrapped(tsmFile, fallback) {
+  const bytes = fs.readFileSync(tsmFile);
+  const { loadTsm } = await import(path.join(root, 'build/web/tsm.js'));
+  const tsm = await loadTsm({ wasmBinary: fs.readFileSync(path.join(root, 'build/web/tsm_decoder.wasm')) });
+  const { fixtureGlb } = await import('./fixture-glb.mjs');
+  return fixtureGlb(bytes, tsm.decode(bytes), { fallback });
+}
+
+// ---- assets --------------------------------------------------------------------
+const help = execFileSync(TSM, ['encode', '--help'], { encoding: 'utf8' });
+const sphere = path.join(out, 'sphere.glb');
+fs.writeFileSync(sphere, sphereGlb());
+// Does the encoder write glTF? (Before it did, it refused a .glb output.)
+let writesGltf = true;
+try { execFileSync(TSM, ['encode', sphere, '-o', path.join(out, 'probe.glb'), '-f', '--quiet'], { stdio: 'pipe' }); }
+catch (e) { writesGltf = false; }
+fs.rmSync(path.join(out, 'probe.glb'), { force: true });
+const hasFallback = help.includes('--fallback') || !writesGltf;
+// name, original (a file; its URL on the test server)
+const assets = [{ name: 'sphere', file: sphere, url: '/data/gltf/sphere.glb' }];
+for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruck.gltf', 'assets/2CylinderEngine.glb']) {
+  const file = path.join(CORPUS, rel);
+  if (fs.existsSync(file)) assets.push({ name: path.basename(rel).replace(/\.gl(b|tf)$/, ''), file, url: `/corpus/${rel}` });
+  else if (inCI) fail(`corpus asset ${file} missing (CI)`);
+  else console.log(`note: ${file} missing, left out`);
+}
+const written = []; // every glTF file tsm wrote, for the validator
+for (const a of assets) {
+  a.variants = [];
+  for (const fallback of hasFallback ? [false, true] : [false]) {
+    const name = `${a.name}${fallback ? '.fallback' : ''}.tsm.glb`;
+    const file = path.join(out, name);
+    if (!writesGltf) {
+      // an encoder without the glTF writer: the test's own wrapper of its .tsm stream
+      if (inCI) { fail(`${name}: tsm encode writes no glTF`); continue; }
+      if (a.name !== 'sphere') { console.log(`note: tsm encode writes no glTF yet: ${a.name} left out`); continue; }
+      const tsmFile = file.replace(/\.glb$/, '.tsm');
+      execFileSync(TSM, ['encode', a.file, '-o', tsmFile, '-f', '--quiet']);
+      fs.writeFileSync(file, await wrapped(tsmFile, fallback));
+      console.log(`note: tsm encode writes no glTF yet: ${name} made by web/test/fixture-glb.mjs`);
+    } else {
+      try {
+        execFileSync(TSM, ['encode', a.file, '-o', file, '-f', '--quiet', ...(fallback ? ['--fallback'] : [])],
+          { stdio: ['ignore', 'ignore', 'pipe'] });
+      } catch (e) {
+        fail(`tsm encode ${a.file}${fallback ? ' --fallback' : ''}: ${String(e.stderr || e.message).trim()}`);
+        continue;
+      }
+    }
+    let json;
+    try { ({ json } = readGlb(fs.readFileSync(file))); } catch (e) { fail(`${name}: ${e.message}`); continue; }
+    if (!(json.extensionsUsed || []).includes('TSM_mesh_compression')) { fail(`${name}: no TSM_mesh_compression in extensionsUsed`); continue; }
+    const required = (json.extensionsRequired || []).includes('TSM_mesh_compression');
+    if (required === fallback) fail(`${name}: the extension is ${required ? '' : 'not '}required`);
+    written.push(file);
+    a.variants.push({ name, fallback, url: `/data/gltf/${name}`, bytes: fs.statSync(file).size });
+  }
+  // `tsm decode` back to plain glTF: also validated
+  if (a.variants.length && writesGltf) {
+    const plain = path.join(out, `${a.name}.plain.glb`);
+    try {
+      execFileSync(TSM, ['decode', path.join(out, a.variants[0].name), '-o', plain, '-f', '--quiet'], { stdio: ['ignore', 'ignore', 'pipe'] });
+      written.push(plain);
+    } catch (e) { fail(`tsm decode ${a.variants[0].name}: ${String(e.stderr || e.message).trim()}`); }
+  }
+}
+fs.writeFileSync(path.join(out, 'index.json'), JSON.stringify(assets.filter((a) => a.variants.length)
+  .map((a) => ({ name: a.name, original: a.url, compressed: a.variants[0].url })), null, 1));
+
+// ---- Khronos validator ---------------------------------------------------------
+for (const file of written) {
+  const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), {
+    uri: path.basename(file), maxIssues: 100,
+    externalResourceFunction: (uri) => fs.promises.readFile(path.resolve(path.dirname(file), decodeURIComponent(uri))),
+  });
+  const { numErrors, numWarnings, numInfos } = report.issues;
+  const errors = report.issues.messages.filter((m) => m.severity === 0);
+  if (numErrors) fail(`validator ${path.basename(file)}: ${numErrors} errors: ` +
+    errors.slice(0, 5).map((m) => `${m.code} ${m.pointer || ''} ${m.message}`).join('; '));
+  else ok(`validator ${path.basename(file)}: no errors (${numWarnings} warnings, ${numInfos} infos: ` +
+    `${[...new Set(report.issues.messages.map((m) => m.code))].join(', ') || 'none'})`);
+}
+
+// ---- three.js in Chromium ------------------------------------------------------
+const server = await startServer();
+const base = `http://localhost:${server.address().port}`;
+const browser = await launch();
+const problems = [];
+async function view(page, query) {
+  await page.goto(`${base}/gltf.html?${new URLSearchParams(query)}`);
+  await page.waitForFunction(() => ['done', 'error'].includes(window.tsmGltf && window.tsmGltf.state), null, { timeout: 180000 });
+  return page.evaluate(() => window.tsmGltf);
+}
+// what three.js made of an asset: per mesh, counts and attributes (name, itemSize, normalized)
+const shape = (v) => v.meshes.map((m) => ({ vertices: m.vertexCount, indices: m.indexCount, skinned: m.skinned,
+  attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized ? 'n' : ''}`).sort().join(' ') }));
+try {
+  const page = await browser.newPage({ viewport: { width: 1000, height: 560 } });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
+  for (const a of assets) {
+    for (const v of a.variants) {
+      // the sphere also through the worker (threshold 0); the corpus assets with the default threshold
+      for (const worker of v.fallback ? [null] : a.name === 'sphere' ? [null, 0] : [null]) {
+        const label = `three.js ${v.name}${worker === 0 ? ' (worker)' : ''}`;
+        const before = problems.length;
+        const q = { a: v.url, b: a.url };
+        if (worker !== null) q.worker = worker;
+        const r = await view(page, q);
+        await page.screenshot({ path: path.join(shots, `gltf-${v.name}${worker === 0 ? '-worker' : ''}.png`) });
+        const diffs = [];
+        if (r.state !== 'done') diffs.push(r.error);
+        else {
+          const [got, want] = r.views.map(shape);
+          if (JSON.stringify(got) !== JSON.stringify(want))
+            diffs.push(`meshes differ: tsm ${JSON.stringify(got)}, original ${JSON.stringify(want)}`);
+          if (!(r.diff.drawn > 0.05)) diffs.push(`the original covers ${(100 * r.diff.drawn).toFixed(1)}% of the picture: nothing to compare`);
+          if (!(r.diff.meanAbs <= MAX_MEAN_ABS && r.diff.over32 <= MAX_OVER32))
+            diffs.push(`rendering differs: mean ${r.diff.meanAbs.toFixed(3)} levels, ${(100 * r.diff.over32).toFixed(2)}% pixels off by > 32`);
+        }
+        diffs.push(...problems.slice(before));
+        if (diffs.length) fail(`${label}: ${diffs.join('; ')}`);
+        else {
+          const m = r.views[0].meshes;
+          ok(`${label}: ${m.length} mesh(es), ${m.reduce((s, x) => s + x.vertexCount, 0)} vertices, ` +
+            `${m.reduce((s, x) => s + (x.indexCount || 0), 0) / 3} triangles, attributes as the original's; rendering: mean ` +
+            `${r.diff.meanAbs.toFixed(3)} levels, ${(100 * r.diff.over32).toFixed(3)}% of ${r.diff.pixels} pixels off by > 32 ` +
+            `(the model covers ${(100 * r.diff.drawn).toFixed(0)}%); ` +
+            `load ${r.views[0].loadMs.toFixed(0)} ms (original ${r.views[1].loadMs.toFixed(0)} ms)`);
+        }
+      }
+    }
+  }
+  // A fallback file without the plugin: three.js reads the uncompressed copy.
+  const fb = assets[0].variants.find((v) => v.fallback);
+  if (fb) {
+    const r = await view(page, { a: fb.url, b: assets[0].url, plain: 1 });
+    if (r.state === 'done' && r.diff.meanAbs <= MAX_MEAN_ABS) ok(`${fb.name} without the plugin: mean ${r.diff.meanAbs.toFixed(3)} levels`);
+    else fail(`${fb.name} without the plugin: ${r.error || JSON.stringify(r.diff)}`);
+  }
+  // Damaged streams are refused with an error (a rejected load), the page keeps working.
+  if (assets[0].variants.length) {
+    const r = await page.evaluate(async (url) => {
+      const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+      const { GLTFTsmExtension } = await import('/dist/gltf-tsm-extension.js');
+      const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
+      const dv = new DataView(bytes.buffer);
+      const jsonLength = dv.getUint32(12, true);
+      const json = JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + jsonLength)));
+      const bv = json.bufferViews[json.meshes[0].primitives[0].extensions.TSM_mesh_compression.bufferView];
+      const at = 20 + jsonLength + 8 + (bv.byteOffset || 0);
+      const load = async (b, threshold) => {
+        const loader = new GLTFLoader();
+        loader.register((parser) => new GLTFTsmExtension(parser, { workerThreshold: threshold }));
+        try { await loader.parseAsync(b.buffer, ''); return 'loaded'; } catch (e) { return `${e.name}: ${e.message}`; }
+      };
+      const res = {};
+      const flipped = bytes.slice(); flipped[at + (bv.byteLength >> 1)] ^= 0x55;
+      res.flipped = await load(flipped, Infinity);
+      res.flippedWorker = await load(flipped, 0);
+      const zeroed = bytes.slice(); zeroed.fill(0, at, at + bv.byteLength);
+      res.zeroed = await load(zeroed, Infinity);
+      res.after = await load(bytes, Infinity);
+      return res;
+    }, assets[0].variants[0].url);
+    if (r.flipped.startsWith('TsmError') && r.flippedWorker.startsWith('TsmError') && r.zeroed.startsWith('TsmError') && r.after === 'loaded')
+      ok(`damaged streams refused: ${JSON.stringify(r)}`);
+    else fail(`damaged streams: ${JSON.stringify(r)}`);
+  }
+} finally {
+  await browser.close();
+  server.close();
+}
+console.log(`gltf: ${passed} passed, ${failed} failed`);
+process.exit(failed ? 1 : 0);
