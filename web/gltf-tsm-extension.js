@@ -1,6 +1,8 @@
 // A three.js GLTFLoader plugin for TSM_mesh_compression: mesh primitives
 // whose vertex attributes and indices are one .tsm stream in a bufferView
-// (format-spec/gltf/).
+// (format-spec/gltf/TSM_mesh_compression.md): POSITION is the stream's
+// positions, each semantic of the extension's `attributes` the decoded
+// attribute of that number; vertex i of the stream is vertex i of the primitive.
 //
 //   import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 //   import { GLTFTsmExtension } from '@tsm-codec/decoder/three';
@@ -65,10 +67,12 @@ export class GLTFTsmExtension {
     const vertexCount = mesh.positions.length / 3;
     if (mesh.faceOffsets) throw new Error(`${EXTENSION_NAME}: the stream has faces that are not triangles`);
     const cache = parser.cache;
-    for (const [semantic, id] of Object.entries(ext.attributes || {})) {
+    // POSITION is always the stream's positions (the extension does not list it).
+    const listed = { ...(ext.attributes || {}), POSITION: -1 };
+    for (const [semantic, id] of Object.entries(listed)) {
       const accessorIndex = primitive.attributes[semantic];
       if (accessorIndex === undefined) {
-        throw new Error(`${EXTENSION_NAME}: attribute ${semantic} is in the extension but not in the primitive's attributes`);
+        throw new Error(`${EXTENSION_NAME}: ${semantic} is compressed but the primitive has no ${semantic} accessor`);
       }
       const accessor = parser.json.accessors[checkIndex(accessorIndex, parser.json.accessors, 'accessor')];
       let values, components, type = 'f32';

@@ -5,6 +5,7 @@
 //         /data/       -> build/web/data/     (.tsm and .drc files made by web/prepare-data.sh)
 //         /draco/      -> web/node_modules/draco3d/
 //         /three/      -> web/node_modules/three/  (three.js for gltf.html)
+//         /meshopt/    -> web/node_modules/meshoptimizer/  (its decoder, for gltf-bench.html)
 //         /corpus/     -> the corpus (CORPUS, default ../shared/corpus), read only: the original glTF assets
 // --throttle BYTES_PER_SECOND slows the /data/ responses down (to watch streaming);
 // so does ?throttle=N on a request. TSM_WEB_DIST=DIR serves another build as /dist/.
@@ -20,6 +21,7 @@ const routes = [
   ['/data/', path.join(root, 'build/web/data')],
   ['/draco/', path.join(here, 'node_modules/draco3d')],
   ['/three/', path.join(here, 'node_modules/three')],
+  ['/meshopt/', path.join(here, 'node_modules/meshoptimizer')],
   ['/corpus/', path.resolve(process.env.CORPUS || path.join(root, '../shared/corpus'))],
   ['/', path.join(here, 'demo')],
 ];

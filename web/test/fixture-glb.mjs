@@ -28,7 +28,7 @@ export function fixtureGlb(tsmBytes, mesh, { fallback = false } = {}) {
   const min = [0, 1, 2].map((k) => mesh.positions.filter((_, i) => i % 3 === k).reduce((x, y) => Math.min(x, y)));
   const max = [0, 1, 2].map((k) => mesh.positions.filter((_, i) => i % 3 === k).reduce((x, y) => Math.max(x, y)));
   const attributes = { POSITION: accessor(mesh.positions, 'VEC3', { min, max }) };
-  const map = { POSITION: 0 };
+  const map = {};
   mesh.attributes.forEach((a, id) => {
     const semantic = GLTF_SEMANTIC[a.kind];
     if (!semantic || a.domain !== 'vertex' || semantic in attributes) return;
