@@ -33,8 +33,9 @@ export class GLTFTsmExtension {
   /** options: { workerThreshold (bytes; streams at least this large are decoded
    *  in a Web Worker, default 256 KiB; Infinity: never, 0: always), wasmUrl,
    *  workerUrl, decodeOptions ({ maxVertices, maxFaces, maxCorners }), decoder
-   *  (a TsmDecoder from loadTsm, shared between loaders), worker (from
-   *  createTsmWorker, shared; kept) }. */
+   *  (a TsmDecoder from loadTsm), worker (from createTsmWorker) }. Without
+   *  decoder / worker, one of each per page is made when first needed and
+   *  shared by all loaders. */
   constructor(parser, options = {}) {
     this.name = EXTENSION_NAME;
     this.parser = parser;
@@ -51,11 +52,6 @@ export class GLTFTsmExtension {
     if (!compressed.length) return null;
     return Promise.all(compressed.map((p) => this.primePrimitive(p)))
       .then(() => this.parser.loadMesh(meshIndex));
-  }
-
-  afterRoot() {
-    if (this.worker && !this.options.worker) { this.worker.terminate(); this.worker = null; }
-    return null;
   }
 
   // Decodes a primitive's stream and caches its accessors as decoded.
@@ -101,12 +97,33 @@ export class GLTFTsmExtension {
   decode(bytes) {
     const o = this.options;
     if (bytes.length >= this.workerThreshold && typeof Worker !== 'undefined') {
-      this.worker = this.worker || createTsmWorker(o.workerUrl);
-      return decodeInWorker(bytes, { worker: this.worker, wasmUrl: o.wasmUrl, decodeOptions: o.decodeOptions });
+      const worker = this.worker || shared(workers, String(o.workerUrl || ''), () => createTsmWorker(o.workerUrl));
+      return decodeInWorker(bytes, { worker, wasmUrl: o.wasmUrl, decodeOptions: o.decodeOptions });
     }
-    this.decoder = this.decoder || loadTsm(o.wasmUrl ? { wasmUrl: o.wasmUrl } : {});
-    return this.decoder.then((d) => d.decode(bytes, o.decodeOptions));
+    const key = String(o.wasmUrl || '');
+    const decoder = this.decoder || shared(decoders, key, () => loadTsm(o.wasmUrl ? { wasmUrl: o.wasmUrl } : {}));
+    return decoder.then((d) => {
+      try {
+        return d.decode(bytes, o.decodeOptions);
+      } catch (e) {
+        if (d.dead && decoders.get(key) === decoder) decoders.delete(key); // aborted (out of memory): a new one next time
+        throw e;
+      }
+    });
   }
+}
+
+// One main-thread decoder and one worker per page (per wasm / worker URL),
+// shared by every loader and kept: each load then skips compiling the module.
+const decoders = new Map();
+const workers = new Map();
+function shared(map, key, make) {
+  if (!map.has(key)) {
+    const made = make();
+    map.set(key, made);
+    if (made && typeof made.catch === 'function') made.catch(() => map.delete(key)); // a failed load is retried next time
+  }
+  return map.get(key);
 }
 
 function checkIndex(i, list, what) {

@@ -9,7 +9,8 @@
 # installed into a scratch project and imported (web/test/package.mjs).
 #
 #   web/test.sh            # the test
-#   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md)
+#   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md),
+#                          # and the glTF one beside draco3d and meshopt (build/web/gltf-bench.md)
 #
 # When emscripten or Chromium (or Node/npm) cannot be had, it prints
 # "web test SKIPPED: <reason>" and exits 0, except in CI (the CI variable set
@@ -81,5 +82,6 @@ node "$HERE/test/gltf.mjs" || fail "the glTF / three.js test failed (screenshots
 node "$HERE/test/package.mjs" || fail "the npm package test failed (scratch project in build/web/pack-test/)"
 if [ "$BENCH" = 1 ]; then
   node "$HERE/test/bench.mjs" || fail "the bench failed"
+  node "$HERE/test/gltf-bench.mjs" || fail "the glTF bench failed"
 fi
 exit 0

@@ -49,10 +49,13 @@ self.onmessage = (e) => {
   // Messages are handled one after another (the decoder loads asynchronously).
   queue = queue.then(async () => {
     if (msg.type === 'decode') {
+      let dec = null;
       try {
-        const mesh = (await decoder(msg.wasmUrl)).decode(msg.bytes, msg.decodeOptions);
+        dec = await decoder(msg.wasmUrl);
+        const mesh = dec.decode(msg.bytes, msg.decodeOptions);
         self.postMessage({ type: 'mesh', id: msg.id, mesh }, buffersOf(mesh));
       } catch (err) {
+        if (dec && dec.dead) decoderReady = null; // the module aborted (out of memory): load a new one next time
         self.postMessage(errorMessage(err, msg.id));
       }
       return;

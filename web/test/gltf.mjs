@@ -206,11 +206,31 @@ try {
       res.flippedWorker = await load(flipped, 0);
       const zeroed = bytes.slice(); zeroed.fill(0, at, at + bv.byteLength);
       res.zeroed = await load(zeroed, Infinity);
+      // The JSON lying about the stream: an attribute number it does not have, a vertex count it does not decode to.
+      const withJson = (edit) => {
+        const j = structuredClone(json);
+        edit(j);
+        let text = new TextEncoder().encode(JSON.stringify(j));
+        const padded = new Uint8Array((text.length + 3) & ~3).fill(0x20); padded.set(text); text = padded;
+        const rest = bytes.subarray(20 + jsonLength);
+        const b = new Uint8Array(20 + text.length + rest.length);
+        const d = new DataView(b.buffer);
+        b.set(bytes.subarray(0, 12)); d.setUint32(8, b.length, true);
+        d.setUint32(12, text.length, true); d.setUint32(16, 0x4e4f534a, true);
+        b.set(text, 20); b.set(rest, 20 + text.length);
+        return b;
+      };
+      const prim = (j) => j.meshes[0].primitives[0];
+      res.badAttribute = await load(withJson((j) => { prim(j).extensions.TSM_mesh_compression.attributes.NORMAL = 99; }), Infinity);
+      res.badCount = await load(withJson((j) => { j.accessors[prim(j).attributes.POSITION].count += 1; }), Infinity);
+      res.badView = await load(withJson((j) => { prim(j).extensions.TSM_mesh_compression.bufferView = 1e6; }), Infinity);
       res.after = await load(bytes, Infinity);
       return res;
     }, assets[0].variants[0].url);
-    if (r.flipped.startsWith('TsmError') && r.flippedWorker.startsWith('TsmError') && r.zeroed.startsWith('TsmError') && r.after === 'loaded')
-      ok(`damaged streams refused: ${JSON.stringify(r)}`);
+    const named = (x) => x.includes('TSM_mesh_compression');
+    if (r.flipped.startsWith('TsmError') && r.flippedWorker.startsWith('TsmError') && r.zeroed.startsWith('TsmError') &&
+        named(r.badAttribute) && named(r.badCount) && named(r.badView) && r.after === 'loaded')
+      ok(`damaged streams and lying JSON refused: ${JSON.stringify(r)}`);
     else fail(`damaged streams: ${JSON.stringify(r)}`);
   }
 } finally {
