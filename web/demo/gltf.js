@@ -9,14 +9,21 @@
 // normalized, array } } }] }], diff (a against b: { meanAbs, over32, pixels, drawn }) }.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { GLTFTsmExtension } from '/dist/gltf-tsm-extension.js';
 
 const params = new URLSearchParams(location.search);
 const SIZE = Number(params.get('size') || 480);
 const state = (window.tsmGltf = { state: 'loading', views: [] });
 
+// three.js's own Draco and meshopt support, for originals compressed with those
+let draco = null;
 function loader() {
   const l = new GLTFLoader();
+  draco = draco || new DRACOLoader().setDecoderPath('/three/examples/jsm/libs/draco/gltf/');
+  l.setDRACOLoader(draco);
+  l.setMeshoptDecoder(MeshoptDecoder);
   const workerThreshold = params.has('worker') ? Number(params.get('worker')) : undefined;
   if (params.get('plain') !== '1') l.register((parser) => new GLTFTsmExtension(parser, { workerThreshold }));
   return l;

@@ -70,6 +70,20 @@ for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruc
   else if (inCI) fail(`corpus asset ${file} missing (CI)`);
   else console.log(`note: ${file} missing, left out`);
 }
+// Transcoding: Draco- and meshopt-compressed inputs (the corpus's Draco engine, Fox through gltfpack -cc),
+// compared with the input as three.js loads it (its DRACOLoader, MeshoptDecoder). Their attributes may
+// change type (KHR_mesh_quantization's integers come back as floats): names and sizes are compared.
+const dracoEngine = path.join(CORPUS, 'assets/2CylinderEngine_Draco/2CylinderEngine.gltf');
+if (fs.existsSync(dracoEngine)) {
+  assets.push({ name: '2CylinderEngine_Draco', file: dracoEngine, url: '/corpus/assets/2CylinderEngine_Draco/2CylinderEngine.gltf', transcoded: true });
+}
+const fox = assets.find((a) => a.name === 'Fox');
+if (fox) {
+  const file = path.join(out, 'Fox_meshopt.glb');
+  execFileSync(process.execPath, [path.join(here, '../node_modules/gltfpack/cli.js'), '-i', fox.file, '-o', file, '-cc'],
+    { stdio: ['ignore', 'ignore', 'pipe'] });
+  assets.push({ name: 'Fox_meshopt', file, url: '/data/gltf/Fox_meshopt.glb', transcoded: true });
+}
 const written = []; // every glTF file tsm wrote, for the validator
 for (const a of assets) {
   a.variants = [];
@@ -138,8 +152,8 @@ async function view(page, query) {
   return page.evaluate(() => window.tsmGltf);
 }
 // what three.js made of an asset: per mesh, counts and attributes (name, itemSize, normalized)
-const shape = (v) => v.meshes.map((m) => ({ vertices: m.vertexCount, indices: m.indexCount, skinned: m.skinned,
-  attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized ? 'n' : ''}`).sort().join(' ') }));
+const shape = (v, transcoded) => v.meshes.map((m) => ({ vertices: m.vertexCount, indices: m.indexCount, skinned: m.skinned,
+  attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized && !transcoded ? 'n' : ''}`).sort().join(' ') }));
 try {
   const page = await browser.newPage({ viewport: { width: 1000, height: 560 } });
   page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
@@ -157,7 +171,7 @@ try {
         const diffs = [];
         if (r.state !== 'done') diffs.push(r.error);
         else {
-          const [got, want] = r.views.map(shape);
+          const [got, want] = r.views.map((x) => shape(x, a.transcoded));
           if (JSON.stringify(got) !== JSON.stringify(want))
             diffs.push(`meshes differ: tsm ${JSON.stringify(got)}, original ${JSON.stringify(want)}`);
           if (!(r.diff.drawn > 0.05)) diffs.push(`the original covers ${(100 * r.diff.drawn).toFixed(1)}% of the picture: nothing to compare`);
