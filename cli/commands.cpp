@@ -815,9 +815,11 @@ int cmd_encode(const EncodeArgs& a) {
   if (single_file_output(a.inputs, a.output)) {
     const MeshFormat f = format_from_extension(a.output);
     const std::string tsm_name = with_extension(a.output, ".tsm");
-    if (f == MeshFormat::gltf || f == MeshFormat::glb)
-      return usage_error(a.output + ": encode writes .tsm files; glTF output of compressed meshes is not supported "
-                         "yet: give -o " + tsm_name + " (tsm decode turns the .tsm back into glTF)");
+    if (f == MeshFormat::gltf || f == MeshFormat::glb) {
+      if (gltf_output(a, a.output)) return gltf_encode(a);
+      return usage_error(a.output + ": a glTF output (TSM_mesh_compression) takes one input file; for several, give "
+                         "-o " + tsm_name + " or run once per file");
+    }
     if (f != MeshFormat::unknown)
       return usage_error(a.output + ": encode writes .tsm files, not " + mesh_format_name(f) + "; give -o " +
                          tsm_name + " (tsm decode turns the .tsm back into " + mesh_format_name(f) + ")");
@@ -844,6 +846,12 @@ int cmd_encode(const EncodeArgs& a) {
 int cmd_decode(const DecodeArgs& a) {
   install_signal_guard();
   const MeshFormat wanted = parse_format(lower(a.format));
+  // A compressed glTF in, a plain glTF out.
+  if (a.inputs.size() == 1 && (format_from_extension(a.inputs[0]) == MeshFormat::gltf ||
+                               format_from_extension(a.inputs[0]) == MeshFormat::glb)) {
+    if (gltf_output(a, a.output)) return gltf_decode(a);
+    return usage_error(a.inputs[0] + ": decode of a glTF writes a plain glTF: give -o NAME.glb or NAME.gltf");
+  }
   // Every writable format has one extension; PLY is the default.
   const std::string ext = writable_format(wanted) ? writable_format(wanted)->extension : ".ply";
   // One output format for the run: --format, else the extension of a single

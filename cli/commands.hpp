@@ -27,6 +27,7 @@ struct EncodeArgs : BatchArgs {
   // Simplify first, within this distance of the input ("E" model units or
   // "E%" of the bounding-box diagonal; "" = no simplification).
   std::string max_error;
+  bool fallback = false;  // glTF output: an uncompressed copy beside each stream
 };
 
 struct DecodeArgs : BatchArgs {
@@ -47,6 +48,10 @@ std::string output_extensions_text();
 std::string output_formats_text();
 
 int cmd_encode(const EncodeArgs& a);
+// glTF to glTF (gltf_command.cpp): one input file and a .glb / .gltf output.
+bool gltf_output(const BatchArgs& a, const std::string& output);
+int gltf_encode(const EncodeArgs& a);
+int gltf_decode(const DecodeArgs& a);
 int cmd_decode(const DecodeArgs& a);
 int cmd_info(const InfoArgs& a);
 

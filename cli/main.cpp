@@ -203,6 +203,9 @@ int main(int argc, char** argv) {
                   "Simplify first (tsm simplify): the result stays within this distance of the input, in model units "
                   "or E% of the bounding-box diagonal");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
+  enc->add_flag("--fallback", ea.fallback,
+                "glTF output: keep an uncompressed copy of each compressed primitive, for viewers without "
+                "TSM_mesh_compression");
   enc->add_flag("--allow-nonfinite", ea.allow_nonfinite,
                 "Let the readers accept NaN/inf values (the encoder refuses them all the same, so this only moves the "
                 "error from the reader to the encoder; kept for scripts)");
@@ -210,6 +213,7 @@ int main(int argc, char** argv) {
   enc->footer(
       "Examples:\n"
       "  tsm encode dragon.ply -o dragon.tsm -q 14 -l 6\n"
+      "  tsm encode scene.glb -o small.glb -q 11 --normal-bits 8    # glTF with TSM_mesh_compression\n"
       "  tsm encode meshes/*.ply meshes/*.obj -o packed/ -j 4     # packed/NAME.tsm for each\n"
       "  tsm encode --input-format obj - < part.obj > part.tsm    # stdin to stdout\n"
       "  tsm encode *.stl -o out/ --json --quiet | jq .bits_per_vertex\n"

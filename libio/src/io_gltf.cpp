@@ -191,6 +191,7 @@
 #include <tuple>
 #include <vector>
 
+#include "gltf_files.hpp"
 #include "tsm/io.hpp"
 
 #ifndef TSM_VERSION
@@ -2513,6 +2514,27 @@ class PassThroughWriter {
 };
 
 }  // namespace
+
+Status read_file_beside(const std::string& dir, const std::string& uri, std::string& out) {
+  if (dir.empty())
+    return Status(ErrorCode::unsupported, "external file " + shown_uri(uri) +
+                                              ": external files are not read here (the glTF did not come from a "
+                                              "file: give the .gltf file's path)");
+  FsContext ctx;
+  ctx.dir = dir;
+  ctx.prefix = dir + "/";
+  const std::string rel = uri_decoded(uri);
+  const std::string why = unsafe_reference(rel);
+  if (!why.empty())
+    return Status(ErrorCode::parse_error, "uri " + shown_uri(uri) + " " + why +
+                                              "; refused: external files are read only from the .gltf file's "
+                                              "folder and its subfolders, by relative URI");
+  std::vector<unsigned char> bytes;
+  std::string err;
+  if (!fs_read(&bytes, &err, ctx.prefix + rel, &ctx)) return Status(ErrorCode::io_error, ctx.error);
+  out.assign(bytes.begin(), bytes.end());
+  return Status::Ok();
+}
 
 Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options,
                  ReadInfo* info) {
