@@ -2,7 +2,7 @@
 // geometry decoded in headless Chromium by each codec's own decoder
 // (web/demo/gltf-bench.html): tsm (`tsm encode`, TSM_mesh_compression,
 // defaults: positions 14 bits, normals 10, texture coordinates 12, colours
-// 10), Draco (KHR_draco_mesh_compression, written by glTF-Transform with
+// 10; at the default level 6 and at level 0, the fastest to decode), Draco (KHR_draco_mesh_compression, written by glTF-Transform with
 // draco3d's encoder, edgebreaker, the same quantization bits) and meshopt
 // (gltfpack -cc -vp 14 -vt 12 -vn 10 -vc 10, EXT_meshopt_compression).
 // Writes build/web/gltf-bench.md and .json.
@@ -35,14 +35,10 @@ for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruc
   const src = path.join(CORPUS, rel);
   if (!fs.existsSync(src)) { console.log(`note: ${src} missing, left out`); continue; }
   const name = path.basename(rel).replace(/\.gl(b|tf)$/, '');
-  const files = { tsm: `${name}.tsm.glb`, draco: `${name}.draco.glb`, meshopt: `${name}.meshopt.glb` };
+  const files = { tsm: `${name}.tsm.glb`, tsm_l0: `${name}.tsm-l0.glb`, draco: `${name}.draco.glb`, meshopt: `${name}.meshopt.glb` };
   const dest = (k) => path.join(out, files[k]);
-  try {
-    execFileSync(TSM, ['encode', src, '-o', dest('tsm'), '-f', '--quiet'], { stdio: ['ignore', 'ignore', 'pipe'] });
-  } catch (e) {
-    console.log(`note: tsm encode ${rel} -o .glb failed, tsm left out: ${String(e.stderr || e.message).trim()}`);
-    delete files.tsm;
-  }
+  execFileSync(TSM, ['encode', src, '-o', dest('tsm'), '-f', '--quiet']);
+  execFileSync(TSM, ['encode', src, '-o', dest('tsm_l0'), '-f', '--quiet', '-l', '0']);
   const doc = await io.read(src);
   // glTF-Transform's Draco writer skips primitives without indices (Fox's): give them 0, 1, 2, ...
   for (const mesh of doc.getRoot().listMeshes()) {
@@ -82,10 +78,11 @@ if (r.state !== 'done') { console.error('gltf bench failed:', r.error); process.
 const n = (x) => x.toLocaleString('en-US');
 const lines = [`Chromium ${r.chromium}, headless, this machine; geometry of each file decoded into typed arrays, ` +
   `median of ${r.reps} runs after 2 warm-up runs, the three decoders taking turns.`, '',
-  '| asset | tsm ms | Draco ms | meshopt ms | tsm .glb bytes | Draco .glb bytes | meshopt .glb bytes | tsm geometry bytes | Draco geometry bytes | meshopt geometry bytes |',
-  '|---|---|---|---|---|---|---|---|---|---|'];
+  '| asset | tsm ms | tsm -l 0 ms | Draco ms | meshopt ms | tsm .glb bytes | tsm -l 0 .glb bytes | Draco .glb bytes | meshopt .glb bytes | ' +
+  'tsm geometry bytes | tsm -l 0 geometry bytes | Draco geometry bytes | meshopt geometry bytes |',
+  '|---|---|---|---|---|---|---|---|---|---|---|---|---|'];
 for (const x of r.rows) {
-  const c = ['tsm', 'draco', 'meshopt'];
+  const c = ['tsm', 'tsm_l0', 'draco', 'meshopt'];
   lines.push(`| ${x.name} | ${c.map((k) => (x[k] ? x[k].ms.toFixed(2) : '-')).join(' | ')} | ` +
     `${c.map((k) => (x[k] ? n(x[k].fileBytes) : '-')).join(' | ')} | ${c.map((k) => (x[k] ? n(x[k].geometryBytes) : '-')).join(' | ')} |`);
 }
