@@ -45,6 +45,14 @@ int check_files(const BatchArgs& a, const std::string& output, bool force, const
   if (fs::equivalent(a.inputs[0], output, ec))
     return refuse(output + ": is the input; give another output name");
   if (!force && fs::exists(output, ec)) return refuse(output + ": already exists; pass -f (--force) to overwrite it");
+  // A .gltf output's buffer file beside it.
+  if (format_from_extension(output) == MeshFormat::gltf) {
+    const fs::path bin = fs::path(output).replace_extension(".bin");
+    if (fs::equivalent(a.inputs[0], bin, ec))
+      return refuse(bin.string() + ": the .bin beside the output would be the input; give another output name");
+    if (!force && fs::exists(bin, ec))
+      return refuse(bin.string() + " (the output's buffer file): already exists; pass -f (--force) to overwrite it");
+  }
   return kExitOk;
 }
 

@@ -36,5 +36,13 @@ install(FILES ${PROJECT_BINARY_DIR}/tsmConfig.cmake ${PROJECT_BINARY_DIR}/tsmCon
 # `cmake --install <build> --prefix <anywhere>` gives a working file.
 file(RELATIVE_PATH TSM_PC_TO_PREFIX ${CMAKE_INSTALL_PREFIX}/${TSM_INSTALL_PKGCONFIGDIR} ${CMAKE_INSTALL_PREFIX})
 string(REGEX REPLACE "/$" "" TSM_PC_TO_PREFIX "${TSM_PC_TO_PREFIX}")
+set(TSM_IO_PC_LIBS "")
+if(TSM_IO_NEEDS_DRACO)
+  string(APPEND TSM_IO_PC_LIBS " -ldraco")
+endif()
+if(TSM_IO_NEEDS_MESHOPT)
+  string(APPEND TSM_IO_PC_LIBS " -lmeshoptimizer")
+endif()
+string(STRIP "${TSM_IO_PC_LIBS}" TSM_IO_PC_LIBS)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/tsm.pc.in ${PROJECT_BINARY_DIR}/tsm.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/tsm.pc DESTINATION ${TSM_INSTALL_PKGCONFIGDIR})

@@ -18,8 +18,11 @@ PACKAGES=(
   libgtest-dev python3 python3-zstandard zstd
   # the Python module tsmcodec (python/) and its tests, for Debian's python3
   pybind11-dev python3-numpy python3-pytest
-  # comparison (optional at build time; the bench shows its columns when present)
-  libdraco-dev draco
+  # comparison (optional at build time; the bench shows its columns when present);
+  # Draco and meshoptimizer also decode KHR_draco_mesh_compression and
+  # EXT_meshopt_compression glTF input (libio); gltfpack makes meshopt glTF
+  # for the transcoding tests and the glTF size table
+  libdraco-dev draco gltfpack
   # comparison/oracles: CGAL's bounded-error Hausdorff distance checks `tsm
   # compare` and `tsm simplify` (tests/cgal, bench); meshoptimizer's simplifier
   # is the simplification benchmark's reference (header-only / optional)

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
 #include "tsm/gltf_transcode.hpp"
@@ -89,7 +91,7 @@ Glb split_glb(const std::string& glb) {
 std::vector<double> accessor_values(const Glb& g, size_t index, size_t* components = nullptr) {
   const json& a = g.doc["accessors"][index];
   const std::string type = a["type"];
-  const size_t n = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
+  const size_t n = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : type == "MAT4" ? 16 : 4;
   if (components) *components = n;
   const int ct = a["componentType"];
   const size_t cb = ct == 5126 || ct == 5125 ? 4 : ct == 5123 || ct == 5122 ? 2 : 1;
@@ -128,14 +130,10 @@ struct Source {
   std::string glb;
   json doc;
   size_t vertices = 0;
-  std::vector<float> positions, normals, uvs, weights, target;
+  std::vector<float> positions, normals, uvs, weights, target, custom;
   std::vector<uint32_t> tris0, tris1;  // the two triangle primitives
   float step = 0;                      // position quantization step at -q 12
 };
-
-void append_floats(std::string& bin, const std::vector<float>& v) {
-  bin.append(reinterpret_cast<const char*>(v.data()), v.size() * 4);
-}
 
 size_t add_view(json& doc, std::string& bin, const std::string& bytes, int target) {
   bin.resize((bin.size() + 3) / 4 * 4, '\0');
@@ -171,6 +169,7 @@ Source make_source() {
     const float w = 0.25f + 0.5f * static_cast<float>(i % 7) / 7.0f;
     s.weights.insert(s.weights.end(), {w, 1.0f - w, 0.0f, 0.0f});
     s.target.insert(s.target.end(), {0.0f, 0.01f * static_cast<float>(i % 5), 0.0f});
+    s.custom.push_back(0.1f * static_cast<float>(i) + 0.03f);
   }
   for (size_t f = 0; f < sphere.face_count(); ++f)
     for (int k = 0; k < 3; ++k) (f % 3 == 0 ? s.tris1 : s.tris0).push_back(sphere.face(f)[k]);
@@ -199,6 +198,11 @@ Source make_source() {
   for (size_t i = 0; i < s.vertices; ++i) joints += {char(i & 0xFF), char(i >> 8), 0, 1};
   const size_t jnt = add_accessor(doc, bin, joints, 5121, "VEC4", s.vertices, 34962);
   const size_t wts = add_accessor(doc, bin, floats(s.weights), 5126, "VEC4", s.vertices, 34962);
+  const size_t cus = add_accessor(doc, bin, floats(s.custom), 5126, "SCALAR", s.vertices, 34962);
+  // One byte per vertex: written back with a 4-byte stride (vertex data alignment).
+  std::string flags;
+  for (size_t i = 0; i < s.vertices; ++i) flags += static_cast<char>(i % 3);
+  const size_t flg = add_accessor(doc, bin, flags, 5121, "SCALAR", s.vertices, 34962);
   const size_t tgt = add_accessor(doc, bin, floats(s.target), 5126, "VEC3", s.vertices, 34962);
   doc["accessors"][tgt]["min"] = {0.0, 0.0, 0.0};
   doc["accessors"][tgt]["max"] = {0.0, 0.04f, 0.0};
@@ -214,7 +218,8 @@ Source make_source() {
   doc["accessors"][times]["min"] = {0.0};
   doc["accessors"][times]["max"] = {1.0};
   const size_t rot = add_accessor(doc, bin, floats({0, 0, 0, 1, 0, 0.7071f, 0, 0.7071f}), 5126, "VEC4", 2, 0);
-  const json attrs = {{"POSITION", pos}, {"NORMAL", nor}, {"TEXCOORD_0", uv}, {"JOINTS_0", jnt}, {"WEIGHTS_0", wts}};
+  const json attrs = {{"POSITION", pos}, {"NORMAL", nor}, {"TEXCOORD_0", uv}, {"JOINTS_0", jnt}, {"WEIGHTS_0", wts},
+                      {"_CUSTOM", cus}, {"_FLAG", flg}};
   doc["meshes"] = {{{"name", "sphere"},
                     {"primitives",
                      {{{"attributes", attrs}, {"indices", i0}, {"material", 0}, {"targets", {{{"POSITION", tgt}}}},
@@ -277,14 +282,24 @@ void check_primitive(const Glb& g, const json& prim, const Source& s, const std:
   }
   ASSERT_EQ(seen.size(), n) << "every source vertex once";
   const std::vector<double> p = accessor_values(g, at["POSITION"]), nn = accessor_values(g, at["NORMAL"]),
-                            uv = accessor_values(g, at["TEXCOORD_0"]), w = accessor_values(g, at["WEIGHTS_0"]);
+                            uv = accessor_values(g, at["TEXCOORD_0"]), w = accessor_values(g, at["WEIGHTS_0"]),
+                            cu = accessor_values(g, at["_CUSTOM"]), fl = accessor_values(g, at["_FLAG"]);
+  EXPECT_EQ(g.doc["accessors"][at["WEIGHTS_0"].get<size_t>()]["componentType"], 5123);
+  EXPECT_EQ(g.doc["accessors"][at["WEIGHTS_0"].get<size_t>()]["normalized"], true);
   for (size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[3 * i + c], s.positions[3 * id[i] + c], 0.51 * s.step);
     double dot = 0;
     for (int c = 0; c < 3; ++c) dot += nn[3 * i + c] * s.normals[3 * id[i] + c];
     EXPECT_GT(dot, 0.999);
     for (int c = 0; c < 2; ++c) EXPECT_NEAR(uv[2 * i + c], s.uvs[2 * id[i] + c], 1e-3);
-    for (int c = 0; c < 4; ++c) EXPECT_EQ(w[4 * i + c], s.weights[4 * id[i] + c]) << "WEIGHTS_0 is exact";
+    double sum = 0;
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_NEAR(w[4 * i + c] / 65535.0, s.weights[4 * id[i] + c], 1.01 / 65535.0);
+      sum += w[4 * i + c];
+    }
+    EXPECT_EQ(sum, 65535.0) << "weights sum to 1 exactly";
+    EXPECT_EQ(cu[i], s.custom[id[i]]) << "float custom attributes are exact";
+    EXPECT_EQ(fl[i], id[i] % 3) << "integer custom attributes are exact";
   }
   if (with_target) {
     const std::vector<double> t = accessor_values(g, prim["targets"][0]["POSITION"]);
@@ -326,10 +341,11 @@ TEST(GltfExtension, CompressedGlbDecodesToTheSourceAndKeepsTheDocument) {
     EXPECT_FALSE(ext["attributes"].contains("POSITION"));
     EXPECT_TRUE(ext["attributes"].contains("NORMAL"));
     EXPECT_TRUE(ext["attributes"].contains("JOINTS_0"));
-    EXPECT_FALSE(ext["attributes"].contains("WEIGHTS_0")) << "float weights stay ordinary accessors";
+    EXPECT_TRUE(ext["attributes"].contains("WEIGHTS_0"));
+    EXPECT_FALSE(ext["attributes"].contains("_CUSTOM")) << "float custom attributes stay ordinary accessors";
     EXPECT_FALSE(c.doc["accessors"][prim["indices"].get<size_t>()].contains("bufferView"));
     EXPECT_FALSE(c.doc["accessors"][prim["attributes"]["POSITION"].get<size_t>()].contains("bufferView"));
-    EXPECT_TRUE(c.doc["accessors"][prim["attributes"]["WEIGHTS_0"].get<size_t>()].contains("bufferView"));
+    EXPECT_TRUE(c.doc["accessors"][prim["attributes"]["_CUSTOM"].get<size_t>()].contains("bufferView"));
     EXPECT_TRUE(c.doc["accessors"][prim["attributes"]["POSITION"].get<size_t>()].contains("min"));
     // The stream is a .tsm file.
     const json& view = c.doc["bufferViews"][ext["bufferView"].get<size_t>()];
@@ -517,6 +533,7 @@ TEST(GltfExtensionCorpus, MeshoptInputFromGltfpackTranscodes) {
   ASSERT_TRUE(transcode_file((tmp / "packed.glb").string(), tmp / "plain_out.glb", false).ok());
   const Glb a = split_glb(slurp(tmp / "plain_in.glb")), b = split_glb(slurp(tmp / "plain_out.glb"));
   EXPECT_FALSE(listed(a.doc, "extensionsUsed", "EXT_meshopt_compression"));
+  for (const json& v : a.doc["bufferViews"]) EXPECT_FALSE(v.contains("extensions")) << v.dump();
   EXPECT_EQ(primitive_counts(a), primitive_counts(b));
   EXPECT_FALSE(primitive_counts(a).empty());
   fs::remove_all(tmp);

@@ -178,7 +178,8 @@ Status decode_meshopt(Document& doc) {
     ojson& view = doc.json["bufferViews"][i];
     if (!view.is_object() || !view.contains("extensions") || !view["extensions"].is_object()) continue;
     for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
-      if (!view["extensions"].contains(name)) continue;
+      // (decoding one removes an emptied "extensions": never recreate it here)
+      if (!view.contains("extensions") || !view["extensions"].contains(name)) continue;
       found = true;
 #ifdef TSM_IO_HAVE_MESHOPT
       TSM_RETURN_IF_ERROR(decode_meshopt_view(doc, i, name));
@@ -263,7 +264,8 @@ Status fill_accessor(Document& doc, size_t acc, const std::vector<double>& raw, 
   const size_t count = raw.size() / components;
   if (count == 0) return doc.error("accessors[" + std::to_string(acc) + "]: the decoded data is empty");
   size_t stride = 0;
-  const size_t view = add_buffer_view(doc, pack_values(raw, ct, components, target, &stride), target, stride);
+  std::string bytes = pack_values(raw, ct, components, target, &stride);  // sets stride first
+  const size_t view = add_buffer_view(doc, std::move(bytes), target, stride);
   a["bufferView"] = view;
   a.erase("byteOffset");
   a.erase("sparse");

@@ -461,20 +461,17 @@ std::vector<std::string> image_files(const Document& doc) {
 
 namespace {
 
-// Extensions whose buffer views are all named by "bufferView" members; with
-// any other one in extensionsUsed, no buffer view is dropped (an unknown
-// extension may name views under other keys).
+// Extensions known to name buffer views under other keys than "bufferView"
+// (property tables: "values", "arrayOffsets", "stringOffsets"). With one of
+// them in extensionsUsed no buffer view is dropped; every other extension
+// (KHR_draco_mesh_compression, KHR_texture_basisu, EXT_mesh_gpu_instancing,
+// ...) follows the core's convention of a "bufferView" member.
 bool views_all_known(const ojson& json) {
   static const std::set<std::string> other_keys = {"EXT_structural_metadata", "EXT_mesh_features",
                                                     "EXT_instance_features", "EXT_feature_metadata"};
   if (!json.contains("extensionsUsed") || !json["extensionsUsed"].is_array()) return true;
-  for (const ojson& e : json["extensionsUsed"]) {
-    if (!e.is_string()) continue;
-    const std::string n = e.get<std::string>();
-    const bool known = n.compare(0, 4, "KHR_") == 0 || n == "EXT_mesh_gpu_instancing" || n == "TSM_mesh_compression" ||
-                       n.compare(0, 12, "EXT_texture_") == 0 || n == "EXT_lights_image_based";
-    if (!known || other_keys.count(n)) return false;
-  }
+  for (const ojson& e : json["extensionsUsed"])
+    if (e.is_string() && other_keys.count(e.get<std::string>())) return false;
   return true;
 }
 
@@ -504,10 +501,55 @@ void renumber_views(ojson& j, const std::map<uint64_t, uint64_t>& to) {
   }
 }
 
+// Animation and skin accessors must not use a view with byteStride (the
+// spec; some exporters add one anyway): drop it from views that no vertex
+// attribute uses and whose accessors are tightly packed, which means the same.
+void drop_needless_strides(Document& doc) {
+  const size_t views = doc.count_of("bufferViews");
+  std::vector<char> vertex(views, 0), loose(views, 0);
+  for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
+    const ojson& mesh = doc.json["meshes"][m];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (const ojson& p : mesh["primitives"]) {
+      std::vector<const ojson*> maps;
+      if (p.is_object() && p.contains("attributes")) maps.push_back(&p["attributes"]);
+      if (p.is_object() && p.contains("targets") && p["targets"].is_array())
+        for (const ojson& t : p["targets"]) maps.push_back(&t);
+      for (const ojson* map : maps) {
+        if (!map->is_object()) continue;
+        for (const auto& kv : map->items()) {
+          if (!kv.value().is_number_unsigned() || kv.value().get<uint64_t>() >= doc.count_of("accessors")) continue;
+          const ojson& a = doc.json["accessors"][kv.value().get<size_t>()];
+          if (a.is_object() && a.contains("bufferView") && a["bufferView"].is_number_unsigned() &&
+              a["bufferView"].get<uint64_t>() < views)
+            vertex[a["bufferView"].get<size_t>()] = 1;
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < doc.count_of("accessors"); ++i) {
+    const ojson& a = doc.json["accessors"][i];
+    if (!a.is_object() || !a.contains("bufferView") || !a["bufferView"].is_number_unsigned() ||
+        a["bufferView"].get<uint64_t>() >= views)
+      continue;
+    const size_t v = a["bufferView"].get<size_t>();
+    const ojson& view = doc.json["bufferViews"][v];
+    const std::string type = a.contains("type") && a["type"].is_string() ? a["type"].get<std::string>() : "";
+    const size_t columns = type == "MAT4" ? 16 : type == "MAT3" ? 9 : type == "MAT2" ? 4 : type_components(type);
+    const size_t elem = component_bytes(a.value("componentType", 0)) * columns;
+    if (!view.is_object() || !view.contains("byteStride") || view["byteStride"] != elem) loose[v] = 1;
+  }
+  for (size_t v = 0; v < views; ++v) {
+    ojson& view = doc.json["bufferViews"][v];
+    if (view.is_object() && view.contains("byteStride") && !vertex[v] && !loose[v]) view.erase("byteStride");
+  }
+}
+
 }  // namespace
 
 Status save_document(Document& doc, bool binary, const std::string& bin_uri, std::string& main, std::string& bin) {
   ojson& json = doc.json;
+  drop_needless_strides(doc);
   const size_t views = doc.count_of("bufferViews");
   std::set<uint64_t> used;
   if (views_all_known(json)) {

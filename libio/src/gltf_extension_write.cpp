@@ -3,8 +3,8 @@
 // a buffer view. The encoder decodes its own stream and writes the
 // primitive's accessors from the decoded mesh (count, type, min / max; with
 // --fallback their data too), so that accessors and stream agree. Attributes
-// the stream does not hold exactly enough (float WEIGHTS_n, float custom
-// attributes, morph targets) are written as ordinary accessors in the
+// the stream does not hold exactly enough (float custom attributes, morph
+// targets) are written as ordinary accessors in the
 // decoded vertex order, which a second encoding with a vertex-number
 // attribute tells (checked to give the same mesh).
 // Also the top-level transcoder: load, decode compressed input, compress (or
@@ -37,17 +37,53 @@ struct Slot {
   size_t accessor = 0;
   AccessorData data;
   int stream = -1;  // index in the stream's attributes; -1: an ordinary accessor
+  // The accessor the stream's values fill.
+  int out_type = kFloat;
+  bool out_normalized = false;
 };
 
 bool starts_with(const std::string& s, const char* prefix) { return s.compare(0, std::strlen(prefix), prefix) == 0; }
 
+// Float skin weights as normalized unsigned shorts (a type the glTF core
+// allows for WEIGHTS_n), each vertex's summing to exactly 65535 when its
+// floats sum to 1: coded exactly from there.
+std::vector<float> weights_u16(const AccessorData& d) {
+  std::vector<float> out(d.raw.size());
+  for (size_t i = 0; i < d.count; ++i) {
+    double sum = 0, qsum = 0;
+    size_t largest = 0;
+    for (uint32_t c = 0; c < d.components; ++c) {
+      const size_t k = i * d.components + c;
+      sum += d.raw[k];
+      out[k] = static_cast<float>(std::nearbyint(std::min(1.0, std::max(0.0, d.raw[k])) * 65535.0));
+      qsum += out[k];
+      if (d.raw[k] > d.raw[i * d.components + largest]) largest = c;
+    }
+    const size_t k = i * d.components + largest;
+    if (std::fabs(sum - 1.0) < 1e-3 && out[k] + (65535.0 - qsum) >= 0 && out[k] + (65535.0 - qsum) <= 65535.0)
+      out[k] += static_cast<float>(65535.0 - qsum);
+  }
+  return out;
+}
+
 // How a primitive attribute goes into the stream: false when it stays an
 // ordinary accessor. Integer accessors are coded exactly (their values and
 // componentType kept); NORMAL as unit vectors; float TEXCOORD_n, COLOR_n and
-// TANGENT quantized.
-bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& att) {
+// TANGENT quantized; float WEIGHTS_n as normalized unsigned shorts.
+bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& att, int& out_type,
+                      bool& out_normalized) {
   att = Attribute();
   att.components = d.components;
+  out_type = kFloat;
+  out_normalized = false;
+  if (starts_with(sem, "WEIGHTS_") && d.component_type == kFloat) {
+    att.name = sem;
+    att.type = AttributeType::u16;
+    att.values = weights_u16(d);
+    out_type = kUShort;
+    out_normalized = true;
+    return true;
+  }
   if (sem == "NORMAL" && d.components == 3) {
     att.name = "normal";
     att.kind = AttributeKind::normal;
@@ -65,6 +101,8 @@ bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& 
                                              : AttributeType::i32;
     if (color && att.type != AttributeType::i32) att.kind = AttributeKind::color;
     att.values.assign(d.raw.begin(), d.raw.end());
+    out_type = d.component_type;
+    out_normalized = d.normalized;
     return true;
   }
   if (starts_with(sem, "TEXCOORD_") && d.components == 2) att.kind = AttributeKind::texcoord;
@@ -123,7 +161,9 @@ void strip_data(ojson& a) {
 }
 
 // The accessor a compressed primitive writes instead of `old`: `old` itself
-// when nothing else names it, else a new one (name, extras kept).
+// when nothing else names it any more (the last of the primitives sharing
+// it: no accessor is left behind, and no index elsewhere changes), else a
+// new one (name, extras kept).
 size_t output_accessor(Document& doc, size_t old, std::vector<int>& refs) {
   --refs[old];
   if (refs[old] == 0) {
@@ -150,7 +190,8 @@ void write_accessor(Document& doc, size_t acc, int ct, bool normalized, uint32_t
   if (min_max) set_min_max(a, raw, components);
   if (!with_data) return;
   size_t stride = 0;
-  a["bufferView"] = add_buffer_view(doc, pack_values(raw, ct, components, target, &stride), target, stride);
+  std::string bytes = pack_values(raw, ct, components, target, &stride);  // sets stride first
+  a["bufferView"] = add_buffer_view(doc, std::move(bytes), target, stride);
 }
 
 // Values of an ordinary accessor in the decoded vertex order.
@@ -264,7 +305,7 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
     if (s.target >= 0) outside = true;
     if (s.target >= 0 || s.semantic == "POSITION") continue;
     Attribute att;
-    if (stream_attribute(s.semantic, s.data, att)) {
+    if (stream_attribute(s.semantic, s.data, att, s.out_type, s.out_normalized)) {
       s.stream = static_cast<int>(mesh.attributes.size());
       mesh.attributes.push_back(std::move(att));
     } else {
@@ -320,8 +361,7 @@ Status Compressor::write(ojson& prim, const std::string& where, std::vector<Slot
                      data, true, kArrayBuffer);
     } else if (s.stream >= 0) {
       const Attribute& att = decoded.attributes[static_cast<size_t>(s.stream)];
-      const bool exact = s.data.component_type != kFloat && att.kind != AttributeKind::normal;
-      write_accessor(doc, acc, exact ? s.data.component_type : kFloat, exact && s.data.normalized, s.data.components,
+      write_accessor(doc, acc, s.out_type, s.out_normalized, s.data.components,
                      std::vector<double>(att.values.begin(), att.values.end()), data, false, kArrayBuffer);
       ext_attributes[s.semantic] = s.stream;
     } else {
@@ -376,7 +416,6 @@ Status embed_images(Document& doc, GltfTranscodeReport& report) {
 
 Status compress_document(Document& doc, const GltfTranscodeOptions& options, GltfTranscodeReport& report) {
   Compressor c{doc, options, report, accessor_references(doc)};
-  const std::vector<int> before = c.refs;
   for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
     ojson& mesh = doc.json["meshes"][m];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
@@ -384,10 +423,6 @@ Status compress_document(Document& doc, const GltfTranscodeOptions& options, Glt
       TSM_RETURN_IF_ERROR(c.primitive(mesh["primitives"][p],
                                       "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]"));
   }
-  // Accessors that compressed primitives shared and nothing names any more:
-  // their data goes (the accessors stay, so no index elsewhere changes).
-  for (size_t a = 0; a < before.size(); ++a)
-    if (before[a] > 1 && c.refs[a] == 0) strip_data(doc.json["accessors"][a]);
   if (report.primitives_compressed > 0) use_extension(doc.json, "TSM_mesh_compression", !options.fallback);
   return Status::Ok();
 }
@@ -461,11 +496,16 @@ Status transcode_gltf_file(const std::string& input, const std::string& output, 
   GltfOutput out;
   TSM_RETURN_IF_ERROR(transcode_gltf(bytes, input, in_dir.string(), options, binary, bin_uri, out, report));
   std::error_code ec;
+  fs::create_directories(out_dir, ec);  // missing folders are made, as for .tsm outputs
   const bool same_dir = fs::equivalent(in_dir, out_dir, ec);
   for (const auto& file : out.files) {
     const bool image = file.first != bin_uri;
     if (image && same_dir) continue;  // already beside the output
     const fs::path target = out_dir / percent_decoded(file.first);
+    if (image && fs::exists(target, ec)) {  // never replaced: it may be another asset's
+      if (report) report->add_note("image " + target.string() + " exists already, left as it is");
+      continue;
+    }
     if (image) fs::create_directories(target.parent_path(), ec);
     TSM_RETURN_IF_ERROR(write_file_atomic(target.string(), file.second));
   }

@@ -49,9 +49,11 @@ Status transcode_gltf(std::string_view bytes, const std::string& name, const std
                       const GltfTranscodeOptions& options, bool binary, const std::string& bin_uri, GltfOutput& out,
                       GltfTranscodeReport* report = nullptr);
 
-// Files: reads `input`, writes `output` (.glb or .gltf by its name, and the
-// .gltf's .bin and images beside it), each atomically. Existing files are
-// replaced only when `force` (the output itself is checked by the caller).
+// Files: reads `input`, writes `output` (.glb or .gltf by its name; for a
+// .gltf also NAME.bin beside it, and the images the document names by
+// relative URI, copied when the output is in another folder and never over
+// an existing file), each atomically. The caller decides whether `output`
+// and NAME.bin may be replaced.
 Status transcode_gltf_file(const std::string& input, const std::string& output, const GltfTranscodeOptions& options,
                            GltfTranscodeReport* report = nullptr);
 
