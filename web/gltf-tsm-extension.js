@@ -43,6 +43,8 @@ export class GLTFTsmExtension {
     this.workerThreshold = options.workerThreshold ?? 256 * 1024;
     this.decoder = options.decoder ? Promise.resolve(options.decoder) : null;
     this.worker = options.worker || null;
+    this.streams = new Map(); // buffer view -> decoded mesh (a promise)
+    this.sources = new Map(); // accessor -> the buffer view its values come from
   }
 
   loadMesh(meshIndex) {
@@ -58,8 +60,12 @@ export class GLTFTsmExtension {
   async primePrimitive(primitive) {
     const parser = this.parser;
     const ext = primitive.extensions[EXTENSION_NAME];
-    const bytes = await parser.getDependency('bufferView', checkIndex(ext.bufferView, parser.json.bufferViews, 'bufferView'));
-    const mesh = await this.decode(new Uint8Array(bytes));
+    const view = checkIndex(ext.bufferView, parser.json.bufferViews, 'bufferView');
+    // one decode per stream, however many primitives or meshes name it
+    if (!this.streams.has(view)) {
+      this.streams.set(view, parser.getDependency('bufferView', view).then((bytes) => this.decode(new Uint8Array(bytes))));
+    }
+    const mesh = await this.streams.get(view);
     const vertexCount = mesh.positions.length / 3;
     if (mesh.faceOffsets) throw new Error(`${EXTENSION_NAME}: the stream has faces that are not triangles`);
     const cache = parser.cache;
@@ -71,6 +77,7 @@ export class GLTFTsmExtension {
         throw new Error(`${EXTENSION_NAME}: ${semantic} is compressed but the primitive has no ${semantic} accessor`);
       }
       const accessor = parser.json.accessors[checkIndex(accessorIndex, parser.json.accessors, 'accessor')];
+      this.claim(accessorIndex, view);
       let values, components, type = 'f32';
       if (semantic === 'POSITION') {
         values = mesh.positions; components = 3;
@@ -84,6 +91,7 @@ export class GLTFTsmExtension {
     }
     if (primitive.indices !== undefined) {
       const accessor = parser.json.accessors[checkIndex(primitive.indices, parser.json.accessors, 'accessor')];
+      this.claim(primitive.indices, view);
       if (accessor.count !== mesh.indices.length) {
         throw new Error(`${EXTENSION_NAME}: the indices accessor has ${accessor.count} entries, the stream ${mesh.indices.length}`);
       }
@@ -92,6 +100,15 @@ export class GLTFTsmExtension {
       cache.add(`accessor:${primitive.indices}`, Promise.resolve(new BufferAttribute(
         Type === Uint32Array ? mesh.indices : Type.from(mesh.indices), 1)));
     }
+  }
+
+  // An accessor takes its values from one stream only.
+  claim(accessorIndex, view) {
+    const other = this.sources.get(accessorIndex);
+    if (other !== undefined && other !== view) {
+      throw new Error(`${EXTENSION_NAME}: accessor ${accessorIndex} is decoded from two streams (buffer views ${other} and ${view})`);
+    }
+    this.sources.set(accessorIndex, view);
   }
 
   decode(bytes) {

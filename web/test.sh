@@ -49,8 +49,10 @@ apt_install() {  # packages...; returns non-zero when they cannot be installed
 }
 
 command -v node >/dev/null && command -v npm >/dev/null || skip "node and npm are not installed"
-# the library's build dependencies (header-only in the wasm build) and Draco's encoder CLI for the bench files
-apt_install libxxhash-dev libzstd-dev libeigen3-dev draco zstd || fail "cannot install libxxhash-dev libzstd-dev libeigen3-dev draco zstd (see build/web/install.log)"
+# the library's build dependencies (header-only in the wasm build), Draco's encoder CLI for the bench files,
+# and Draco's and meshoptimizer's libraries: with them the native CLI reads Draco- and meshopt-compressed glTF (web/test/gltf.mjs)
+apt_install libxxhash-dev libzstd-dev libeigen3-dev draco zstd libdraco-dev libmeshoptimizer-dev ||
+  fail "cannot install libxxhash-dev libzstd-dev libeigen3-dev draco zstd libdraco-dev libmeshoptimizer-dev (see build/web/install.log)"
 apt_install emscripten node-acorn || skip "emscripten cannot be installed (apt-get install emscripten node-acorn failed; build/web/install.log)"
 command -v emcc >/dev/null || skip "emcc not found after installing emscripten"
 apt_install chromium || skip "Chromium cannot be installed (apt-get install chromium failed; build/web/install.log)"

@@ -3,6 +3,7 @@
 // with the same camera and lights.
 // Query: ?a=URL (the compressed file) &b=URL (the original; optional)
 //        &worker=BYTES (the plugin's workerThreshold) &plain=1 (no plugin) &size=PX
+//        &t=SECONDS (the time in the first animation clip drawn, default 0.7)
 // Without a=, the assets of /data/gltf/index.json are offered.
 // window.tsmGltf: { state: 'loading' | 'done' | 'error', views: [{ url, loadMs,
 // meshes: [{ name, vertexCount, indexCount, attributes: { name: { itemSize,
@@ -108,6 +109,12 @@ async function main() {
     const t0 = performance.now();
     const gltf = await loader().loadAsync(url);
     const loadMs = performance.now() - t0;
+    // Animated assets are drawn 0.7 s into their first clip: a posed skin shows its joints and weights.
+    if (gltf.animations.length) {
+      const mixer = new THREE.AnimationMixer(gltf.scene);
+      mixer.clipAction(gltf.animations[0]).play();
+      mixer.update(Number(params.get('t') || 0.7));
+    }
     camera = camera || cameraFor(gltf.scene);
     const meshes = describe(gltf.scene);
     const v = meshes.reduce((s, m) => s + m.vertexCount, 0), t = meshes.reduce((s, m) => s + (m.indexCount || m.vertexCount) / 3, 0);

@@ -147,9 +147,11 @@ async function view(page, query) {
   return page.evaluate(() => window.tsmGltf);
 }
 // what three.js made of an asset: per mesh, counts and attributes (name, itemSize, normalized)
-// (triangles: tsm writes indices for a primitive that had none, 0 1 2 ...)
+// (triangles: tsm writes indices for a primitive that had none, 0 1 2 ...;
+// normalized flags but skinWeight's: tsm writes float WEIGHTS_n as normalized u16)
 const shape = (v, transcoded) => v.meshes.map((m) => ({ vertices: m.vertexCount, triangles: (m.indexCount ?? m.vertexCount) / 3, skinned: m.skinned,
-  attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized && !transcoded ? 'n' : ''}`).sort().join(' ') }));
+  attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized && !transcoded && k !== 'skinWeight' ? 'n' : ''}`)
+    .sort().join(' ') }));
 try {
   const page = await browser.newPage({ viewport: { width: 1000, height: 560 } });
   page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
@@ -234,12 +236,20 @@ try {
       res.badAttribute = await load(withJson((j) => { prim(j).extensions.TSM_mesh_compression.attributes.NORMAL = 99; }), Infinity);
       res.badCount = await load(withJson((j) => { j.accessors[prim(j).attributes.POSITION].count += 1; }), Infinity);
       res.badView = await load(withJson((j) => { prim(j).extensions.TSM_mesh_compression.bufferView = 1e6; }), Infinity);
+      // a second primitive naming the same accessors with another stream (a copy of the view under a new number)
+      res.twoStreams = await load(withJson((j) => {
+        const ext = prim(j).extensions.TSM_mesh_compression;
+        j.bufferViews.push({ ...j.bufferViews[ext.bufferView] });
+        const copy = structuredClone(prim(j));
+        copy.extensions.TSM_mesh_compression.bufferView = j.bufferViews.length - 1;
+        j.meshes[0].primitives.push(copy);
+      }), Infinity);
       res.after = await load(bytes, Infinity);
       return res;
     }, assets[0].variants[0].url);
     const named = (x) => x.includes('TSM_mesh_compression');
     if (r.flipped.startsWith('TsmError') && r.flippedWorker.startsWith('TsmError') && r.zeroed.startsWith('TsmError') &&
-        named(r.badAttribute) && named(r.badCount) && named(r.badView) && r.after === 'loaded')
+        named(r.badAttribute) && named(r.badCount) && named(r.badView) && named(r.twoStreams) && r.after === 'loaded')
       ok(`damaged streams and lying JSON refused: ${JSON.stringify(r)}`);
     else fail(`damaged streams: ${JSON.stringify(r)}`);
   }
