@@ -811,15 +811,21 @@ int cmd_encode(const EncodeArgs& a) {
     return usage_error("--max-error " + a.max_error +
                        ": give a positive number in model units, or a percentage of the bounding-box diagonal such "
                        "as 0.5%");
+  if (a.fallback && format_from_extension(a.output) != MeshFormat::gltf &&
+      format_from_extension(a.output) != MeshFormat::glb)
+    return usage_error("--fallback keeps an uncompressed copy inside a glTF output; give -o NAME.glb or NAME.gltf, "
+                       "or drop it");
+  // A glTF name: a glTF with TSM_mesh_compression, from one input file.
+  const MeshFormat output_format = format_from_extension(a.output);
+  if (output_format == MeshFormat::gltf || output_format == MeshFormat::glb) {
+    if (gltf_output(a, a.output)) return gltf_encode(a);
+    return usage_error(a.output + ": a glTF output (TSM_mesh_compression) takes one input file (not stdin); run "
+                       "once per file, or give -o DIR/ for .tsm files");
+  }
   // encode writes .tsm data: a mesh file name for it would be a lie.
   if (single_file_output(a.inputs, a.output)) {
     const MeshFormat f = format_from_extension(a.output);
     const std::string tsm_name = with_extension(a.output, ".tsm");
-    if (f == MeshFormat::gltf || f == MeshFormat::glb) {
-      if (gltf_output(a, a.output)) return gltf_encode(a);
-      return usage_error(a.output + ": a glTF output (TSM_mesh_compression) takes one input file; for several, give "
-                         "-o " + tsm_name + " or run once per file");
-    }
     if (f != MeshFormat::unknown)
       return usage_error(a.output + ": encode writes .tsm files, not " + mesh_format_name(f) + "; give -o " +
                          tsm_name + " (tsm decode turns the .tsm back into " + mesh_format_name(f) + ")");

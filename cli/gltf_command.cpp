@@ -73,6 +73,8 @@ int run(const std::string& input, const std::string& output, const GltfTranscode
     const std::string bin_uri = fs::path(output).stem().string() + ".bin";
     if (s.ok()) s = transcode_gltf(plain, input, "", options, binary, bin_uri, out, &report);
     const fs::path dir = fs::path(output).parent_path();
+    std::error_code ec;
+    if (!dir.empty()) fs::create_directories(dir, ec);
     for (size_t i = 0; s.ok() && i < out.files.size(); ++i)
       s = write_file_atomic((dir / out.files[i].first).string(), out.files[i].second);
     if (s.ok()) s = write_file_atomic(output, out.main);

@@ -1038,12 +1038,26 @@ TEST_F(CliBatch, OutputNamesSayWhatTheyHold) {
     EXPECT_NE(r.err.find("tsm decode"), std::string::npos) << name << ": " << r.err;
     EXPECT_FALSE(fs::exists(file(name))) << name;
   }
+  // A glTF name: a glTF with TSM_mesh_compression (one input only); decode
+  // gives a plain glTF back; --fallback is for glTF outputs only.
   for (const char* name : {"x.glb", "x.gltf"}) {
+    r = tsm("encode " + q("a.ply") + " " + q("b.obj") + " -o " + q(name));
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("takes one input file"), std::string::npos) << r.err;
+    r = tsm("encode " + q("a.ply") + " -o " + q(name) + " --quiet");
+    EXPECT_EQ(r.code, 0) << name << ": " << r.err;
+    EXPECT_NE(slurp(file(name)).find("\"extensionsRequired\":[\"TSM_mesh_compression\"]"), std::string::npos) << name;
     r = tsm("encode " + q("a.ply") + " -o " + q(name));
     EXPECT_EQ(r.code, 2) << name << ": " << r.err;
-    EXPECT_NE(r.err.find("glTF output of compressed meshes is not supported yet"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(file(name))) << name;
+    EXPECT_NE(r.err.find("already exists"), std::string::npos) << r.err;
+    r = tsm("decode " + q(name) + " -o " + q("plain.glb") + " -f --quiet");
+    EXPECT_EQ(r.code, 0) << name << ": " << r.err;
+    EXPECT_EQ(slurp(file("plain.glb")).find("TSM_mesh_compression"), std::string::npos) << name;
   }
+  EXPECT_TRUE(fs::is_regular_file(file("x.bin")));
+  r = tsm("encode " + q("a.ply") + " -o " + q("x2.tsm") + " --fallback");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--fallback"), std::string::npos) << r.err;
   // Missing folders of a single output are created.
   r = tsm("encode " + q("a.ply") + " -o " + q("nodir/x/y.tsm") + " --quiet");
   EXPECT_EQ(r.code, 0) << r.err;

@@ -32,6 +32,10 @@ namespace tsm::gltf {
 namespace {
 
 constexpr size_t kMaxDecodedView = size_t(1) << 30;
+// meshoptimizer's codecs shrink data at most 64 times (the vertex codec's
+// 2-bit header per 16 bytes): a view claiming more is refused before the
+// allocation.
+constexpr uint64_t kMaxMeshoptRatio = 128;
 
 // The bytes of a buffer view (checked), for an extension's stream.
 Status stream_bytes(const Document& doc, const ojson& ext, const std::string& where, std::string_view& out) {
@@ -142,7 +146,7 @@ Status decode_meshopt_view(Document& doc, size_t index, const char* name) {
     return doc.error(where + ": bytes " + std::to_string(offset) + "+" + std::to_string(length) +
                      " lie outside buffers[" + std::to_string(buffer) + "]");
   if (stride == 0 || stride > 256 || count == 0 || count > kMaxDecodedView / stride ||
-      count * stride > view.value("byteLength", uint64_t(0)))
+      count * stride > view.value("byteLength", uint64_t(0)) || count * stride > kMaxMeshoptRatio * length + 4096)
     return doc.error(where + ": byteStride " + std::to_string(stride) + " x count " + std::to_string(count) +
                      " does not fit the buffer view");
   const auto* src = reinterpret_cast<const unsigned char*>(data.data() + offset);

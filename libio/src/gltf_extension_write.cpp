@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -249,11 +250,35 @@ Status read_slots(const Document& doc, const ojson& prim, const std::string& whe
   return Status::Ok();
 }
 
+// Primitives that share a vertex buffer each use part of it: each keeps only
+// the vertices its triangles use (in their order), so that every stream
+// holds its own vertices once.
+void compact_vertices(std::vector<Slot>& slots, std::vector<uint32_t>& idx, size_t n) {
+  std::vector<uint32_t> remap(n, UINT32_MAX);
+  for (uint32_t v : idx) remap[v] = 0;
+  std::vector<uint32_t> kept;
+  for (size_t v = 0; v < n; ++v)
+    if (remap[v] == 0) {
+      remap[v] = static_cast<uint32_t>(kept.size());
+      kept.push_back(static_cast<uint32_t>(v));
+    }
+  if (kept.size() == n) return;
+  for (uint32_t& v : idx) v = remap[v];
+  for (Slot& s : slots) {
+    s.data.raw = reordered(s.data, kept);
+    s.data.count = kept.size();
+  }
+}
+
 struct Compressor {
   Document& doc;
   const GltfTranscodeOptions& options;
   GltfTranscodeReport& report;
   std::vector<int> refs;
+  // Values the primitives may read in all: accessors shared by many
+  // primitives are read (and encoded) once per primitive, so a small file
+  // naming one accessor from thousands of primitives is refused, not run.
+  size_t budget = 0;
 
   Status primitive(ojson& prim, const std::string& where);
   Status write(ojson& prim, const std::string& where, std::vector<Slot>& slots, const Mesh& decoded,
@@ -272,6 +297,12 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
   if (!prim["attributes"].contains("POSITION")) return keep("no POSITION");
   std::vector<Slot> slots;
   TSM_RETURN_IF_ERROR(read_slots(doc, prim, where, slots));
+  for (const Slot& s : slots) {
+    if (s.data.raw.size() > budget)
+      return doc.error(where + ": the primitives read their shared accessors over and over (more values than 64 "
+                               "times the file's bytes); refused");
+    budget -= s.data.raw.size();
+  }
   const Slot* position = nullptr;
   for (const Slot& s : slots)
     if (s.semantic == "POSITION" && s.target < 0) position = &s;
@@ -294,6 +325,7 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
   for (uint32_t v : idx)
     if (v >= n) return doc.error(where + ": a triangle index is past the vertex count " + std::to_string(n));
   if (idx.empty()) return keep("no triangles");
+  compact_vertices(slots, idx, n);
 
   Mesh mesh;
   mesh.positions = position->data.values();
@@ -415,7 +447,8 @@ Status embed_images(Document& doc, GltfTranscodeReport& report) {
 }  // namespace
 
 Status compress_document(Document& doc, const GltfTranscodeOptions& options, GltfTranscodeReport& report) {
-  Compressor c{doc, options, report, accessor_references(doc)};
+  Compressor c{doc, options, report, accessor_references(doc), size_t(1) << 20};
+  for (const std::string& b : doc.buffers) c.budget += 64 * b.size();
   for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
     ojson& mesh = doc.json["meshes"][m];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
