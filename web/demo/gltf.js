@@ -6,7 +6,7 @@
 //        &t=SECONDS (the time in the first animation clip drawn, default 0.7)
 // Without a=, the assets of /data/gltf/index.json are offered.
 // window.tsmGltf: { state: 'loading' | 'done' | 'error', views: [{ url, loadMs,
-// meshes: [{ name, vertexCount, indexCount, attributes: { name: { itemSize,
+// meshes: [{ name, vertexCount, usedVertices, indexCount, attributes: { name: { itemSize,
 // normalized, array } } }] }], diff (a against b: { meanAbs, over32, pixels, drawn }) }.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -38,7 +38,9 @@ function describe(scene) {
     const attributes = {};
     for (const [name, a] of Object.entries(g.attributes))
       attributes[name] = { itemSize: a.itemSize, normalized: a.normalized, array: a.array.constructor.name, count: a.count };
-    meshes.push({ name: o.name, vertexCount: g.attributes.position.count, indexCount: g.index ? g.index.count : null,
+    // the vertices the triangles use (tsm keeps only those)
+    const usedVertices = g.index ? new Set(g.index.array).size : g.attributes.position.count;
+    meshes.push({ name: o.name, vertexCount: g.attributes.position.count, usedVertices, indexCount: g.index ? g.index.count : null,
       attributes, skinned: !!o.isSkinnedMesh });
   });
   return meshes;

@@ -147,9 +147,10 @@ async function view(page, query) {
   return page.evaluate(() => window.tsmGltf);
 }
 // what three.js made of an asset: per mesh, counts and attributes (name, itemSize, normalized)
-// (triangles: tsm writes indices for a primitive that had none, 0 1 2 ...;
-// normalized flags but skinWeight's: tsm writes float WEIGHTS_n as normalized u16)
-const shape = (v, transcoded) => v.meshes.map((m) => ({ vertices: m.vertexCount, triangles: (m.indexCount ?? m.vertexCount) / 3, skinned: m.skinned,
+// (vertices the triangles use: tsm keeps those only; triangles: tsm writes
+// indices for a primitive that had none, 0 1 2 ...; normalized flags but
+// skinWeight's: tsm writes float WEIGHTS_n as normalized u16)
+const shape = (v, transcoded) => v.meshes.map((m) => ({ vertices: m.usedVertices, triangles: (m.indexCount ?? m.vertexCount) / 3, skinned: m.skinned,
   attributes: Object.entries(m.attributes).map(([k, a]) => `${k}:${a.itemSize}${a.normalized && !transcoded && k !== 'skinWeight' ? 'n' : ''}`)
     .sort().join(' ') }));
 try {
@@ -172,6 +173,8 @@ try {
           const [got, want] = r.views.map((x) => shape(x, a.transcoded));
           if (JSON.stringify(got) !== JSON.stringify(want))
             diffs.push(`meshes differ: tsm ${JSON.stringify(got)}, original ${JSON.stringify(want)}`);
+          const unused = r.views[0].meshes.filter((m) => m.vertexCount !== m.usedVertices);
+          if (unused.length) diffs.push(`vertices no triangle uses: ${unused.map((m) => `${m.name} ${m.vertexCount - m.usedVertices}`).join(', ')}`);
           if (!(r.diff.drawn > 0.05)) diffs.push(`the original covers ${(100 * r.diff.drawn).toFixed(1)}% of the picture: nothing to compare`);
           if (!(r.diff.meanAbs <= MAX_MEAN_ABS && r.diff.over32 <= MAX_OVER32))
             diffs.push(`rendering differs: mean ${r.diff.meanAbs.toFixed(3)} levels, ${(100 * r.diff.over32).toFixed(2)}% pixels off by > 32`);
@@ -180,7 +183,9 @@ try {
         if (diffs.length) fail(`${label}: ${diffs.join('; ')}`);
         else {
           const m = r.views[0].meshes;
-          ok(`${label}: ${m.length} mesh(es), ${m.reduce((s, x) => s + x.vertexCount, 0)} vertices, ` +
+          const dropped = r.views[1].meshes.reduce((s, x) => s + x.vertexCount, 0) - m.reduce((s, x) => s + x.vertexCount, 0);
+          ok(`${label}: ${m.length} mesh(es), ${m.reduce((s, x) => s + x.vertexCount, 0)} vertices` +
+            `${dropped ? ` (the original's ${dropped} unused ones dropped)` : ''}, ` +
             `${m.reduce((s, x) => s + (x.indexCount ?? x.vertexCount), 0) / 3} triangles, attributes as the original's; rendering: mean ` +
             `${r.diff.meanAbs.toFixed(3)} levels, ${(100 * r.diff.over32).toFixed(3)}% of ${r.diff.pixels} pixels off by > 32 ` +
             `(the model covers ${(100 * r.diff.drawn).toFixed(0)}%); ` +

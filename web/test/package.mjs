@@ -66,9 +66,10 @@ console.log(JSON.stringify({ version: tsm.version, vertices: mesh.vertexCount, f
 let r = null;
 try { r = JSON.parse(run(process.execPath, ['client.mjs'], { cwd: scratch })); } catch (e) { check(false, `client.mjs: ${e.stderr || e.message}`); }
 if (r) {
-  // the sphere of web/test/sphere-glb.mjs: 25 × 41 vertices, 2 × 24 × 40 − 80 triangles
+  // the sphere of web/test/sphere-glb.mjs: 25 × 41 vertices, 2 × 24 × 40 − 80 triangles, which use all
+  // vertices but 2 (the first of the top row, the last of the bottom one): the .tsm keeps them, the glTF writer not
   check(r.vertices === 1025 && r.faces === 1840 && r.kinds.join() === 'normal,texcoord,color' && r.refused !== '' &&
-    r.three.vertices === 1025 && r.three.indices === 3 * 1840 && r.three.attributes.join() === 'color,normal,position,uv' &&
+    r.three.vertices === 1023 && r.three.indices === 3 * 1840 && r.three.attributes.join() === 'color,normal,position,uv' &&
     r.three.colorType === 'Uint8Array' && r.three.colorNormalized, `imported by name under Node: ${JSON.stringify(r)}`);
 }
 

@@ -1,6 +1,8 @@
 // A generated test asset: a UV sphere (one primitive, u16 indices) with
 // float normals, texture coordinates and u8 normalized RGBA colours, as a
-// plain .glb: the mesh the glTF tests have without the corpus.
+// plain .glb: the mesh the glTF tests have without the corpus. Two of its
+// vertices are used by no triangle (the first of the top row, the last of the
+// bottom one).
 import { BinWriter, writeGlb } from './glb.mjs';
 
 export function sphereGlb(rings = 24, sectors = 40) {
