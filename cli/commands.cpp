@@ -22,6 +22,7 @@
 
 #include "batch.hpp"
 #include "cli_util.hpp"
+#include "tsm/gltf_transcode.hpp"
 #include "tsm/io.hpp"
 
 namespace tsm::cli {
@@ -247,6 +248,20 @@ Status parse_mesh_as(std::string_view bytes, const std::string& input, MeshForma
   if (input != "-" && ro.external_files_dir.empty()) {
     const std::string dir = fs::path(input).parent_path().string();
     ro.external_files_dir = dir.empty() ? "." : dir;
+  }
+  // glTF with compressed primitives (Draco, meshopt, tsm's own extension):
+  // decoded to a plain glTF first, which the reader takes.
+  const MeshFormat gltf_kind = forced != MeshFormat::unknown ? forced : sniff_format(bytes);
+  if ((gltf_kind == MeshFormat::gltf || gltf_kind == MeshFormat::glb) &&
+      (bytes.find("KHR_draco_mesh_compression") != std::string_view::npos ||
+       bytes.find("_meshopt_compression") != std::string_view::npos ||
+       bytes.find("TSM_mesh_compression") != std::string_view::npos)) {
+    GltfTranscodeOptions plain_options;
+    plain_options.compress = false;
+    GltfOutput plain;
+    TSM_RETURN_IF_ERROR(transcode_gltf(bytes, name, ro.external_files_dir, plain_options, true, "", plain));
+    info = ReadInfo();
+    return read_gltf(plain.main, name, mesh, ro, &info);
   }
   if (forced == MeshFormat::unknown) {
     if (input == "-" && bytes.empty())
@@ -813,13 +828,15 @@ int cmd_encode(const EncodeArgs& a) {
                        "as 0.5%");
   if (a.fallback && format_from_extension(a.output) != MeshFormat::gltf &&
       format_from_extension(a.output) != MeshFormat::glb)
-    return usage_error("--fallback keeps an uncompressed copy inside a glTF output; give -o NAME.glb or NAME.gltf, "
-                       "or drop it");
+    return usage_error(
+        "--fallback keeps an uncompressed copy inside a glTF output; give -o NAME.glb or NAME.gltf, "
+        "or drop it");
   // A glTF name: a glTF with TSM_mesh_compression, from one input file.
   const MeshFormat output_format = format_from_extension(a.output);
   if (output_format == MeshFormat::gltf || output_format == MeshFormat::glb) {
     if (gltf_output(a, a.output)) return gltf_encode(a);
-    return usage_error(a.output + ": a glTF output (TSM_mesh_compression) takes one input file (not stdin); run "
+    return usage_error(a.output +
+                       ": a glTF output (TSM_mesh_compression) takes one input file (not stdin); run "
                        "once per file, or give -o DIR/ for .tsm files");
   }
   // encode writes .tsm data: a mesh file name for it would be a lie.

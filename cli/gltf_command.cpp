@@ -42,8 +42,7 @@ int check_files(const BatchArgs& a, const std::string& output, bool force, const
   if (a.json) return refuse("--json is not available with a glTF output; drop it");
   std::error_code ec;
   if (!fs::exists(a.inputs[0], ec)) return fail(Status(ErrorCode::io_error, a.inputs[0] + ": no such file"));
-  if (fs::equivalent(a.inputs[0], output, ec))
-    return refuse(output + ": is the input; give another output name");
+  if (fs::equivalent(a.inputs[0], output, ec)) return refuse(output + ": is the input; give another output name");
   if (!force && fs::exists(output, ec)) return refuse(output + ": already exists; pass -f (--force) to overwrite it");
   // A .gltf output's buffer file beside it.
   if (format_from_extension(output) == MeshFormat::gltf) {
@@ -83,7 +82,7 @@ int run(const std::string& input, const std::string& output, const GltfTranscode
   if (quiet) return kExitOk;
   if (!report.notes.empty()) std::fprintf(stderr, "tsm: note: %s\n", printable(report.notes).c_str());
   std::error_code ec;
-  const auto in_bytes = fs::file_size(input, ec), out_bytes = fs::file_size(output, ec);
+  const auto out_bytes = fs::file_size(output, ec);
   std::string what;
   if (options.compress)
     what = strf(", %s compressed (%s, %s; streams %s), %zu kept",
@@ -93,7 +92,6 @@ int run(const std::string& input, const std::string& output, const GltfTranscode
                 count_of(report.stream_bytes, "byte", "bytes").c_str(), report.primitives_kept);
   std::printf("%s: %s -> %s: %s%s\n", printable(input).c_str(), verb, printable(output).c_str(),
               count_of(static_cast<unsigned long long>(out_bytes), "byte", "bytes").c_str(), what.c_str());
-  (void)in_bytes;
   return kExitOk;
 }
 
@@ -119,8 +117,9 @@ int gltf_encode(const EncodeArgs& a) {
 int gltf_decode(const DecodeArgs& a) {
   if (int rc = check_files(a, a.output, a.force, "decode")) return rc;
   if (!is_gltf_name(a.inputs[0]))
-    return refuse(a.inputs[0] + ": decode writes glTF from a glTF (.glb / .gltf) input; a .tsm file decodes to "
-                                "glTF through its own name: tsm decode NAME.tsm -o NAME.glb");
+    return refuse(a.inputs[0] +
+                  ": decode writes glTF from a glTF (.glb / .gltf) input; a .tsm file decodes to "
+                  "glTF through its own name: tsm decode NAME.tsm -o NAME.glb");
   GltfTranscodeOptions o;
   o.compress = false;
   return run(a.inputs[0], a.output, o, a.quiet, "plain glTF");

@@ -146,14 +146,15 @@ size_t add_view(json& doc, std::string& bin, const std::string& bytes, int targe
 
 size_t add_accessor(json& doc, std::string& bin, const std::string& bytes, int ct, const char* type, size_t count,
                     int target, bool normalized = false) {
-  json a = {{"bufferView", add_view(doc, bin, bytes, target)}, {"componentType", ct}, {"count", count},
-            {"type", type}};
+  json a = {{"bufferView", add_view(doc, bin, bytes, target)}, {"componentType", ct}, {"count", count}, {"type", type}};
   if (normalized) a["normalized"] = true;
   doc["accessors"].push_back(a);
   return doc["accessors"].size() - 1;
 }
 
-std::string floats(const std::vector<float>& v) { return std::string(reinterpret_cast<const char*>(v.data()), v.size() * 4); }
+std::string floats(const std::vector<float>& v) {
+  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * 4);
+}
 
 Source make_source() {
   Source s;
@@ -218,11 +219,14 @@ Source make_source() {
   doc["accessors"][times]["min"] = {0.0};
   doc["accessors"][times]["max"] = {1.0};
   const size_t rot = add_accessor(doc, bin, floats({0, 0, 0, 1, 0, 0.7071f, 0, 0.7071f}), 5126, "VEC4", 2, 0);
-  const json attrs = {{"POSITION", pos}, {"NORMAL", nor}, {"TEXCOORD_0", uv}, {"JOINTS_0", jnt}, {"WEIGHTS_0", wts},
-                      {"_CUSTOM", cus}, {"_FLAG", flg}};
+  const json attrs = {{"POSITION", pos},  {"NORMAL", nor},  {"TEXCOORD_0", uv}, {"JOINTS_0", jnt},
+                      {"WEIGHTS_0", wts}, {"_CUSTOM", cus}, {"_FLAG", flg}};
   doc["meshes"] = {{{"name", "sphere"},
                     {"primitives",
-                     {{{"attributes", attrs}, {"indices", i0}, {"material", 0}, {"targets", {{{"POSITION", tgt}}}},
+                     {{{"attributes", attrs},
+                       {"indices", i0},
+                       {"material", 0},
+                       {"targets", {{{"POSITION", tgt}}}},
                        {"extras", {{"part", "a"}}}},
                       {{"attributes", attrs}, {"indices", i1}, {"material", 1}},
                       {{"attributes", {{"POSITION", pos}}}, {"indices", i1}, {"mode", 1}}}},
@@ -236,9 +240,8 @@ Source make_source() {
                   {{"name", "joint"}},
                   {{"name", "root"}, {"children", {1}}}};
   doc["skins"] = {{{"joints", {1}}, {"inverseBindMatrices", inv}}};
-  doc["animations"] = {
-      {{"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}}}},
-       {"samplers", {{{"input", times}, {"output", rot}, {"interpolation", "LINEAR"}}}}}};
+  doc["animations"] = {{{"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}}}},
+                        {"samplers", {{{"input", times}, {"output", rot}, {"interpolation", "LINEAR"}}}}}};
   doc["buffers"] = {{{"byteLength", (bin.size() + 3) / 4 * 4}}};
   s.doc = doc;
   s.glb = make_glb(doc, bin);
@@ -316,7 +319,8 @@ void check_primitive(const Glb& g, const json& prim, const Source& s, const std:
   for (size_t t = 0; t < tris.size(); t += 3) want.insert(key(tris[t], tris[t + 1], tris[t + 2]));
   const std::vector<double> ix = accessor_values(g, prim["indices"]);
   for (size_t t = 0; t + 2 < ix.size(); t += 3)
-    got.insert(key(id[static_cast<size_t>(ix[t])], id[static_cast<size_t>(ix[t + 1])], id[static_cast<size_t>(ix[t + 2])]));
+    got.insert(
+        key(id[static_cast<size_t>(ix[t])], id[static_cast<size_t>(ix[t + 1])], id[static_cast<size_t>(ix[t + 2])]));
   EXPECT_EQ(got, want);
 }
 
@@ -350,7 +354,8 @@ TEST(GltfExtension, CompressedGlbDecodesToTheSourceAndKeepsTheDocument) {
     // The stream is a .tsm file.
     const json& view = c.doc["bufferViews"][ext["bufferView"].get<size_t>()];
     tsm::Mesh m;
-    ASSERT_TRUE(tsm::decode(c.bin.substr(view.value("byteOffset", size_t(0)), view["byteLength"].get<size_t>()), m).ok());
+    ASSERT_TRUE(
+        tsm::decode(c.bin.substr(view.value("byteOffset", size_t(0)), view["byteLength"].get<size_t>()), m).ok());
     // Every accessor of the primitive has the stream's counts (primitive 1
     // keeps only the vertices its triangles use).
     for (const auto& kv : prim["attributes"].items())
@@ -419,8 +424,9 @@ TEST(GltfExtension, HostileInputGivesErrors) {
   std::string packed;
   ASSERT_TRUE(transcode(s.glb, true, false, packed).ok());
   Glb c = split_glb(packed);
-  const json& view = c.doc["bufferViews"][c.doc["meshes"][0]["primitives"][0]["extensions"]["TSM_mesh_compression"]
-                                              ["bufferView"].get<size_t>()];
+  const json& view =
+      c.doc["bufferViews"]
+           [c.doc["meshes"][0]["primitives"][0]["extensions"]["TSM_mesh_compression"]["bufferView"].get<size_t>()];
   const size_t at = view.value("byteOffset", size_t(0)), len = view["byteLength"];
   for (size_t k = at + len / 3; k < at + len / 3 + 16; ++k) c.bin[k] ^= 0x5A;
   st = transcode(make_glb(c.doc, c.bin), false, false, out);
@@ -433,7 +439,8 @@ TEST(GltfExtension, HostileInputGivesErrors) {
   EXPECT_TRUE(contains(st.message(), "attributes.NORMAL")) << st.message();
   // Truncated container, JSON nested too deep.
   EXPECT_FALSE(transcode(s.glb.substr(0, s.glb.size() / 2), true, false, out).ok());
-  std::string deep = "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + std::string(5000, '[') + std::string(5000, ']') + "}";
+  std::string deep =
+      "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + std::string(5000, '[') + std::string(5000, ']') + "}";
   st = transcode(deep, true, false, out);
   EXPECT_TRUE(contains(st.message(), "nested")) << st.message();
 }
@@ -441,9 +448,7 @@ TEST(GltfExtension, HostileInputGivesErrors) {
 TEST(GltfExtension, ExternalFilesStayInTheFolder) {
   const fs::path dir = fs::temp_directory_path() / ("tsm_gltf_ext_" + std::to_string(::getpid()));
   fs::create_directories(dir / "in");
-  {
-    std::ofstream(dir / "secret.bin", std::ios::binary) << std::string(64, 'x');
-  }
+  { std::ofstream(dir / "secret.bin", std::ios::binary) << std::string(64, 'x'); }
   json doc = {{"asset", {{"version", "2.0"}}}, {"buffers", {{{"uri", "../secret.bin"}, {"byteLength", 64}}}}};
   tsm::GltfOutput out;
   tsm::Status st = tsm::transcode_gltf(doc.dump(), "in.gltf", (dir / "in").string(), {}, true, "x.bin", out);
@@ -473,7 +478,8 @@ std::vector<std::pair<size_t, size_t>> primitive_counts(const Glb& g) {
   for (const json& m : g.doc["meshes"])
     for (const json& p : m["primitives"]) {
       const size_t v = g.doc["accessors"][p["attributes"]["POSITION"].get<size_t>()]["count"];
-      const size_t t = p.contains("indices") ? g.doc["accessors"][p["indices"].get<size_t>()]["count"].get<size_t>() : v;
+      const size_t t =
+          p.contains("indices") ? g.doc["accessors"][p["indices"].get<size_t>()]["count"].get<size_t>() : v;
       out.emplace_back(v, t);
     }
   return out;
@@ -510,9 +516,10 @@ TEST(GltfExtensionCorpus, AssetsRoundTripWithTheirCounts) {
   TSM_REQUIRE_CORPUS();
   const fs::path tmp = fs::temp_directory_path() / ("tsm_gltf_assets_" + std::to_string(::getpid()));
   fs::create_directories(tmp);
-  for (const char* rel : {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf", "assets/2CylinderEngine.glb",
-                          "assets/MultiUVTest/MultiUVTest.gltf", "assets/VertexColorTest/VertexColorTest.gltf",
-                          "assets/Box_Draco.glb", "assets/2CylinderEngine_Draco/2CylinderEngine.gltf"}) {
+  for (const char* rel :
+       {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf", "assets/2CylinderEngine.glb",
+        "assets/MultiUVTest/MultiUVTest.gltf", "assets/VertexColorTest/VertexColorTest.gltf", "assets/Box_Draco.glb",
+        "assets/2CylinderEngine_Draco/2CylinderEngine.gltf"}) {
     SCOPED_TRACE(rel);
     const std::string in = tsm_test::corpus_file(rel);
     ASSERT_TRUE(transcode_file(in, tmp / "plain_in.glb", false).ok());
@@ -553,5 +560,22 @@ TEST(GltfExtensionCorpus, MeshoptInputFromGltfpackTranscodes) {
   for (const json& v : a.doc["bufferViews"]) EXPECT_FALSE(v.contains("extensions")) << v.dump();
   expect_same_primitives(primitive_counts(a), primitive_counts(b));
   EXPECT_FALSE(primitive_counts(a).empty());
+  fs::remove_all(tmp);
+}
+
+TEST(GltfExtensionCorpus, CompressedGltfEncodesToTsmThroughTheTool) {
+  TSM_REQUIRE_CORPUS();
+  const fs::path tmp = fs::temp_directory_path() / ("tsm_gltf_cli_" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  const std::string in = tsm_test::corpus_file("assets/2CylinderEngine_Draco/2CylinderEngine.gltf");
+  const std::string cmd = std::string("'") + TSM_CLI_PATH + "' encode '" + in + "' -o '" + (tmp / "d.tsm").string() +
+                          "' --quiet 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  tsm::Mesh m;
+  ASSERT_TRUE(tsm::decode(slurp(tmp / "d.tsm"), m).ok());
+  ASSERT_TRUE(transcode_file(in, tmp / "plain.glb", false).ok());
+  size_t triangles = 0;
+  for (const auto& vt : primitive_counts(split_glb(slurp(tmp / "plain.glb")))) triangles += vt.second / 3;
+  EXPECT_EQ(m.face_count(), triangles);
   fs::remove_all(tmp);
 }

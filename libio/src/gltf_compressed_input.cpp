@@ -68,8 +68,8 @@ Status accessor_shape(const Document& doc, size_t acc, int& ct, uint32_t& compon
 }
 
 // The semantic -> accessor map of a primitive, checked.
-Status primitive_accessor(const Document& doc, const ojson& prim, const std::string& semantic,
-                          const std::string& where, size_t& acc) {
+Status primitive_accessor(const Document& doc, const ojson& prim, const std::string& semantic, const std::string& where,
+                          size_t& acc) {
   const ojson& attrs = prim["attributes"];
   int64_t a = -1;
   TSM_RETURN_IF_ERROR(doc.index_of(attrs, semantic.c_str(), doc.count_of("accessors"), where + ".attributes", a));
@@ -119,8 +119,10 @@ Status decode_draco(Document& doc, ojson& prim, const std::string& where) {
       const draco::AttributeValueIndex v = att->mapped_index(draco::PointIndex(static_cast<uint32_t>(p)));
       const bool ok = ct == kFloat ? att->ConvertValue<float>(v, static_cast<int8_t>(n), f)
                                    : att->ConvertValue<int32_t>(v, static_cast<int8_t>(n), i32);
-      if (!ok) return doc.error(ew + ".attributes." + it.key() + ": Draco cannot give its values as the accessor's type");
-      for (uint32_t c = 0; c < n; ++c) raw[p * n + c] = ct == kFloat ? static_cast<double>(f[c]) : static_cast<double>(i32[c]);
+      if (!ok)
+        return doc.error(ew + ".attributes." + it.key() + ": Draco cannot give its values as the accessor's type");
+      for (uint32_t c = 0; c < n; ++c)
+        raw[p * n + c] = ct == kFloat ? static_cast<double>(f[c]) : static_cast<double>(i32[c]);
     }
     TSM_RETURN_IF_ERROR(fill_accessor(doc, acc, raw, n, kArrayBuffer));
   }
@@ -161,10 +163,14 @@ Status decode_meshopt_view(Document& doc, size_t index, const char* name) {
   else
     return doc.error(where + ": mode \"" + mode + "\" with byteStride " + std::to_string(stride) + " is not valid");
   if (rc != 0) return doc.error(where + ": meshoptimizer cannot decode the data (error " + std::to_string(rc) + ")");
-  if (filter == "OCTAHEDRAL" && (stride == 4 || stride == 8)) meshopt_decodeFilterOct(&out[0], count, stride);
-  else if (filter == "QUATERNION" && stride == 8) meshopt_decodeFilterQuat(&out[0], count, stride);
-  else if (filter == "EXPONENTIAL" && stride % 4 == 0) meshopt_decodeFilterExp(&out[0], count, stride);
-  else if (filter != "NONE") return doc.error(where + ": filter \"" + filter + "\" is not valid here");
+  if (filter == "OCTAHEDRAL" && (stride == 4 || stride == 8))
+    meshopt_decodeFilterOct(&out[0], count, stride);
+  else if (filter == "QUATERNION" && stride == 8)
+    meshopt_decodeFilterQuat(&out[0], count, stride);
+  else if (filter == "EXPONENTIAL" && stride % 4 == 0)
+    meshopt_decodeFilterExp(&out[0], count, stride);
+  else if (filter != "NONE")
+    return doc.error(where + ": filter \"" + filter + "\" is not valid here");
   doc.buffers.push_back(std::move(out));
   doc.json["buffers"].push_back(ojson{{"byteLength", doc.buffers.back().size()}});
   view["buffer"] = doc.buffers.size() - 1;
@@ -216,9 +222,9 @@ Status decode_tsm(Document& doc, ojson& prim, const std::string& where) {
   int64_t ia = -1;
   TSM_RETURN_IF_ERROR(doc.index_of(prim, "indices", doc.count_of("accessors"), where, ia));
   if (ia < 0) return doc.error(where + ": a TSM_mesh_compression primitive needs an indices accessor");
-  TSM_RETURN_IF_ERROR(
-      fill_accessor(doc, static_cast<size_t>(ia), std::vector<double>(mesh.indices.begin(), mesh.indices.end()), 1,
-                    kElementArrayBuffer));
+  TSM_RETURN_IF_ERROR(fill_accessor(doc, static_cast<size_t>(ia),
+                                    std::vector<double>(mesh.indices.begin(), mesh.indices.end()), 1,
+                                    kElementArrayBuffer));
   size_t pos = 0;
   TSM_RETURN_IF_ERROR(primitive_accessor(doc, prim, "POSITION", where, pos));
   TSM_RETURN_IF_ERROR(
@@ -240,8 +246,8 @@ Status decode_tsm(Document& doc, ojson& prim, const std::string& where) {
       return doc.error(aw + ": stream attribute '" + att.name + "' does not fit accessors[" + std::to_string(acc) +
                        "] (a vertex attribute of the accessor's components, float for FLOAT accessors, integer "
                        "for integer ones)");
-    TSM_RETURN_IF_ERROR(fill_accessor(doc, acc, std::vector<double>(att.values.begin(), att.values.end()), comps,
-                                      kArrayBuffer));
+    TSM_RETURN_IF_ERROR(
+        fill_accessor(doc, acc, std::vector<double>(att.values.begin(), att.values.end()), comps, kArrayBuffer));
   }
   // Accessors outside the stream must have the stream's vertex count.
   for (auto it = prim["attributes"].begin(); it != prim["attributes"].end(); ++it) {

@@ -43,8 +43,10 @@ size_t json_depth(std::string_view s, size_t limit) {
   for (size_t i = 0; i < s.size(); ++i) {
     const char c = s[i];
     if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -101,8 +103,9 @@ Status split_glb(const Document& doc, std::string_view bytes, std::string_view& 
   if (load_u32(bytes.data() + 4) != 2)
     return doc.error("GLB version " + std::to_string(load_u32(bytes.data() + 4)) + " (only glTF 2.0 is read)");
   const uint64_t length = load_u32(bytes.data() + 8);
-  if (length > bytes.size()) return doc.error("GLB header says " + std::to_string(length) + " bytes, the file has " +
-                                              std::to_string(bytes.size()) + " (truncated?)");
+  if (length > bytes.size())
+    return doc.error("GLB header says " + std::to_string(length) + " bytes, the file has " +
+                     std::to_string(bytes.size()) + " (truncated?)");
   size_t at = 12;
   has_bin = false;
   bool has_json = false;
@@ -136,11 +139,13 @@ Status load_buffers(Document& doc, std::string_view bin, bool has_bin) {
     const uint64_t length = b["byteLength"].get<uint64_t>();
     std::string& out = doc.buffers[i];
     if (!b.contains("uri")) {
-      const bool meshopt_fallback = b.contains("extensions") && b["extensions"].is_object() &&
-                                    (b["extensions"].contains("EXT_meshopt_compression") ||
-                                     b["extensions"].contains("KHR_meshopt_compression"));
-      if (i == 0 && has_bin) out.assign(bin.data(), bin.size());
-      else if (!meshopt_fallback) return doc.error(where + " has no uri and is not the GLB binary chunk");
+      const bool meshopt_fallback =
+          b.contains("extensions") && b["extensions"].is_object() &&
+          (b["extensions"].contains("EXT_meshopt_compression") || b["extensions"].contains("KHR_meshopt_compression"));
+      if (i == 0 && has_bin)
+        out.assign(bin.data(), bin.size());
+      else if (!meshopt_fallback)
+        return doc.error(where + " has no uri and is not the GLB binary chunk");
       // A meshopt fallback buffer has no bytes: its views are compressed.
       if (meshopt_fallback && !(i == 0 && has_bin)) continue;
     } else {
@@ -309,7 +314,8 @@ Status load_document(std::string_view bytes, const std::string& name, const std:
   }
   if (!doc.json.is_object() || !doc.json.contains("asset")) return doc.error("no \"asset\" object");
   for (const char* array : {"buffers", "bufferViews", "accessors", "meshes"})
-    if (doc.json.contains(array) && !doc.json[array].is_array()) return doc.error(std::string(array) + " is not an array");
+    if (doc.json.contains(array) && !doc.json[array].is_array())
+      return doc.error(std::string(array) + " is not an array");
   return load_buffers(doc, bin, has_bin);
 }
 
@@ -442,8 +448,10 @@ void drop_extension(ojson& json, const std::string& name) {
     ojson kept = ojson::array();
     for (const ojson& e : json[key])
       if (e != name) kept.push_back(e);
-    if (kept.empty()) json.erase(key);
-    else json[key] = kept;
+    if (kept.empty())
+      json.erase(key);
+    else
+      json[key] = kept;
   }
 }
 
@@ -468,7 +476,7 @@ namespace {
 // ...) follows the core's convention of a "bufferView" member.
 bool views_all_known(const ojson& json) {
   static const std::set<std::string> other_keys = {"EXT_structural_metadata", "EXT_mesh_features",
-                                                    "EXT_instance_features", "EXT_feature_metadata"};
+                                                   "EXT_instance_features", "EXT_feature_metadata"};
   if (!json.contains("extensionsUsed") || !json["extensionsUsed"].is_array()) return true;
   for (const ojson& e : json["extensionsUsed"])
     if (e.is_string() && other_keys.count(e.get<std::string>())) return false;
@@ -478,8 +486,10 @@ bool views_all_known(const ojson& json) {
 void collect_views(const ojson& j, std::set<uint64_t>& used) {
   if (j.is_object()) {
     for (auto it = j.begin(); it != j.end(); ++it) {
-      if (it.key() == "bufferView" && it.value().is_number_unsigned()) used.insert(it.value().get<uint64_t>());
-      else collect_views(it.value(), used);
+      if (it.key() == "bufferView" && it.value().is_number_unsigned())
+        used.insert(it.value().get<uint64_t>());
+      else
+        collect_views(it.value(), used);
     }
   } else if (j.is_array()) {
     for (const ojson& e : j) collect_views(e, used);
@@ -571,8 +581,10 @@ Status save_document(Document& doc, bool binary, const std::string& bin_uri, std
     bin.resize((bin.size() + 3) / 4 * 4, '\0');
     ojson v = json["bufferViews"][i];
     v["buffer"] = 0;
-    if (bin.empty()) v.erase("byteOffset");
-    else v["byteOffset"] = bin.size();
+    if (bin.empty())
+      v.erase("byteOffset");
+    else
+      v["byteOffset"] = bin.size();
     // byteOffset first, as usual.
     ojson ordered = ojson::object();
     ordered["buffer"] = 0;

@@ -92,8 +92,8 @@ bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& 
     return true;
   }
   const bool color = starts_with(sem, "COLOR_") && (d.components == 3 || d.components == 4);
-  att.name = sem == "COLOR_0"               ? "color"
-             : color                        ? "color" + sem.substr(6)
+  att.name = sem == "COLOR_0"                ? "color"
+             : color                         ? "color" + sem.substr(6)
              : starts_with(sem, "TEXCOORD_") ? "texcoord" + sem.substr(9)
                                              : sem;
   if (d.component_type != kFloat) {
@@ -106,9 +106,12 @@ bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& 
     out_normalized = d.normalized;
     return true;
   }
-  if (starts_with(sem, "TEXCOORD_") && d.components == 2) att.kind = AttributeKind::texcoord;
-  else if (color) att.kind = AttributeKind::color;
-  else if (!(sem == "TANGENT" && d.components == 4)) return false;
+  if (starts_with(sem, "TEXCOORD_") && d.components == 2)
+    att.kind = AttributeKind::texcoord;
+  else if (color)
+    att.kind = AttributeKind::color;
+  else if (!(sem == "TANGENT" && d.components == 4))
+    return false;
   att.values = d.values();
   return true;
 }
@@ -186,8 +189,10 @@ void write_accessor(Document& doc, size_t acc, int ct, bool normalized, uint32_t
   a["componentType"] = ct;
   a["count"] = raw.size() / components;
   a["type"] = type_for_components(components);
-  if (normalized) a["normalized"] = true;
-  else a.erase("normalized");
+  if (normalized)
+    a["normalized"] = true;
+  else
+    a.erase("normalized");
   if (min_max) set_min_max(a, raw, components);
   if (!with_data) return;
   size_t stride = 0;
@@ -281,8 +286,8 @@ struct Compressor {
   size_t budget = 0;
 
   Status primitive(ojson& prim, const std::string& where);
-  Status write(ojson& prim, const std::string& where, std::vector<Slot>& slots, const Mesh& decoded,
-               const std::vector<uint32_t>& order, std::string stream, int indices_ct, int64_t indices);
+  Status write(ojson& prim, std::vector<Slot>& slots, const Mesh& decoded, const std::vector<uint32_t>& order,
+               std::string stream, int indices_ct, int64_t indices);
 };
 
 Status Compressor::primitive(ojson& prim, const std::string& where) {
@@ -299,8 +304,9 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
   TSM_RETURN_IF_ERROR(read_slots(doc, prim, where, slots));
   for (const Slot& s : slots) {
     if (s.data.raw.size() > budget)
-      return doc.error(where + ": the primitives read their shared accessors over and over (more values than 64 "
-                               "times the file's bytes); refused");
+      return doc.error(where +
+                       ": the primitives read their shared accessors over and over (more values than 64 "
+                       "times the file's bytes); refused");
     budget -= s.data.raw.size();
   }
   const Slot* position = nullptr;
@@ -351,19 +357,18 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
   if (!s.ok()) return keep("the encoder refused it: " + s.message());
   Mesh decoded;
   s = decode(stream, decoded);
-  if (!s.ok()) return Status(ErrorCode::internal, doc.name + ": " + where + ": tsm cannot decode its own stream: " +
-                                                      s.message());
+  if (!s.ok())
+    return Status(ErrorCode::internal, doc.name + ": " + where + ": tsm cannot decode its own stream: " + s.message());
   std::vector<uint32_t> order;
   if (outside && !decoded_order(mesh, decoded, options.encode, order))
     return keep("its uncompressed attributes could not be put in the decoded vertex order");
   const int indices_ct =
       indices >= 0 ? doc.json["accessors"][static_cast<size_t>(indices)].value("componentType", kUInt) : kUInt;
-  return write(prim, where, slots, decoded, order, std::move(stream), indices_ct, indices);
+  return write(prim, slots, decoded, order, std::move(stream), indices_ct, indices);
 }
 
-Status Compressor::write(ojson& prim, const std::string& where, std::vector<Slot>& slots, const Mesh& decoded,
-                         const std::vector<uint32_t>& order, std::string stream, int indices_ct, int64_t indices) {
-  (void)where;
+Status Compressor::write(ojson& prim, std::vector<Slot>& slots, const Mesh& decoded, const std::vector<uint32_t>& order,
+                         std::string stream, int indices_ct, int64_t indices) {
   const bool data = options.fallback;
   const size_t n = decoded.vertex_count();
   // Indices: the input's type when every index fits it (the largest value of
@@ -389,8 +394,8 @@ Status Compressor::write(ojson& prim, const std::string& where, std::vector<Slot
     acc = output_accessor(doc, s.accessor, refs);
     holder[s.semantic] = acc;
     if (s.semantic == "POSITION" && s.target < 0) {
-      write_accessor(doc, acc, kFloat, false, 3, std::vector<double>(decoded.positions.begin(), decoded.positions.end()),
-                     data, true, kArrayBuffer);
+      write_accessor(doc, acc, kFloat, false, 3,
+                     std::vector<double>(decoded.positions.begin(), decoded.positions.end()), data, true, kArrayBuffer);
     } else if (s.stream >= 0) {
       const Attribute& att = decoded.attributes[static_cast<size_t>(s.stream)];
       write_accessor(doc, acc, s.out_type, s.out_normalized, s.data.components,
@@ -501,8 +506,10 @@ Status transcode_gltf(std::string_view bytes, const std::string& name, const std
       for (const std::string& uri : gltf::image_files(doc)) {
         std::string image;
         Status s = read_file_beside(dir, uri, image);
-        if (s.ok()) out.files.emplace_back(uri, std::move(image));
-        else r.add_note("image \"" + uri + "\" not copied: " + s.message());
+        if (s.ok())
+          out.files.emplace_back(uri, std::move(image));
+        else
+          r.add_note("image \"" + uri + "\" not copied: " + s.message());
       }
     }
     std::string bin;

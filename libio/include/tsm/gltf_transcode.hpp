@@ -24,9 +24,9 @@ struct GltfTranscodeOptions {
 
 struct GltfTranscodeReport {
   size_t primitives_compressed = 0;
-  size_t primitives_kept = 0;   // not triangles, or not compressible (see notes)
+  size_t primitives_kept = 0;          // not triangles, or not compressible (see notes)
   size_t vertices = 0, triangles = 0;  // of the compressed primitives
-  size_t stream_bytes = 0;      // sum of the tsm streams
+  size_t stream_bytes = 0;             // sum of the tsm streams
   std::string notes;
   void add_note(const std::string& note) {
     if (note.empty()) return;
