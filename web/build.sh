@@ -174,8 +174,8 @@ emcc "${LOPT[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
   -sINCOMING_MODULE_JS_API=[wasmBinary,locateFile,instantiateWasm,print,printErr,onAbort] \
   -sTEXTDECODER=2 -sDYNAMIC_EXECUTION=0
 echo "web/build.sh: built $OUT/tsm_decoder.js + tsm_decoder.wasm ($(stat -c %s "$OUT/tsm_decoder.wasm") bytes wasm, $(stat -c %s "$OUT/tsm_decoder.js") bytes js)"
-# The JS API beside the glue: build/web/ is the folder a site serves.
-cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$OUT/"
+# The JS API and the three.js plugin beside the glue: build/web/ is the folder a site serves.
+cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$ROOT/web/gltf-tsm-extension.js" "$OUT/"
 STREAMING=false
 grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h" && STREAMING=true
 ATTRIBUTES=false

@@ -4,6 +4,9 @@
 //         /dist/       -> build/web/          (tsm.js, tsm-worker.js, tsm_decoder.{js,wasm})
 //         /data/       -> build/web/data/     (.tsm and .drc files made by web/prepare-data.sh)
 //         /draco/      -> web/node_modules/draco3d/
+//         /three/      -> web/node_modules/three/  (three.js for gltf.html)
+//         /meshopt/    -> web/node_modules/meshoptimizer/  (its decoder, for gltf-bench.html)
+//         /corpus/     -> the corpus (CORPUS, default ../shared/corpus), read only: the original glTF assets
 // --throttle BYTES_PER_SECOND slows the /data/ responses down (to watch streaming);
 // so does ?throttle=N on a request. TSM_WEB_DIST=DIR serves another build as /dist/.
 import http from 'node:http';
@@ -17,11 +20,15 @@ const routes = [
   ['/dist/', path.resolve(process.env.TSM_WEB_DIST || path.join(root, 'build/web'))],
   ['/data/', path.join(root, 'build/web/data')],
   ['/draco/', path.join(here, 'node_modules/draco3d')],
+  ['/three/', path.join(here, 'node_modules/three')],
+  ['/meshopt/', path.join(here, 'node_modules/meshoptimizer')],
+  ['/corpus/', path.resolve(process.env.CORPUS || path.join(root, '../shared/corpus'))],
   ['/', path.join(here, 'demo')],
 ];
 const types = {
   '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8', '.mjs': 'text/javascript; charset=utf-8',
   '.wasm': 'application/wasm', '.css': 'text/css', '.json': 'application/json', '.png': 'image/png',
+  '.glb': 'model/gltf-binary', '.gltf': 'model/gltf+json',
 };
 
 export function startServer({ port = 0, throttle = 0, chunk = 16384 } = {}) {

@@ -4,10 +4,13 @@
 # (web/prepare-data.sh), and runs the Chromium test (web/test/browser.mjs):
 # each mesh streamed through the decoder in headless Chromium, counts and
 # index/position checksums against the native decoder's, screenshots in
-# build/web/screenshots/.
+# build/web/screenshots/; then glTF with TSM_mesh_compression through three.js
+# and the Khronos validator (web/test/gltf.mjs), and the npm package, packed,
+# installed into a scratch project and imported (web/test/package.mjs).
 #
 #   web/test.sh            # the test
-#   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md)
+#   web/test.sh --bench    # then the decode-time bench beside draco3d and the sizes (build/web/bench.md),
+#                          # and the glTF one beside draco3d and meshopt (build/web/gltf-bench.md)
 #
 # When emscripten or Chromium (or Node/npm) cannot be had, it prints
 # "web test SKIPPED: <reason>" and exits 0, except in CI (the CI variable set
@@ -46,8 +49,10 @@ apt_install() {  # packages...; returns non-zero when they cannot be installed
 }
 
 command -v node >/dev/null && command -v npm >/dev/null || skip "node and npm are not installed"
-# the library's build dependencies (header-only in the wasm build) and Draco's encoder CLI for the bench files
-apt_install libxxhash-dev libzstd-dev libeigen3-dev draco zstd || fail "cannot install libxxhash-dev libzstd-dev libeigen3-dev draco zstd (see build/web/install.log)"
+# the library's build dependencies (header-only in the wasm build), Draco's encoder CLI for the bench files,
+# and Draco's and meshoptimizer's libraries: with them the native CLI reads Draco- and meshopt-compressed glTF (web/test/gltf.mjs)
+apt_install libxxhash-dev libzstd-dev libeigen3-dev draco zstd libdraco-dev libmeshoptimizer-dev ||
+  fail "cannot install libxxhash-dev libzstd-dev libeigen3-dev draco zstd libdraco-dev libmeshoptimizer-dev (see build/web/install.log)"
 apt_install emscripten node-acorn || skip "emscripten cannot be installed (apt-get install emscripten node-acorn failed; build/web/install.log)"
 command -v emcc >/dev/null || skip "emcc not found after installing emscripten"
 apt_install chromium || skip "Chromium cannot be installed (apt-get install chromium failed; build/web/install.log)"
@@ -55,6 +60,7 @@ apt_install chromium || skip "Chromium cannot be installed (apt-get install chro
 
 # ---- npm packages (web/package-lock.json) -----------------------------------------
 if [ ! -d "$HERE/node_modules/playwright-core" ] || [ ! -d "$HERE/node_modules/draco3d" ] ||
+   [ ! -d "$HERE/node_modules/three" ] || [ ! -d "$HERE/node_modules/gltf-validator" ] ||
    [ "$HERE/package-lock.json" -nt "$HERE/node_modules/.package-lock.json" ]; then
   (cd "$HERE" && npm ci --no-audit --no-fund >>"$LOG" 2>&1) || skip "npm ci in web/ failed (npm registry unreachable?; build/web/install.log)"
 fi
@@ -74,7 +80,10 @@ TSM="$TSM" bash "$HERE/prepare-data.sh" || fail "web/prepare-data.sh failed"
 
 # ---- test -------------------------------------------------------------------------
 node "$HERE/test/browser.mjs" || fail "the Chromium test failed (screenshots in build/web/screenshots/)"
+node "$HERE/test/gltf.mjs" || fail "the glTF / three.js test failed (screenshots in build/web/screenshots/gltf-*.png)"
+node "$HERE/test/package.mjs" || fail "the npm package test failed (scratch project in build/web/pack-test/)"
 if [ "$BENCH" = 1 ]; then
   node "$HERE/test/bench.mjs" || fail "the bench failed"
+  node "$HERE/test/gltf-bench.mjs" || fail "the glTF bench failed"
 fi
 exit 0

@@ -442,6 +442,37 @@ export async function* decodeStreamInWorker(source, options = {}) {
   }
 }
 
+/** Decodes a whole .tsm file (Uint8Array or ArrayBuffer) in a Web Worker;
+ *  resolves to what TsmDecoder.decode returns, its arrays transferred from the
+ *  worker. The bytes are copied to the worker (the caller's stay intact).
+ *  options: { worker (from createTsmWorker, kept; several decodes may share
+ *  it, they run one after another), workerUrl, wasmUrl, decodeOptions }. */
+export function decodeInWorker(bytes, options = {}) {
+  const own = !options.worker;
+  const worker = options.worker || createTsmWorker(options.workerUrl);
+  const id = ++runCounter;
+  const copy = toBytes(bytes).slice();
+  return new Promise((resolve, reject) => {
+    const done = () => {
+      worker.removeEventListener('message', onMessage);
+      worker.removeEventListener('error', onError);
+      if (own) worker.terminate();
+    };
+    const onMessage = (e) => {
+      const msg = e.data;
+      if (msg.id !== id) return;
+      done();
+      if (msg.type === 'mesh') resolve(msg.mesh);
+      else reject(new TsmError(msg.code, msg.message));
+    };
+    const onError = (e) => { done(); reject(new Error(e.message || 'the tsm worker failed')); };
+    worker.addEventListener('message', onMessage);
+    worker.addEventListener('error', onError);
+    worker.postMessage({ type: 'decode', id, bytes: copy, wasmUrl: options.wasmUrl,
+      decodeOptions: options.decodeOptions }, [copy.buffer]);
+  });
+}
+
 // ---- helpers ----------------------------------------------------------------
 
 const now = () => (typeof performance !== 'undefined' ? performance.now() : Date.now());

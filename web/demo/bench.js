@@ -3,6 +3,7 @@
 // first and the last segment of a throttled download. window.benchResult
 // holds everything for web/test/bench.mjs.
 import { loadTsm } from '/dist/tsm.js';
+import { loadDraco } from './draco.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
@@ -14,20 +15,6 @@ const result = (window.benchResult = { state: 'running', reps: REPS, throttle: T
 
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
 const fetchBytes = async (url) => new Uint8Array(await (await fetch(url)).arrayBuffer());
-
-function loadScript(src) {
-  return new Promise((resolve, reject) => {
-    const s = document.createElement('script');
-    s.src = src; s.onload = resolve; s.onerror = () => reject(new Error('cannot load ' + src));
-    document.head.appendChild(s);
-  });
-}
-
-async function loadDraco() {
-  await loadScript('/draco/draco_decoder_nodejs.js');
-  const wasmBinary = await (await fetch('/draco/draco_decoder.wasm')).arrayBuffer();
-  return await new Promise((resolve) => { window.DracoDecoderModule({ wasmBinary }).then((m) => resolve(m)); });
-}
 
 // As three.js's DRACOLoader: decode, then positions and indices out through
 // the heap with one copy each.

@@ -1,0 +1,137 @@
+// Geometry decode time of compressed glTF: tsm (TSM_mesh_compression) beside
+// draco3d (KHR_draco_mesh_compression) and meshoptimizer's decoder
+// (EXT_meshopt_compression), on the files of /data/gltf-bench/index.json
+// (made by web/test/gltf-bench.mjs). Only the decoding of the compressed
+// buffer views into typed arrays is timed: no three.js, no textures.
+// window.benchResult holds the figures for web/test/gltf-bench.mjs.
+import { loadTsm } from '/dist/tsm.js';
+import { MeshoptDecoder } from '/meshopt/meshopt_decoder.mjs';
+import { loadDraco } from './draco.js';
+
+const params = new URLSearchParams(location.search);
+const REPS = Number(params.get('reps') || 15);
+const result = (window.benchResult = { state: 'running', reps: REPS, rows: [] });
+const log = (s) => { document.getElementById('log').textContent += '\n' + s; };
+const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
+
+// A .glb's JSON and the bytes of each buffer view (buffer 0 is the binary chunk).
+async function readGlb(url) {
+  const bytes = new Uint8Array(await (await fetch(url)).arrayBuffer());
+  const dv = new DataView(bytes.buffer);
+  if (dv.getUint32(0, true) !== 0x46546c67) throw new Error(`${url}: not a .glb`);
+  const jl = dv.getUint32(12, true);
+  const json = JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + jl)));
+  const bin = bytes.subarray(28 + jl, 28 + jl + dv.getUint32(20 + jl, true));
+  const view = (i) => { const v = json.bufferViews[i]; return bin.subarray(v.byteOffset || 0, (v.byteOffset || 0) + v.byteLength); };
+  return { json, bytes, bin, view };
+}
+
+const primitives = (json) => (json.meshes || []).flatMap((m) => m.primitives);
+
+// Each codec: the work list of a file (what to decode) and the decoding of it.
+function tsmJobs(g) {
+  return primitives(g.json).filter((p) => p.extensions && p.extensions.TSM_mesh_compression)
+    .map((p) => g.view(p.extensions.TSM_mesh_compression.bufferView));
+}
+function dracoJobs(g) {
+  return primitives(g.json).filter((p) => p.extensions && p.extensions.KHR_draco_mesh_compression)
+    .map((p) => ({ bytes: g.view(p.extensions.KHR_draco_mesh_compression.bufferView),
+      ids: Object.values(p.extensions.KHR_draco_mesh_compression.attributes) }));
+}
+// The meshopt-compressed buffer views of mesh geometry (gltfpack also compresses animations: not counted).
+function meshoptJobs(g) {
+  const geometry = new Set();
+  const use = (a) => { const acc = g.json.accessors[a]; if (acc && acc.bufferView !== undefined) geometry.add(acc.bufferView); };
+  for (const p of primitives(g.json)) {
+    Object.values(p.attributes).forEach(use);
+    if (p.indices !== undefined) use(p.indices);
+    for (const t of p.targets || []) Object.values(t).forEach(use);
+  }
+  return g.json.bufferViews.filter((v, i) => geometry.has(i) && v.extensions && v.extensions.EXT_meshopt_compression).map((v) => {
+    const e = v.extensions.EXT_meshopt_compression;
+    const b = g.json.buffers[e.buffer];
+    if (!b || b.uri !== undefined || e.buffer !== 0) throw new Error('meshopt data outside the .glb binary chunk');
+    return { e, src: g.bin.subarray(e.byteOffset || 0, (e.byteOffset || 0) + e.byteLength) };
+  });
+}
+
+// As three.js's DRACOLoader: decode, then indices and every listed attribute out through the heap, one copy each.
+function dracoDecode(draco, job) {
+  const decoder = new draco.Decoder();
+  const mesh = new draco.Mesh();
+  try {
+    const status = decoder.DecodeArrayToMesh(job.bytes, job.bytes.byteLength, mesh);
+    if (!status.ok() || mesh.ptr === 0) throw new Error('draco: ' + status.error_msg());
+    const n = mesh.num_faces() * 3;
+    let ptr = draco._malloc(n * 4);
+    decoder.GetTrianglesUInt32Array(mesh, n * 4, ptr);
+    const out = [new Uint32Array(draco.HEAPU32.buffer, ptr, n).slice()];
+    draco._free(ptr);
+    for (const id of job.ids) {
+      const attr = decoder.GetAttributeByUniqueId(mesh, id);
+      const k = mesh.num_points() * attr.num_components();
+      ptr = draco._malloc(k * 4);
+      decoder.GetAttributeDataArrayForAllPoints(mesh, attr, draco.DT_FLOAT32, k * 4, ptr);
+      out.push(new Float32Array(draco.HEAPF32.buffer, ptr, k).slice());
+      draco._free(ptr);
+    }
+    return { vertices: mesh.num_points(), triangles: n / 3 };
+  } finally {
+    draco.destroy(mesh);
+    draco.destroy(decoder);
+  }
+}
+
+function table(head, rows) {
+  const t = document.createElement('table');
+  t.innerHTML = '<tr>' + head.map((x) => `<th>${x}</th>`).join('') + '</tr>' +
+    rows.map((r) => '<tr>' + r.map((x) => `<td>${x}</td>`).join('') + '</tr>').join('');
+  document.getElementById('out').append(t);
+}
+
+async function main() {
+  const index = await (await fetch('/data/gltf-bench/index.json')).json();
+  const tsm = await loadTsm();
+  const draco = await loadDraco();
+  await MeshoptDecoder.ready;
+  const codecs = {
+    tsm: { jobs: tsmJobs, run: (j) => { const m = tsm.decode(j); return { vertices: m.vertexCount, triangles: m.faceCount }; } },
+    draco: { jobs: dracoJobs, run: (j) => dracoDecode(draco, j) },
+    meshopt: {
+      jobs: meshoptJobs,
+      run: (j) => {
+        const target = new Uint8Array(j.e.count * j.e.byteStride);
+        MeshoptDecoder.decodeGltfBuffer(target, j.e.count, j.e.byteStride, j.src, j.e.mode, j.e.filter);
+        return { bytes: target.length };
+      },
+    },
+  };
+  codecs.tsm_l0 = codecs.tsm; // the same decoder, files written at level 0
+  const rows = [];
+  for (const asset of index) {
+    const files = {};
+    for (const [codec, url] of Object.entries(asset.files)) {
+      const g = await readGlb(url);
+      files[codec] = { url, fileBytes: g.bytes.length, jobs: codecs[codec].jobs(g) };
+      const f = files[codec];
+      f.geometryBytes = f.jobs.reduce((s, j) => s + (j.src || j.bytes || j).byteLength, 0);
+      if (!f.jobs.length) { log(`${url}: nothing compressed with ${codec}, left out`); delete files[codec]; }
+    }
+    const times = Object.fromEntries(Object.keys(files).map((c) => [c, []]));
+    const runAll = (c) => { const t0 = performance.now(); let info; for (const j of files[c].jobs) info = codecs[c].run(j); return [performance.now() - t0, info]; };
+    for (let i = 0; i < 2; ++i) for (const c of Object.keys(files)) runAll(c);
+    for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c)[0]);
+    const row = { name: asset.name };
+    for (const c of Object.keys(files)) row[c] = { fileBytes: files[c].fileBytes, geometryBytes: files[c].geometryBytes,
+      streams: files[c].jobs.length, ms: median(times[c]), minMs: Math.min(...times[c]) };
+    result.rows.push(row);
+    log(`${asset.name}: ` + Object.keys(files).map((c) => `${c} ${row[c].ms.toFixed(2)} ms`).join(', '));
+    rows.push([asset.name, ...['tsm', 'tsm_l0', 'draco', 'meshopt'].map((c) => (row[c] ? `${row[c].ms.toFixed(2)} ms (${row[c].geometryBytes.toLocaleString()} B)` : '-'))]);
+    await new Promise((r) => setTimeout(r, 0));
+  }
+  table(['asset', 'tsm', 'tsm -l 0', 'Draco (draco3d)', 'meshopt'], rows);
+  result.state = 'done';
+  log('done');
+}
+
+main().catch((e) => { result.state = 'error'; result.error = String(e && e.stack || e); log('error: ' + (e.stack || e)); });
