@@ -516,10 +516,14 @@ TEST(GltfExtensionCorpus, AssetsRoundTripWithTheirCounts) {
   TSM_REQUIRE_CORPUS();
   const fs::path tmp = fs::temp_directory_path() / ("tsm_gltf_assets_" + std::to_string(::getpid()));
   fs::create_directories(tmp);
-  for (const char* rel :
-       {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf", "assets/2CylinderEngine.glb",
-        "assets/MultiUVTest/MultiUVTest.gltf", "assets/VertexColorTest/VertexColorTest.gltf", "assets/Box_Draco.glb",
-        "assets/2CylinderEngine_Draco/2CylinderEngine.gltf"}) {
+  // The two engines (55,843 vertices each) only in the plain build: under
+  // the sanitizers they took two minutes and reach no code the others miss.
+  std::vector<const char*> assets = {"assets/Fox/Fox.gltf", "assets/CesiumMilkTruck/CesiumMilkTruck.gltf",
+                                     "assets/MultiUVTest/MultiUVTest.gltf",
+                                     "assets/VertexColorTest/VertexColorTest.gltf", "assets/Box_Draco.glb"};
+  if (!tsm_test::kSanitized)
+    assets.insert(assets.end(), {"assets/2CylinderEngine.glb", "assets/2CylinderEngine_Draco/2CylinderEngine.gltf"});
+  for (const char* rel : assets) {
     SCOPED_TRACE(rel);
     const std::string in = tsm_test::corpus_file(rel);
     ASSERT_TRUE(transcode_file(in, tmp / "plain_in.glb", false).ok());
