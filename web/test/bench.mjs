@@ -6,8 +6,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { startServer } from '../serve.mjs';
-import { launch } from './chromium.mjs';
+import { runBenchPage } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const root = path.resolve(here, '../..');
@@ -15,20 +14,7 @@ const arg = (name, d) => { const i = process.argv.indexOf(name); return i > 0 ? 
 const q = new URLSearchParams({ reps: arg('--reps', '15'), throttle: arg('--throttle', '2000000') });
 if (arg('--meshes')) q.set('meshes', arg('--meshes'));
 
-const server = await startServer();
-const browser = await launch();
-let r;
-try {
-  const page = await browser.newPage();
-  page.on('pageerror', (e) => console.error('page error:', e.message));
-  await page.goto(`http://localhost:${server.address().port}/bench.html?${q}`);
-  await page.waitForFunction(() => window.benchResult && window.benchResult.state !== 'running', null, { timeout: 900000 });
-  r = await page.evaluate(() => window.benchResult);
-  r.chromium = browser.version();
-} finally {
-  await browser.close();
-  server.close();
-}
+const r = await runBenchPage(`bench.html?${q}`, 900000);
 if (r.state !== 'done') { console.error('bench failed:', r.error); process.exit(1); }
 const n = (x) => x.toLocaleString('en-US');
 const f = (x, d = 1) => (x == null ? '-' : x.toFixed(d));

@@ -15,8 +15,7 @@ import { fileURLToPath } from 'node:url';
 import { NodeIO } from '@gltf-transform/core';
 import { ALL_EXTENSIONS, KHRDracoMeshCompression } from '@gltf-transform/extensions';
 import draco3d from 'draco3d';
-import { startServer } from '../serve.mjs';
-import { launch } from './chromium.mjs';
+import { runBenchPage } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const web = path.resolve(here, '..');
@@ -60,20 +59,7 @@ for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruc
 }
 fs.writeFileSync(path.join(out, 'index.json'), JSON.stringify(index, null, 1));
 
-const server = await startServer();
-const browser = await launch();
-let r;
-try {
-  const page = await browser.newPage();
-  page.on('pageerror', (e) => console.error('page error:', e.message));
-  await page.goto(`http://localhost:${server.address().port}/gltf-bench.html?reps=${arg('--reps', '15')}`);
-  await page.waitForFunction(() => window.benchResult && window.benchResult.state !== 'running', null, { timeout: 600000 });
-  r = await page.evaluate(() => window.benchResult);
-  r.chromium = browser.version();
-} finally {
-  await browser.close();
-  server.close();
-}
+const r = await runBenchPage(`gltf-bench.html?reps=${arg('--reps', '15')}`, 600000);
 if (r.state !== 'done') { console.error('gltf bench failed:', r.error); process.exit(1); }
 const n = (x) => x.toLocaleString('en-US');
 const lines = [`Chromium ${r.chromium}, headless, this machine; geometry of each file decoded into typed arrays, ` +
