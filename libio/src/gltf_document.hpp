@@ -12,18 +12,13 @@
 #include <string_view>
 #include <vector>
 
+#include "gltf_types.hpp"
 #include "tsm/status.hpp"
 
 namespace tsm::gltf {
 
 using ojson = nlohmann::ordered_json;
 
-constexpr int kByte = 5120;
-constexpr int kUByte = 5121;
-constexpr int kShort = 5122;
-constexpr int kUShort = 5123;
-constexpr int kUInt = 5125;
-constexpr int kFloat = 5126;
 constexpr int kArrayBuffer = 34962;
 constexpr int kElementArrayBuffer = 34963;
 
@@ -43,8 +38,6 @@ struct Document {
 // beside the .gltf in `dir`).
 Status load_document(std::string_view bytes, const std::string& name, const std::string& dir, Document& doc);
 
-// Bytes per component, 0 for an unknown component type.
-size_t component_bytes(int component_type);
 // Components of "SCALAR", "VEC2", "VEC3", "VEC4"; 0 for others.
 uint32_t type_components(const std::string& type);
 const char* type_for_components(uint32_t components);

@@ -191,6 +191,7 @@
 #include <tuple>
 #include <vector>
 
+#include "gltf_types.hpp"
 #include "gltf_files.hpp"
 #include "tsm/io.hpp"
 
@@ -222,18 +223,6 @@ const char kPassMagic[4] = {'t', 's', 'm', 'G'};
 constexpr uint32_t kPassVersion = 1;
 const char* const kGroupTag = "_gltf_group";
 const char* const kPrimitiveTag = "_gltf_primitive";
-
-size_t component_size(int ct) {
-  switch (ct) {
-    case kByte:
-    case kUByte: return 1;
-    case kShort:
-    case kUShort: return 2;
-    case kUInt:
-    case kFloat: return 4;
-    default: return 0;
-  }
-}
 
 const char* component_name(int ct) {
   switch (ct) {
@@ -1012,7 +1001,7 @@ class GltfReader {
     v.normalized = a.normalized;
     v.components = type_components(a.type);
     v.count = a.count;
-    v.csize = component_size(a.componentType);
+    v.csize = gltf::component_bytes(a.componentType);
     if (v.csize == 0)
       return error(at + ": component type " + std::to_string(a.componentType) + " (" +
                    component_name(a.componentType) + ") is not a glTF 2.0 accessor type");
@@ -1051,7 +1040,7 @@ class GltfReader {
       const tinygltf::BufferView* view;
       const tinygltf::Buffer* buffer;
       TSM_RETURN_IF_ERROR(check_view(sp.indices.bufferView, sat + " indices", view, buffer));
-      const size_t isize = component_size(v.sparse_index_type);
+      const size_t isize = gltf::component_bytes(v.sparse_index_type);
       if (!fits(static_cast<size_t>(sp.indices.byteOffset), v.sparse_count, isize, isize, view->byteLength))
         return error(sat + " indices run past the end of buffer view " + std::to_string(sp.indices.bufferView));
       v.sparse_indices = buffer->data.data() + view->byteOffset + static_cast<size_t>(sp.indices.byteOffset);
@@ -1082,7 +1071,7 @@ class GltfReader {
           dst[i * v.components + c] = load_value(v.component_type, normalized, p + c * v.csize);
       }
     }
-    const size_t isize = component_size(v.sparse_index_type);
+    const size_t isize = gltf::component_bytes(v.sparse_index_type);
     for (size_t k = 0; k < v.sparse_count; ++k) {
       const uint32_t i = load_index(v.sparse_index_type, v.sparse_indices + k * isize);
       const unsigned char* p = v.sparse_values + k * v.csize * v.components;
@@ -1112,7 +1101,7 @@ class GltfReader {
     out.assign(v.count, 0);
     if (v.data)
       for (size_t i = 0; i < v.count; ++i) out[i] = load_index(v.component_type, v.data + i * v.stride);
-    const size_t isize = component_size(v.sparse_index_type);
+    const size_t isize = gltf::component_bytes(v.sparse_index_type);
     for (size_t k = 0; k < v.sparse_count; ++k) {
       const uint32_t i = load_index(v.sparse_index_type, v.sparse_indices + k * isize);
       out[i] = load_index(v.component_type, v.sparse_values + k * v.csize);
@@ -2086,7 +2075,7 @@ class GltfWriter {
           }
         }
       }
-      const size_t csize = component_size(ct);
+      const size_t csize = gltf::component_bytes(ct);
       const uint32_t comps = a->components;
       const float* src = a->values.data();
       const int view = add_view(mesh_.vertex_count(), csize * comps, TINYGLTF_TARGET_ARRAY_BUFFER,
@@ -2422,7 +2411,7 @@ class PassThroughWriter {
                                 ") is not an integer in 0.." + float_text(top));
           }
       }
-      const size_t csize = component_size(ct);
+      const size_t csize = gltf::component_bytes(ct);
       const size_t view = add_view(verts.size(), csize * comps, TINYGLTF_TARGET_ARRAY_BUFFER,
                                    [&](size_t i, unsigned char* d) {
                                      const float* p = src + static_cast<size_t>(verts[i]) * stride;
