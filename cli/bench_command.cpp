@@ -2,7 +2,8 @@
 // sizes, bits per vertex, encode/decode medians (tsm on one thread against
 // Draco, which has none; tsm on every core in extra columns), maximum error,
 // exactness of each round trip (the oracle; Draco's on the grid Draco used),
-// and reader speed (tsm's reader vs Draco's).
+// and reader speed (tsm's reader vs Draco's). glTF files get a table of
+// their own (bench_assets.cpp): whole assets through tsm, Draco and gltfpack.
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -13,12 +14,13 @@
 #include <thread>
 #include <vector>
 
+#include "bench_assets.hpp"
 #include "bench_draco.hpp"
-#include "cli_util.hpp"
 #include "bench_timing.hpp"
-#include "tsm/tsm.hpp"
+#include "cli_util.hpp"
 #include "tsm/compare.hpp"
 #include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
 
 namespace tsm::cli {
 
@@ -32,7 +34,7 @@ struct Row {
   int q = 0;
   size_t tsm_bytes = 0;
   double tsm_enc = 0, tsm_dec = 0, tsm_err = 0;  // one thread
-  double tsm_enc_mt = -1, tsm_dec_mt = -1;        // every core (-1: one core only)
+  double tsm_enc_mt = -1, tsm_dec_mt = -1;       // every core (-1: one core only)
   bool tsm_exact = false;
   std::string tsm_diff;
   bench::DracoRun cl10, cl7;
@@ -50,8 +52,8 @@ std::vector<std::string> default_meshes() {
   std::vector<std::string> out;
   std::string dir = default_corpus_dir();
   if (!dir.empty()) {
-    for (const char* name : {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply",
-                             "dragon_vrip.ply"})
+    for (const char* name :
+         {"bun_zipper.ply", "dragon_vrip_res4.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply", "dragon_vrip.ply"})
       if (std::filesystem::exists(dir + "/" + name)) out.push_back(dir + "/" + name);
     // Then Draco's edge-case files, by name (those no reader takes are listed as failures).
     std::vector<std::string> edge;
@@ -60,6 +62,15 @@ std::vector<std::string> default_meshes() {
       if (e.is_regular_file()) edge.push_back(e.path().string());
     std::sort(edge.begin(), edge.end());
     out.insert(out.end(), edge.begin(), edge.end());
+    // The real glTF assets (those already compressed by Draco are left out:
+    // gltfpack does not read them).
+    std::vector<std::string> assets;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir + "/assets", ec)) {
+      const std::string p = e.path().string();
+      if (e.is_regular_file() && is_gltf_path(p) && p.find("Draco") == std::string::npos) assets.push_back(p);
+    }
+    std::sort(assets.begin(), assets.end());
+    out.insert(out.end(), assets.begin(), assets.end());
   }
   if (out.empty()) {
     std::string m = default_mesh_path();
@@ -93,11 +104,12 @@ Mesh generated_sphere(int rings, int segments) {
 
 }  // namespace
 
-int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::vector<int>& qbits, int runs,
-              int level, bool quiet) {
+int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::vector<int>& qbits, int runs, int level,
+              bool quiet) {
   std::vector<std::string> meshes = meshes_in.empty() ? default_meshes() : meshes_in;
   std::vector<Row> rows;
   std::vector<ReadRow> reads;
+  std::vector<AssetRow> assets;
   std::vector<std::string> failures;
   const bool have_draco = bench::draco_available();
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -129,6 +141,13 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
         if (!bench::draco_read(path, rr.draco_ms, v, f, rr.draco_error)) rr.draco_ms = -1;
       }
       reads.push_back(rr);
+      if (is_gltf_path(path)) {
+        for (int q : qbits) {
+          assets.push_back(bench_asset(path, q, level, runs, quiet));
+          if (!assets.back().tsm.ok) failures.push_back(rr.mesh + ": " + assets.back().tsm.error);
+        }
+        continue;
+      }
     }
     for (int q : qbits) {
       Row row;
@@ -203,10 +222,12 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
   if (json) {
     // Built with the JSON library: a mesh name that is not UTF-8 still gives valid JSON (U+FFFD).
     using ojson = nlohmann::ordered_json;
-    auto rounded = [](double v, double scale) { return std::isfinite(v) ? ojson(std::round(v * scale) / scale) : ojson(); };
+    auto rounded = [](double v, double scale) {
+      return std::isfinite(v) ? ojson(std::round(v * scale) / scale) : ojson();
+    };
     ojson doc = ojson::object();
     doc["draco"] = have_draco;
-    doc["threads"] = 1;  // tsm_encode_ms and tsm_decode_ms: one thread, as Draco
+    doc["threads"] = 1;    // tsm_encode_ms and tsm_decode_ms: one thread, as Draco
     doc["cores"] = cores;  // the *_all_cores timings: this many threads
     doc["rows"] = ojson::array();
     for (const Row& r : rows) {
@@ -225,8 +246,8 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       }
       o["tsm_exact"] = r.tsm_exact;
       o["tsm_max_error_steps"] = rounded(r.tsm_err, 1e4);
-      for (const auto& [name, d] : {std::pair<std::string, const bench::DracoRun*>{"draco_cl10", &r.cl10},
-                                    {"draco_cl7", &r.cl7}})
+      for (const auto& [name, d] :
+           {std::pair<std::string, const bench::DracoRun*>{"draco_cl10", &r.cl10}, {"draco_cl7", &r.cl7}})
         if (d->ok) {
           o[name + "_bytes"] = d->bytes;
           o[name + "_bpv"] = rounded(bpv(d->bytes, r.vertices), 1e4);
@@ -238,38 +259,45 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
     }
     doc["reads"] = ojson::array();
     for (const ReadRow& r : reads)
-      doc["reads"].push_back({{"mesh", r.mesh}, {"tsm_ms", rounded(r.tsm_ms, 1e3)}, {"draco_ms", rounded(r.draco_ms, 1e3)}});
+      doc["reads"].push_back(
+          {{"mesh", r.mesh}, {"tsm_ms", rounded(r.tsm_ms, 1e3)}, {"draco_ms", rounded(r.draco_ms, 1e3)}});
+    doc["assets"] = asset_rows_json(assets);
     doc["failures"] = failures.size();
     std::printf("%s\n", doc.dump(2, ' ', false, ojson::error_handler_t::replace).c_str());
     return failures.empty() ? kExitOk : kExitBadInput;
   }
 
-  std::printf("Times: medians of %d run%s, ms; tsm on one thread against Draco (which has no threads)", runs,
-              runs == 1 ? "" : "s");
-  if (cores > 1) std::printf("; the last two columns: tsm with %d threads (segments in parallel)", cores);
-  std::printf(".\n\n");
-  std::printf("| mesh | V | q | tsm bytes | tsm bits/v | Draco cl10 bytes | cl10 bits/v | Draco cl7 bytes | tsm/cl10 "
-              "| tsm enc ms | tsm dec ms | cl10 enc ms | cl10 dec ms | enc tsm/cl10 | dec tsm/cl10 | max err (steps) "
-              "| exact: tsm | exact: Draco |");
-  if (cores > 1) std::printf(" tsm enc ms, %d thr | tsm dec ms, %d thr |", cores, cores);
-  std::printf("\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|%s\n",
-              cores > 1 ? "---:|---:|" : "");
-  for (const Row& r : rows) {
-    auto dbytes = [](const bench::DracoRun& d) { return d.ok ? thousands(d.bytes) : std::string("-"); };
-    auto ratio = [](double a, double b) { return b > 0 ? fixed(a / b, 2) : std::string("-"); };
-    std::printf("| %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |",
-                r.mesh.c_str(), thousands(r.vertices).c_str(), r.q, thousands(r.tsm_bytes).c_str(),
-                fixed(bpv(r.tsm_bytes, r.vertices), 2).c_str(), dbytes(r.cl10).c_str(),
-                r.cl10.ok ? fixed(bpv(r.cl10.bytes, r.vertices), 2).c_str() : "-", dbytes(r.cl7).c_str(),
-                r.cl10.ok ? fixed(static_cast<double>(r.tsm_bytes) / static_cast<double>(r.cl10.bytes), 3).c_str() : "-",
-                fixed(r.tsm_enc, 1).c_str(), fixed(r.tsm_dec, 1).c_str(),
-                r.cl10.ok ? fixed(r.cl10.encode_ms, 1).c_str() : "-", r.cl10.ok ? fixed(r.cl10.decode_ms, 1).c_str() : "-",
-                r.cl10.ok ? ratio(r.tsm_enc, r.cl10.encode_ms).c_str() : "-",
-                r.cl10.ok ? ratio(r.tsm_dec, r.cl10.decode_ms).c_str() : "-", fixed(r.tsm_err, 3).c_str(),
-                r.tsm_exact ? "yes" : "NO", have_draco ? (r.draco_exact ? "yes" : "no") : "-");
-    if (cores > 1) std::printf(" %s | %s |", fixed(r.tsm_enc_mt, 1).c_str(), fixed(r.tsm_dec_mt, 1).c_str());
-    std::printf("\n");
+  if (!rows.empty() || assets.empty()) {
+    std::printf("Times: medians of %d run%s, ms; tsm on one thread against Draco (which has no threads)", runs,
+                runs == 1 ? "" : "s");
+    if (cores > 1) std::printf("; the last two columns: tsm with %d threads (segments in parallel)", cores);
+    std::printf(".\n\n");
+    std::printf(
+        "| mesh | V | q | tsm bytes | tsm bits/v | Draco cl10 bytes | cl10 bits/v | Draco cl7 bytes | tsm/cl10 "
+        "| tsm enc ms | tsm dec ms | cl10 enc ms | cl10 dec ms | enc tsm/cl10 | dec tsm/cl10 | max err (steps) "
+        "| exact: tsm | exact: Draco |");
+    if (cores > 1) std::printf(" tsm enc ms, %d thr | tsm dec ms, %d thr |", cores, cores);
+    std::printf("\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|%s\n",
+                cores > 1 ? "---:|---:|" : "");
+    for (const Row& r : rows) {
+      auto dbytes = [](const bench::DracoRun& d) { return d.ok ? thousands(d.bytes) : std::string("-"); };
+      auto ratio = [](double a, double b) { return b > 0 ? fixed(a / b, 2) : std::string("-"); };
+      std::printf(
+          "| %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |", r.mesh.c_str(),
+          thousands(r.vertices).c_str(), r.q, thousands(r.tsm_bytes).c_str(),
+          fixed(bpv(r.tsm_bytes, r.vertices), 2).c_str(), dbytes(r.cl10).c_str(),
+          r.cl10.ok ? fixed(bpv(r.cl10.bytes, r.vertices), 2).c_str() : "-", dbytes(r.cl7).c_str(),
+          r.cl10.ok ? fixed(static_cast<double>(r.tsm_bytes) / static_cast<double>(r.cl10.bytes), 3).c_str() : "-",
+          fixed(r.tsm_enc, 1).c_str(), fixed(r.tsm_dec, 1).c_str(),
+          r.cl10.ok ? fixed(r.cl10.encode_ms, 1).c_str() : "-", r.cl10.ok ? fixed(r.cl10.decode_ms, 1).c_str() : "-",
+          r.cl10.ok ? ratio(r.tsm_enc, r.cl10.encode_ms).c_str() : "-",
+          r.cl10.ok ? ratio(r.tsm_dec, r.cl10.decode_ms).c_str() : "-", fixed(r.tsm_err, 3).c_str(),
+          r.tsm_exact ? "yes" : "NO", have_draco ? (r.draco_exact ? "yes" : "no") : "-");
+      if (cores > 1) std::printf(" %s | %s |", fixed(r.tsm_enc_mt, 1).c_str(), fixed(r.tsm_dec_mt, 1).c_str());
+      std::printf("\n");
+    }
   }
+  if (!assets.empty()) print_asset_table(assets);
   if (!reads.empty()) {
     std::printf("\n| mesh | tsm read ms | Draco read ms | Draco/tsm |\n|---|---:|---:|---:|\n");
     for (const ReadRow& r : reads)

@@ -261,7 +261,8 @@ int main(int argc, char** argv) {
   bool bench_json = false, bench_quiet = false;
   std::vector<int> bench_q{11, 14};
   int bench_runs = 3, bench_level = kDefaultLevel;
-  CLI::App* ben = app.add_subcommand("bench", "Compare tsm with Draco (cl7, cl10) on meshes, in one process");
+  CLI::App* ben = app.add_subcommand(
+      "bench", "Compare tsm with Draco (cl7, cl10) on meshes, and with draco_transcoder and gltfpack on glTF assets");
   ben->add_option("meshes", bench_meshes, "Mesh files (default: the corpus beside the project, else the default mesh)");
   ben->add_option("-q,--quantization", bench_q, "Quantization bits to test (repeatable)")->check(CLI::Range(1, 30));
   ben->add_option("--runs", bench_runs, "Timed runs per measurement (median is shown)")->check(CLI::Range(1, 100));

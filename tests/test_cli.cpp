@@ -1188,4 +1188,44 @@ TEST_F(Cli, BenchReadsGltfAndGlb) {
   }
 }
 
+// A glTF file gets a row in the assets table: tsm's .glb and geometry bytes
+// and decode time, and the same for draco_transcoder and gltfpack when they
+// are installed (scripts/setup.sh installs both, so in CI they must work).
+TEST_F(Cli, BenchComparesGltfAssets) {
+  ASSERT_TRUE(tsm::write_mesh(file("ball.glb"), tsm_test::icosphere(3)).ok());
+  Result r = tsm("bench " + quote(file("ball.glb")) + " --runs 1 -q 11 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_EQ(doc["assets"].size(), 1u) << r.out;
+  const auto& row = doc["assets"][0];
+  EXPECT_EQ(row["asset"], "ball.glb");
+  EXPECT_EQ(row["vertices"], 642);
+  EXPECT_EQ(row["triangles"], 1280);
+  EXPECT_EQ(row["input_bytes"].get<size_t>(), fs::file_size(file("ball.glb")));
+  const auto& t = row["tsm"];
+  ASSERT_TRUE(t["ok"].get<bool>()) << r.out;
+  // The geometry is the stream: far smaller than the 642 float positions and 1,280 triangles.
+  EXPECT_GT(t["geometry_bytes"].get<size_t>(), 100u) << r.out;
+  EXPECT_LT(t["geometry_bytes"].get<size_t>(), 642u * 12 / 3) << r.out;
+  EXPECT_LT(t["geometry_bytes"].get<size_t>(), t["glb_bytes"].get<size_t>()) << r.out;
+  EXPECT_GT(t["decode_ms"].get<double>(), 0.0) << r.out;
+  EXPECT_TRUE(doc["rows"].empty()) << "a glTF file has no row in the scans table: " << r.out;
+  for (const char* tool : {"draco_transcoder", "gltfpack"}) {
+    const auto& o = row[tool];
+    if (!o["ok"].get<bool>() && !tsm_test::running_in_ci()) {
+      EXPECT_NE(o["error"].get<std::string>().find("not installed"), std::string::npos) << r.out;
+      continue;
+    }
+    ASSERT_TRUE(o["ok"].get<bool>()) << tool << ": " << r.out;
+    EXPECT_GT(o["geometry_bytes"].get<size_t>(), 100u) << tool << ": " << r.out;
+    EXPECT_LT(o["geometry_bytes"].get<size_t>(), o["glb_bytes"].get<size_t>()) << tool << ": " << r.out;
+    EXPECT_GT(o["decode_ms"].get<double>(), 0.0) << tool << ": " << r.out;
+  }
+
+  r = tsm("bench " + quote(file("ball.glb")) + " --runs 1 -q 11 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("| ball.glb | 642 | 1,280 | 11 |"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("| mesh | V | q |"), std::string::npos) << "no empty scans table: " << r.out;
+}
+
 }  // namespace

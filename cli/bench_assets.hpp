@@ -1,0 +1,43 @@
+// `tsm bench` on glTF assets: the compressed .glb and its geometry bytes for
+// tsm (TSM_mesh_compression), Draco through glTF (draco_transcoder) and
+// meshoptimizer (gltfpack -cc), at the same quantization where each tool
+// allows, and the time each file takes to become a plain glTF again.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace tsm::cli {
+
+struct AssetTool {
+  bool ok = false;
+  size_t glb_bytes = 0, geometry_bytes = 0;
+  double encode_ms = -1, decode_ms = -1;  // encode_ms: tsm only (the others run as programs)
+  std::string error;                      // why there is no figure
+};
+
+struct AssetRow {
+  std::string name;
+  int q = 0;
+  size_t input_bytes = 0, vertices = 0, triangles = 0;
+  AssetTool tsm, draco, gltfpack;
+};
+
+// A .glb or .gltf by its name.
+bool is_gltf_path(const std::string& path);
+
+// Bytes of the buffer views a GLB's mesh primitives use: their accessors'
+// views, the views of TSM_mesh_compression and KHR_draco_mesh_compression,
+// and for views compressed with EXT/KHR_meshopt_compression the compressed
+// length. 0 when the bytes are not a GLB.
+size_t glb_geometry_bytes(const std::string& glb);
+
+// Positions at q bits, normals and tangents 8, texture coordinates 10,
+// colours 8 for all three tools; one thread; medians of `runs`.
+AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool quiet);
+
+void print_asset_table(const std::vector<AssetRow>& rows);
+nlohmann::ordered_json asset_rows_json(const std::vector<AssetRow>& rows);
+
+}  // namespace tsm::cli
