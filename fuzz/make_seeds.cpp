@@ -32,6 +32,7 @@
 
 #include "base64.hpp"
 #include "mesh_gen.hpp"
+#include "tsm/gltf_transcode.hpp"
 #include "tsm/io.hpp"
 #include "tsm/tsm.hpp"
 
@@ -290,6 +291,17 @@ void gltf_seeds(const fs::path& dir, const std::string& name, const tsm::Mesh& m
   if (tsm::write_gltf(m, tsm::WriteOptions{}, s, true).ok()) put(dir, name + ".glb", s);
 }
 
+// fuzz_gltf_transcode: a small plain .glb and the same compressed by tsm
+// (TSM_mesh_compression), level 2 as the target encodes.
+void transcode_seeds(const fs::path& dir, const std::string& name, const std::string& glb) {
+  put(dir, name + "_plain.glb", glb);
+  tsm::GltfTranscodeOptions options;
+  options.encode.level = 2;
+  options.encode.threads = 1;
+  tsm::GltfOutput out;
+  if (tsm::transcode_gltf(glb, name, "", options, true, "", out).ok()) put(dir, name + "_tsm.glb", out.main);
+}
+
 void roundtrip_seed(const fs::path& dir, const Named& n) {
   const tsm::Mesh& m = n.mesh;
   if (m.vertex_count() == 0 || m.vertex_count() > 256) return;
@@ -424,8 +436,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1];
-  const fs::path decode_dir = out / "fuzz_decode", read_dir = out / "fuzz_read_mesh", rt_dir = out / "fuzz_roundtrip";
-  for (const fs::path& d : {decode_dir, read_dir, rt_dir}) {
+  const fs::path decode_dir = out / "fuzz_decode", read_dir = out / "fuzz_read_mesh", rt_dir = out / "fuzz_roundtrip",
+                 gltf_dir = out / "fuzz_gltf_transcode";
+  for (const fs::path& d : {decode_dir, read_dir, rt_dir, gltf_dir}) {
     fs::remove_all(d);
     fs::create_directories(d);
   }
@@ -446,6 +459,7 @@ int main(int argc, char** argv) {
       put(read_dir, n.name + "_binary.stl", stl_binary(n.mesh));
     }
     gltf_seeds(read_dir, n.name, n.mesh);
+    if (tsm::write_gltf(n.mesh, tsm::WriteOptions{}, s, true).ok()) transcode_seeds(gltf_dir, n.name, s);
   }
   {
     const std::string doc = gltf_document();
@@ -456,6 +470,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     gltf_seeds(read_dir, "hand_document_written", m);  // the writer's form, .gltf and .glb
+    std::string glb;
+    if (tsm::write_gltf(m, tsm::WriteOptions{}, glb, true).ok()) transcode_seeds(gltf_dir, "hand_document", glb);
   }
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 0);
   encode_seed(decode_dir, "sphere", tsm_test::icosphere(2), 14, 9);

@@ -4,11 +4,11 @@
 # test suite runs its tests in) and runs each for SECONDS with a generated
 # seed corpus:
 #
-#   fuzz/run.sh SECONDS [TARGET...]     (targets: fuzz_decode fuzz_read_mesh fuzz_roundtrip)
+#   fuzz/run.sh SECONDS [TARGET...]     (targets: fuzz_decode fuzz_read_mesh fuzz_roundtrip fuzz_gltf_transcode)
 #   fuzz/run.sh --smoke [TARGET...]     (the test suite's run: reproducible)
 #
 # --smoke runs a fixed number of executions per target (decode 10,000,
-# read_mesh 6,000, roundtrip 800: about 15 s each here) with libFuzzer's
+# read_mesh 6,000, roundtrip 800, gltf_transcode 2,000: about 15-90 s each here) with libFuzzer's
 # seed fixed, from the generated seeds only (a fresh corpus, the kept one is
 # not read), so a commit explores about the same inputs on every machine
 # and every run (not exactly: coverage of threaded or timing-dependent code
@@ -25,7 +25,7 @@
 # target at a time, builds with -j1 (set FUZZ_JOBS to change that).
 set -euo pipefail
 
-usage() { echo "usage: fuzz/run.sh SECONDS|--smoke [fuzz_decode|fuzz_read_mesh|fuzz_roundtrip]..." >&2; exit 2; }
+usage() { echo "usage: fuzz/run.sh SECONDS|--smoke [fuzz_decode|fuzz_read_mesh|fuzz_roundtrip|fuzz_gltf_transcode]..." >&2; exit 2; }
 [ $# -ge 1 ] || usage
 smoke=0
 if [ "$1" = --smoke ]; then
@@ -41,9 +41,10 @@ smoke_runs() {
     fuzz_decode) echo 10000 ;;
     fuzz_read_mesh) echo 6000 ;;
     fuzz_roundtrip) echo 800 ;;
+    fuzz_gltf_transcode) echo 2000 ;;
   esac
 }
-all=(fuzz_decode fuzz_read_mesh fuzz_roundtrip)
+all=(fuzz_decode fuzz_read_mesh fuzz_roundtrip fuzz_gltf_transcode)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 for t in "${targets[@]}"; do
