@@ -2,9 +2,10 @@
 // bytes, as `tsm decode x.glb` and `tsm encode x.glb -o y.glb` meet them: a
 // document with TSM_mesh_compression streams (or Draco / meshopt ones when
 // built in) decoded to a plain glTF, and a document compressed. Refusals must
-// carry a message and never be internal errors; what the transcoder writes
-// it must read back: a compressed output decodes, a plain output compresses,
-// both with the same number of compressed primitives.
+// carry a message and never be internal errors; what the transcoder
+// compresses it must decode, and compress again the same way. (Decoding
+// passes primitives without an extension through as they are: a broken one
+// stays broken, so a plain output is not required to compress.)
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -41,12 +42,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   tsm::GltfOutput plain;
   tsm::GltfTranscodeReport report;
-  if (!run(bytes, "fuzz.glb", false, plain, report) || plain.main.size() > (size_t(1) << 18)) return 0;
-  // A plain glTF the transcoder wrote compresses; the compressed one decodes
-  // and compresses again into as many streams.
+  (void)run(bytes, "fuzz.glb", false, plain, report);
+  // Compressing: what the transcoder compressed decodes, and the decoded
+  // document compresses again into as many streams, vertices and triangles.
   tsm::GltfOutput packed, again, repacked;
   tsm::GltfTranscodeReport r1, r2, r3;
-  if (!run(plain.main, "plain.glb", true, packed, r1)) fail("the transcoder refused its own plain output");
+  if (size > (size_t(1) << 16) || !run(bytes, "fuzz.glb", true, packed, r1)) return 0;
   if (!run(packed.main, "packed.glb", false, again, r2)) fail("the transcoder refused its own compressed output");
   if (!run(again.main, "again.glb", true, repacked, r3)) fail("the transcoder refused its own decoded output");
   if (r3.primitives_compressed != r1.primitives_compressed || r3.vertices != r1.vertices ||
