@@ -22,7 +22,6 @@
 
 #include "batch.hpp"
 #include "cli_util.hpp"
-#include "tsm/gltf_transcode.hpp"
 #include "tsm/io.hpp"
 
 namespace tsm::cli {
@@ -248,20 +247,6 @@ Status parse_mesh_as(std::string_view bytes, const std::string& input, MeshForma
   if (input != "-" && ro.external_files_dir.empty()) {
     const std::string dir = fs::path(input).parent_path().string();
     ro.external_files_dir = dir.empty() ? "." : dir;
-  }
-  // glTF with compressed primitives (Draco, meshopt, tsm's own extension):
-  // decoded to a plain glTF first, which the reader takes.
-  const MeshFormat gltf_kind = forced != MeshFormat::unknown ? forced : sniff_format(bytes);
-  if ((gltf_kind == MeshFormat::gltf || gltf_kind == MeshFormat::glb) &&
-      (bytes.find("KHR_draco_mesh_compression") != std::string_view::npos ||
-       bytes.find("_meshopt_compression") != std::string_view::npos ||
-       bytes.find("TSM_mesh_compression") != std::string_view::npos)) {
-    GltfTranscodeOptions plain_options;
-    plain_options.compress = false;
-    GltfOutput plain;
-    TSM_RETURN_IF_ERROR(transcode_gltf(bytes, name, ro.external_files_dir, plain_options, true, "", plain));
-    info = ReadInfo();
-    return read_gltf(plain.main, name, mesh, ro, &info);
   }
   if (forced == MeshFormat::unknown) {
     if (input == "-" && bytes.empty())

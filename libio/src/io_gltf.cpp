@@ -90,10 +90,11 @@
 //   their bytes in BIN, not compressed by the codec. A mesh used by several
 //   nodes stays one mesh (nodes are untouched).
 //
-// Not read: Draco (KHR_draco_mesh_compression) and meshopt
-// (EXT_meshopt_compression) compressed data, refused with ErrorCode::
-// unsupported when the file requires them (a primitive that only offers
-// Draco beside an uncompressed copy is read from the copy). NaN / infinite
+// Compressed data (KHR_draco_mesh_compression, EXT/KHR_meshopt_compression,
+// TSM_mesh_compression): a primitive that offers an uncompressed copy is
+// read from the copy; when the document needs its compressed data, the
+// transcoder (gltf_transcode.hpp) decodes it into a plain document first
+// (Draco and meshopt only when tsm was built with them). NaN / infinite
 // float values are refused unless ReadOptions::allow_nonfinite.
 //
 // Robustness: the GLB container is checked here before tinygltf sees it, the
@@ -193,6 +194,7 @@
 
 #include "gltf_types.hpp"
 #include "gltf_files.hpp"
+#include "tsm/gltf_transcode.hpp"
 #include "tsm/io.hpp"
 
 #ifndef TSM_VERSION
@@ -2527,7 +2529,22 @@ Status read_file_beside(const std::string& dir, const std::string& uri, std::str
 
 Status read_gltf(std::string_view bytes, const std::string& name, Mesh& out, const ReadOptions& options,
                  ReadInfo* info) {
-  return GltfReader(bytes, name, out, options, info).run();
+  Status s = GltfReader(bytes, name, out, options, info).run();
+  if (s.ok()) return s;
+  bool compressed = false;
+  for (const char* ext : {"KHR_draco_mesh_compression", "_meshopt_compression", "TSM_mesh_compression"})
+    compressed = compressed || bytes.find(ext) != std::string_view::npos;
+  if (!compressed) return s;
+  // Primitives only a compressed copy holds (Draco, meshopt, tsm's own
+  // extension): the transcoder decodes them into a plain document first
+  // (its refusals name what is missing, e.g. a build without Draco).
+  GltfTranscodeOptions plain_options;
+  plain_options.compress = false;
+  GltfOutput plain;
+  TSM_RETURN_IF_ERROR(transcode_gltf(bytes, name, options.external_files_dir, plain_options, true, "", plain));
+  s = GltfReader(plain.main, name, out, options, info).run();
+  if (s.ok() && info) info->add_note("compressed primitives decoded first");
+  return s;
 }
 
 Status write_gltf(const Mesh& mesh, const WriteOptions& options, std::string& out, bool binary, WriteInfo* info) {
