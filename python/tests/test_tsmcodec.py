@@ -131,6 +131,20 @@ def test_bytes_equal_the_tools(tmp_path, args, kwargs):
     assert tsmcodec.encode(tsmcodec.read(ply), **kwargs) == tool
 
 
+@pytest.mark.skipif(not os.environ.get("TSM_CLI"), reason="TSM_CLI (the tsm tool) not given")
+def test_reads_a_compressed_gltf(tmp_path):
+    positions, faces = grid(10)
+    plain = str(tmp_path / "grid.glb")
+    tsmcodec.write(plain, tsmcodec.Mesh(positions, faces))
+    packed = str(tmp_path / "packed.glb")
+    subprocess.run([os.environ["TSM_CLI"], "encode", plain, "-o", packed], check=True, capture_output=True)
+    with open(packed, "rb") as f:
+        assert b"TSM_mesh_compression" in f.read()
+    back = tsmcodec.read(packed)
+    assert back.face_count == len(faces)
+    assert len(back.positions) == len(positions)
+
+
 def test_stream_decoder_grows_segment_by_segment():
     positions, faces = grid(30)
     data = tsmcodec.encode(positions, faces, segment_faces=400)
