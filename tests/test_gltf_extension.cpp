@@ -405,6 +405,24 @@ TEST(GltfExtension, FallbackCopyEqualsTheDecodedValues) {
   check_primitive(c, c.doc["meshes"][0]["primitives"][0], s, s.tris0, true);
 }
 
+// KHR_mesh_quantization stays listed only while a mesh attribute it covers
+// has an integer type: here every one is float, so it goes.
+TEST(GltfExtension, MeshQuantizationDroppedWhenNothingIsQuantized) {
+  const Source s = make_source();
+  const Glb src = split_glb(s.glb);
+  json doc = src.doc;
+  for (const char* key : {"extensionsUsed", "extensionsRequired"}) doc[key].push_back("KHR_mesh_quantization");
+  const std::string listed_glb = make_glb(doc, src.bin);
+  for (bool compress : {true, false}) {
+    std::string out;
+    ASSERT_TRUE(transcode(listed_glb, compress, false, out).ok());
+    const Glb g = split_glb(out);
+    EXPECT_FALSE(listed(g.doc, "extensionsUsed", "KHR_mesh_quantization")) << compress;
+    EXPECT_FALSE(listed(g.doc, "extensionsRequired", "KHR_mesh_quantization")) << compress;
+    EXPECT_TRUE(listed(g.doc, "extensionsUsed", "EXT_test_unknown")) << "other extensions stay";
+  }
+}
+
 TEST(GltfExtension, HostileInputGivesErrors) {
   const Source s = make_source();
   // A buffer view past the buffer.

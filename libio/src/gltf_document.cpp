@@ -455,6 +455,49 @@ void drop_extension(ojson& json, const std::string& name) {
   }
 }
 
+namespace {
+
+// An attribute KHR_mesh_quantization lets be an integer type.
+bool quantizable_semantic(const std::string& semantic) {
+  return semantic == "POSITION" || semantic == "NORMAL" || semantic == "TANGENT" ||
+         semantic.rfind("TEXCOORD_", 0) == 0;
+}
+
+bool integer_accessor(const ojson& json, const ojson& index) {
+  if (!index.is_number_unsigned() || !json.contains("accessors") || !json["accessors"].is_array()) return false;
+  const size_t a = index.get<size_t>();
+  if (a >= json["accessors"].size() || !json["accessors"][a].is_object()) return false;
+  const ojson& type = json["accessors"][a].contains("componentType") ? json["accessors"][a]["componentType"] : ojson();
+  return type.is_number() && type != kFloat;
+}
+
+bool uses_quantized_attribute(const ojson& json, const ojson& attributes) {
+  if (!attributes.is_object()) return false;
+  for (auto it = attributes.begin(); it != attributes.end(); ++it)
+    if (quantizable_semantic(it.key()) && integer_accessor(json, it.value())) return true;
+  return false;
+}
+
+}  // namespace
+
+void drop_unused_mesh_quantization(ojson& json) {
+  if (!json.contains("meshes") || !json["meshes"].is_array()) {
+    drop_extension(json, "KHR_mesh_quantization");
+    return;
+  }
+  for (const ojson& mesh : json["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (const ojson& prim : mesh["primitives"]) {
+      if (!prim.is_object()) continue;
+      if (prim.contains("attributes") && uses_quantized_attribute(json, prim["attributes"])) return;
+      if (prim.contains("targets") && prim["targets"].is_array())
+        for (const ojson& target : prim["targets"])
+          if (uses_quantized_attribute(json, target)) return;
+    }
+  }
+  drop_extension(json, "KHR_mesh_quantization");
+}
+
 std::vector<std::string> image_files(const Document& doc) {
   std::vector<std::string> out;
   for (size_t i = 0; i < doc.count_of("images"); ++i) {

@@ -70,6 +70,10 @@ std::string pack_values(const std::vector<double>& raw, int component_type, uint
 // Adds / removes a name in extensionsUsed / extensionsRequired.
 void use_extension(ojson& json, const std::string& name, bool required);
 void drop_extension(ojson& json, const std::string& name);
+// KHR_mesh_quantization out of extensionsUsed/Required when no mesh
+// attribute it covers (POSITION, NORMAL, TANGENT, TEXCOORD_n, also in morph
+// targets) has an integer component type any more.
+void drop_unused_mesh_quantization(ojson& json);
 
 // The document's image URIs naming files (not data: URIs).
 std::vector<std::string> image_files(const Document& doc);

@@ -512,6 +512,7 @@ Status transcode_gltf(std::string_view bytes, const std::string& name, const std
           r.add_note("image \"" + uri + "\" not copied: " + s.message());
       }
     }
+    gltf::drop_unused_mesh_quantization(doc.json);
     std::string bin;
     TSM_RETURN_IF_ERROR(gltf::save_document(doc, binary, bin_uri, out.main, bin));
     if (!binary && !bin.empty()) out.files.insert(out.files.begin(), {bin_uri, std::move(bin)});
