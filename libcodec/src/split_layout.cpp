@@ -35,8 +35,8 @@ struct Normal {
 Normal reduced(const int64_t v[3]) {
   int64_t m = 0;
   for (int a = 0; a < 3; ++a) m = std::max(m, v[a] < 0 ? -v[a] : v[a]);
-  int s = 0;
-  while ((m >> s) >= 512) ++s;  // the largest component below 2^9
+  // The shift that brings the largest component below 2^9.
+  const int s = m < 512 ? 0 : 64 - __builtin_clzll(static_cast<unsigned long long>(m)) - 9;
   Normal n;
   for (int a = 0; a < 3; ++a) n.x[a] = v[a] >> s;  // floor
   return n;
@@ -84,6 +84,50 @@ struct SplitModels {
 
 // The walk both sides make: per corner, the candidates, then (after the
 // choice) the vertex it is; per face, its edges and its normal remembered.
+// Directed edge (two points) -> the vertices at its ends, as the last face
+// through it left them: open addressing with linear probing (the walk
+// inserts three edges per triangle; std::unordered_map spent most of the
+// decoder's time allocating and freeing their nodes).
+class EdgeMap {
+ public:
+  using Ends = std::pair<uint32_t, uint32_t>;
+  const Ends* find(uint64_t key) const {
+    if (slots_.empty()) return nullptr;
+    for (size_t i = slot_of(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == kEmpty) return nullptr;
+      if (slots_[i].key == key) return &slots_[i].ends;
+    }
+  }
+  void set(uint64_t key, Ends ends) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    size_t i = slot_of(key);
+    while (slots_[i].key != kEmpty && slots_[i].key != key) i = (i + 1) & mask_;
+    if (slots_[i].key == kEmpty) ++used_;
+    slots_[i] = {key, ends};
+  }
+
+ private:
+  // Points are below 2^32 - 1 (a uint32 count), so no key is all ones.
+  static constexpr uint64_t kEmpty = ~uint64_t{0};
+  struct Slot {
+    uint64_t key = kEmpty;
+    Ends ends;
+  };
+  size_t slot_of(uint64_t key) const {
+    return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
+  }
+  void grow() {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(old.empty() ? 1024 : 2 * old.size(), Slot());
+    mask_ = slots_.size() - 1;
+    used_ = 0;
+    for (const Slot& s : old)
+      if (s.key != kEmpty) set(s.key, s.ends);
+  }
+  std::vector<Slot> slots_;
+  size_t mask_ = 0, used_ = 0;
+};
+
 class SplitWalk {
  public:
   SplitWalk(uint32_t points, const std::vector<uint32_t>& q) : made_(points), q_(q) {}
@@ -98,11 +142,11 @@ class SplitWalk {
     auto offer = [&](uint32_t v) {
       if (v != kNoVertex && std::find(cand_.begin(), cand_.end(), v) == cand_.end()) cand_.push_back(v);
     };
-    const auto a = edge_.find(key(next, p));  // the neighbour across p -> next runs next -> p
-    if (a != edge_.end()) offer(a->second.second);
-    const auto b = edge_.find(key(p, prev));  // across prev -> p: p -> prev
-    if (b != edge_.end()) offer(b->second.first);
-    const bool both = a != edge_.end() && b != edge_.end();
+    const EdgeMap::Ends* a = edge_.find(key(next, p));  // the neighbour across p -> next runs next -> p
+    if (a) offer(a->second);
+    const EdgeMap::Ends* b = edge_.find(key(p, prev));  // across prev -> p: p -> prev
+    if (b) offer(b->first);
+    const bool both = a && b;
     const int nb = cand_.empty() ? 0 : !both ? 1 : cand_.size() == 1 ? 2 : 3;
     for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
     close_.resize(cand_.size());
@@ -111,7 +155,13 @@ class SplitWalk {
       close_[i] = closeness(normal_, sum_[cand_[i]].x);
       order_[i] = static_cast<uint32_t>(i);
     }
-    std::stable_sort(order_.begin(), order_.end(), [&](uint32_t x, uint32_t y) { return close_[x] < close_[y]; });
+    // Stable insertion sort: a point has a handful of vertices.
+    for (size_t i = 1; i < order_.size(); ++i) {
+      const uint32_t x = order_[i];
+      size_t j = i;
+      for (; j > 0 && close_[x] < close_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
+      order_[j] = x;
+    }
     sorted_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) sorted_[i] = cand_[order_[i]];
     best_ = close_[order_[0]];
@@ -134,7 +184,7 @@ class SplitWalk {
   void remember(const uint32_t* c, const uint32_t* v, uint32_t n) {
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t j = (i + 1) % n;
-      edge_[key(c[i], c[j])] = {v[i], v[j]};
+      edge_.set(key(c[i], c[j]), {v[i], v[j]});
       for (int a = 0; a < 3; ++a) sum_[v[i]].x[a] += normal_.x[a];
     }
   }
@@ -166,7 +216,7 @@ class SplitWalk {
   std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
   std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
   Normal normal_;                   // the current face's
-  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> edge_;
+  EdgeMap edge_;
   std::vector<uint32_t> cand_, sorted_, order_;
   std::vector<int> close_;
   int best_ = 5;
