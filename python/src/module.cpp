@@ -7,12 +7,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "tsm/distance.hpp"
 #include "tsm/io.hpp"
+#include "tsm/simplify.hpp"
 #include "tsm/tsm.hpp"
 #include "tsm/version.h"
 
@@ -323,6 +327,76 @@ PYBIND11_MODULE(_tsmcodec, m) {
       },
       py::arg("path"), py::arg("mesh"), py::kw_only(), py::arg("ascii") = false,
       "Writes a Mesh by extension (.ply, .obj, .stl, .off, .gltf, .glb)");
+
+  m.def(
+      "simplify",
+      [](const tsm::Mesh& mesh, double max_error, double max_error_percent, uint64_t faces, double ratio) {
+        if (max_error < 0 || max_error_percent < 0 || ratio < 0 || ratio > 1)
+          throw py::value_error("max_error and max_error_percent must be >= 0, ratio within [0, 1]");
+        if (max_error > 0 && max_error_percent > 0)
+          throw py::value_error("give max_error (model units) or max_error_percent (of the diagonal), not both");
+        if (max_error == 0 && max_error_percent == 0 && faces == 0 && ratio == 0)
+          throw py::value_error("say how far to simplify: max_error, max_error_percent, faces or ratio");
+        tsm::SimplifyOptions o;
+        o.max_error = max_error > 0 ? max_error : max_error_percent * tsm::bounding_box(mesh).diagonal() / 100;
+        o.target_faces = faces;
+        if (ratio > 0) {
+          uint64_t triangles = 0;
+          for (size_t f = 0; f < mesh.face_count(); ++f)
+            triangles += mesh.face_size(f) >= 3 ? mesh.face_size(f) - 2 : 0;
+          o.target_faces = std::max<uint64_t>(o.target_faces, static_cast<uint64_t>(std::llround(
+                                                                  ratio * static_cast<double>(triangles))));
+        }
+        tsm::Mesh out;
+        tsm::SimplifyReport r;
+        {
+          py::gil_scoped_release release;
+          check(tsm::simplify(mesh, o, out, &r));
+        }
+        return out;
+      },
+      py::arg("mesh"), py::kw_only(), py::arg("max_error") = 0.0, py::arg("max_error_percent") = 0.0,
+      py::arg("faces") = 0, py::arg("ratio") = 0.0,
+      "Simplifies a Mesh: collapses while the symmetric Hausdorff distance to the input stays within max_error "
+      "(model units) or max_error_percent (of the bounding-box diagonal), guaranteed; faces / ratio stop earlier");
+  m.def(
+      "distance",
+      [](const tsm::Mesh& a, const tsm::Mesh& b, uint64_t samples) {
+        tsm::DistanceOptions o;
+        o.target_samples = samples;
+        tsm::DistanceReport r;
+        {
+          py::gil_scoped_release release;
+          check(tsm::measure_distance(a, b, o, r));
+        }
+        auto side = [](const tsm::OneSidedDistance& s) {
+          py::dict d;
+          d["max"] = s.max;
+          d["bound"] = s.bound;
+          d["mean"] = s.mean;
+          d["rms"] = s.rms;
+          d["samples"] = s.samples;
+          return d;
+        };
+        py::dict d;
+        d["hausdorff"] = r.hausdorff;
+        d["hausdorff_bound"] = r.hausdorff_bound;
+        d["diagonal"] = r.diagonal;
+        d["a_to_b"] = side(r.a_to_b);
+        d["b_to_a"] = side(r.b_to_a);
+        d["spacing"] = r.spacing;
+        d["area_a"] = r.area_a;
+        d["area_b"] = r.area_b;
+        d["volume_a"] = r.volume_a;
+        d["volume_b"] = r.volume_b;
+        d["normal_mean_deg"] = r.normal_mean_deg;
+        d["normal_max_deg"] = r.normal_max_deg;
+        return d;
+      },
+      py::arg("a"), py::arg("b"), py::kw_only(), py::arg("samples") = 1000000,
+      "Metro-style distances between two meshes as a dict (what `tsm compare` prints): symmetric Hausdorff "
+      "distance (sampled, and a guaranteed upper bound), one-sided max/mean/RMS, areas, volumes, normal "
+      "deviation; diagonal is A's bounding-box diagonal");
 
   m.def(
       "info",

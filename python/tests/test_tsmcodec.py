@@ -208,3 +208,43 @@ def test_corpus_bunny_bytes_equal_the_tools(tmp_path):
     lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
     step = float((hi - lo).max()) / ((1 << tsmcodec.info(data)["quantization_bits"]) - 1)
     assert (back.positions >= lo - step).all() and (back.positions <= hi + step).all()
+
+
+def sphere(rings=24, segments=48):
+    positions = [(0.0, 0.0, 1.0)]
+    for r in range(1, rings):
+        th = np.pi * r / rings
+        for s in range(segments):
+            ph = 2 * np.pi * s / segments
+            positions.append((np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)))
+    positions.append((0.0, 0.0, -1.0))
+    south = len(positions) - 1
+
+    def vid(r, s):
+        return 1 + (r - 1) * segments + s % segments
+
+    faces = [(0, vid(1, s), vid(1, s + 1)) for s in range(segments)]
+    for r in range(1, rings - 1):
+        for s in range(segments):
+            faces += [(vid(r, s), vid(r + 1, s), vid(r + 1, s + 1)), (vid(r, s), vid(r + 1, s + 1), vid(r, s + 1))]
+    faces += [(south, vid(rings - 1, s + 1), vid(rings - 1, s)) for s in range(segments)]
+    return np.array(positions, dtype=np.float32), np.array(faces, dtype=np.int32)
+
+
+def test_simplify_within_the_bound_and_distance():
+    positions, faces = sphere()
+    mesh = tsmcodec.Mesh(positions, faces)
+    small = tsmcodec.simplify(mesh, max_error_percent=1.0)
+    assert 0 < small.face_count < len(faces) // 2
+    d = tsmcodec.distance(mesh, small)
+    assert d["diagonal"] == pytest.approx(2 * np.sqrt(3), rel=1e-3)
+    assert d["hausdorff"] <= d["hausdorff_bound"]
+    assert d["hausdorff_bound"] <= 0.01 * d["diagonal"] * 1.0001
+    assert d["a_to_b"]["samples"] > 0 and d["b_to_a"]["mean"] <= d["b_to_a"]["max"]
+    assert tsmcodec.distance(mesh, mesh)["hausdorff"] < 1e-9
+    fewer = tsmcodec.simplify(mesh, ratio=0.25)
+    assert fewer.face_count <= round(0.25 * len(faces)) + 2
+    with pytest.raises(ValueError):
+        tsmcodec.simplify(mesh)
+    with pytest.raises(ValueError):
+        tsmcodec.simplify(mesh, max_error=0.1, max_error_percent=1.0)

@@ -8,9 +8,13 @@
     stream = tsmcodec.StreamDecoder()                 # decoding as the bytes arrive
     for chunk in chunks: stream.feed(chunk)           # stream.mesh grows segment by segment
     stream.finish(); mesh = stream.take_mesh()
+    small = tsmcodec.simplify(mesh, max_error_percent=0.5)   # guaranteed within 0.5% of the diagonal
+    tsmcodec.distance(mesh, small)["hausdorff_bound"]      # Metro-style distances, as `tsm compare`
 
 Errors raise tsmcodec.Error with the library's message.
 """
-from ._tsmcodec import Attribute, Error, Mesh, StreamDecoder, __version__, decode, encode, info, read, write
+from ._tsmcodec import (Attribute, Error, Mesh, StreamDecoder, __version__, decode, distance, encode, info, read,
+                        simplify, write)
 
-__all__ = ["Attribute", "Error", "Mesh", "StreamDecoder", "__version__", "decode", "encode", "info", "read", "write"]
+__all__ = ["Attribute", "Error", "Mesh", "StreamDecoder", "__version__", "decode", "distance", "encode", "info", "read",
+           "simplify", "write"]
