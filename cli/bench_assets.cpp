@@ -79,13 +79,16 @@ int run_program(const std::vector<std::string>& args, const std::string& log) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-// The last non-empty line a program printed, for the note under the table.
+// What a program said when it failed, for the note under the table: its
+// first line naming an error, else its last non-empty line.
 std::string last_line(const std::string& log) {
   std::string text, line, last;
   slurp(log, text);
   std::istringstream in(text);
-  while (std::getline(in, line))
+  while (std::getline(in, line)) {
+    if (line.find("rror") != std::string::npos) return line;
     if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  }
   return last;
 }
 
@@ -118,6 +121,7 @@ void measure_tool_output(const std::string& out_path, const std::string& dir, in
   t.glb_bytes = glb.size();
   t.geometry_bytes = glb_geometry_bytes(glb);
   t.ok = true;
+  t.file = out_path;
   time_decode(glb, fs::path(out_path).filename().string(), dir, runs, t);
 }
 
@@ -165,11 +169,13 @@ void bench_tsm(const std::string& input, const std::string& name, const std::str
   row.tsm.geometry_bytes = glb_geometry_bytes(out.main);
   row.tsm.ok = true;
   time_decode(out.main, name, "", runs, row.tsm);
+  std::ofstream(row.tsm.file, std::ios::binary) << out.main;
 }
 
 std::string cell_bytes(const AssetTool& t, size_t bytes) { return t.ok ? thousands(bytes) : std::string("-"); }
 
 std::string cell_ms(double ms) { return ms >= 0 ? fixed(ms, 1) : std::string("-"); }
+std::string cell_ms2(double ms) { return ms >= 0 ? fixed(ms, 2) : std::string("-"); }
 
 std::string cell_ratio(const AssetTool& a, const AssetTool& b) {
   if (!a.ok || !b.ok || b.geometry_bytes == 0) return "-";
@@ -257,7 +263,7 @@ size_t asset_bytes(const std::string& path, const std::string& text) {
   return bytes;
 }
 
-AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool quiet) {
+AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool quiet, const std::string& work_dir) {
   AssetRow row;
   row.name = fs::path(path).filename().string();
   row.q = q;
@@ -267,16 +273,18 @@ AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool q
     return row;
   }
   row.input_bytes = asset_bytes(path, input);
-  const std::string dir = fs::path(path).parent_path().string();
-  if (!quiet) std::fprintf(stderr, "tsm bench: %s q=%d: tsm glTF\n", row.name.c_str(), q);
-  bench_tsm(input, path, dir.empty() ? "." : dir, q, level, runs, row);
-
-  std::string tmpl = (fs::temp_directory_path() / "tsm-bench-XXXXXX").string();
+  // A folder of its own in the work folder: the three outputs (and images a tool writes beside them).
+  std::string tmpl = work_dir + "/asset-XXXXXX";
   if (!mkdtemp(tmpl.data())) {
-    row.draco.error = row.gltfpack.error = "cannot make a temporary folder";
+    row.tsm.error = row.draco.error = row.gltfpack.error = "cannot make a folder in " + work_dir;
     return row;
   }
   const std::string tmp = tmpl;
+  const std::string dir = fs::path(path).parent_path().string();
+  if (!quiet) std::fprintf(stderr, "tsm bench: %s q=%d: tsm glTF\n", row.name.c_str(), q);
+  row.tsm.file = tmp + "/tsm.glb";
+  bench_tsm(input, path, dir.empty() ? "." : dir, q, level, runs, row);
+  if (!row.tsm.ok) row.tsm.file.clear();
   const std::string qs = std::to_string(q), nb = std::to_string(kNormalBits), tb = std::to_string(kTexcoordBits),
                     cb = std::to_string(kColorBits);
   if (!quiet) std::fprintf(stderr, "tsm bench: %s q=%d: draco_transcoder, gltfpack -cc\n", row.name.c_str(), q);
@@ -285,25 +293,86 @@ AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool q
                 tmp + "/draco.glb", tmp, runs, row.draco);
   bench_program({"gltfpack", "-cc", "-i", path, "-o", tmp + "/meshopt.glb", "-vp", qs, "-vn", nb, "-vt", tb, "-vc", cb},
                 tmp + "/meshopt.glb", tmp, runs, row.gltfpack);
-  std::error_code ec;
-  fs::remove_all(tmp, ec);
   return row;
 }
 
-void print_asset_table(const std::vector<AssetRow>& rows) {
+bool browser_times(std::vector<AssetRow>& rows, const std::string& work_dir, int runs, std::string& error) {
+#ifdef TSM_SOURCE_DIR
+  const std::string script = std::string(TSM_SOURCE_DIR) + "/web/test/gltf-bench.mjs";
+#else
+  const std::string script;
+#endif
+  const std::string setup = "it needs Node, Chromium and the web decoder built from the source tree (bash web/test.sh "
+                            "sets them up)";
+  if (script.empty() || !fs::exists(script)) {
+    error = "no web/test/gltf-bench.mjs beside this tsm: " + setup;
+    return false;
+  }
+  ojson index = ojson::array();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ojson files = ojson::object();
+    for (const auto& [key, t] : {std::pair<const char*, const AssetTool*>{"tsm", &rows[i].tsm},
+                                 {"draco", &rows[i].draco},
+                                 {"meshopt", &rows[i].gltfpack}})
+      if (t->ok && !t->file.empty()) files[key] = t->file;
+    index.push_back({{"name", std::to_string(i)}, {"files", files}});
+  }
+  const std::string index_path = work_dir + "/index.json", result_path = work_dir + "/browser.json";
+  std::ofstream(index_path) << index.dump();
+  const int rc = run_program({"node", script, "--index", index_path, "--reps", std::to_string(std::max(5 * runs, 15))},
+                             result_path);
+  if (rc != 0) {
+    error = rc == -1 ? "node is not installed: " + setup
+                     : "web/test/gltf-bench.mjs failed (exit " + std::to_string(rc) + "): " + last_line(result_path) +
+                           "; " + setup;
+    return false;
+  }
+  // The result is the last line that is a JSON object (the page's errors, if any, come before it).
+  std::string text, line, json_line;
+  slurp(result_path, text);
+  std::istringstream lines(text);
+  while (std::getline(lines, line))
+    if (!line.empty() && line[0] == '{') json_line = line;
+  const ojson result = ojson::parse(json_line, nullptr, false);
+  const ojson& got = member(result, "rows");
+  if (!got.is_array()) {
+    error = "web/test/gltf-bench.mjs printed no result: " + last_line(result_path);
+    return false;
+  }
+  for (const ojson& r : got) {
+    const ojson& name = member(r, "name");
+    if (!name.is_string()) continue;
+    const size_t i = std::stoul(name.get<std::string>());
+    if (i >= rows.size()) continue;
+    for (const auto& [key, t] : {std::pair<const char*, AssetTool*>{"tsm", &rows[i].tsm},
+                                 {"draco", &rows[i].draco},
+                                 {"meshopt", &rows[i].gltfpack}}) {
+      const ojson& ms = member(member(r, key), "ms");
+      if (ms.is_number()) t->browser_ms = ms.get<double>();
+    }
+  }
+  return true;
+}
+
+void print_asset_table(const std::vector<AssetRow>& rows, bool browser) {
   std::printf(
       "\nglTF assets: each file compressed whole; positions at q bits, normals and tangents %d, texture "
       "coordinates %d, colours %d bits in every tool (other attributes at each tool's default). Geometry: "
       "the bytes of the buffer views the meshes use. Decode: the compressed .glb to a plain glTF, in this "
-      "process, one thread, ms.\n\n",
-      kNormalBits, kTexcoordBits, kColorBits);
+      "process, one thread, ms.%s\n\n",
+      kNormalBits, kTexcoordBits, kColorBits,
+      browser ? " Browser: the geometry decoded into typed arrays in headless Chromium by tsm's wasm decoder, draco3d "
+                "and meshoptimizer's MeshoptDecoder (web/test/gltf-bench.mjs), median ms."
+              : "");
   std::printf(
       "| asset | V | T | q | input bytes | tsm .glb | Draco .glb | gltfpack .glb | tsm geometry | Draco "
       "geometry | gltfpack geometry | geometry tsm/Draco | geometry tsm/gltfpack | tsm decode ms | Draco "
-      "decode ms | gltfpack decode ms |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "decode ms | gltfpack decode ms |%s\n",
+      browser ? " tsm browser ms | draco3d browser ms | meshopt browser ms |" : "");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|%s\n",
+              browser ? "---:|---:|---:|" : "");
   for (const AssetRow& r : rows) {
-    std::printf("| %s | %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.name.c_str(),
+    std::printf("| %s | %s | %s | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |", r.name.c_str(),
                 thousands(r.vertices).c_str(), thousands(r.triangles).c_str(), r.q, thousands(r.input_bytes).c_str(),
                 cell_bytes(r.tsm, r.tsm.glb_bytes).c_str(), cell_bytes(r.draco, r.draco.glb_bytes).c_str(),
                 cell_bytes(r.gltfpack, r.gltfpack.glb_bytes).c_str(), cell_bytes(r.tsm, r.tsm.geometry_bytes).c_str(),
@@ -311,6 +380,10 @@ void print_asset_table(const std::vector<AssetRow>& rows) {
                 cell_bytes(r.gltfpack, r.gltfpack.geometry_bytes).c_str(), cell_ratio(r.tsm, r.draco).c_str(),
                 cell_ratio(r.tsm, r.gltfpack).c_str(), cell_ms(r.tsm.decode_ms).c_str(),
                 cell_ms(r.draco.decode_ms).c_str(), cell_ms(r.gltfpack.decode_ms).c_str());
+    if (browser)
+      std::printf(" %s | %s | %s |", cell_ms2(r.tsm.browser_ms).c_str(), cell_ms2(r.draco.browser_ms).c_str(),
+                  cell_ms2(r.gltfpack.browser_ms).c_str());
+    std::printf("\n");
   }
   for (const AssetRow& r : rows)
     for (const auto& [tool, t] :
@@ -329,6 +402,7 @@ ojson asset_rows_json(const std::vector<AssetRow>& rows) {
     }
     if (t.encode_ms >= 0) o["encode_ms"] = std::round(t.encode_ms * 1e3) / 1e3;
     if (t.decode_ms >= 0) o["decode_ms"] = std::round(t.decode_ms * 1e3) / 1e3;
+    if (t.browser_ms >= 0) o["browser_decode_ms"] = std::round(t.browser_ms * 1e3) / 1e3;
     if (!t.error.empty()) o["error"] = t.error;
     return o;
   };

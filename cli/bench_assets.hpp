@@ -14,6 +14,8 @@ struct AssetTool {
   bool ok = false;
   size_t glb_bytes = 0, geometry_bytes = 0;
   double encode_ms = -1, decode_ms = -1;  // encode_ms: tsm only (the others run as programs)
+  double browser_ms = -1;                 // geometry decoded in headless Chromium (--browser)
+  std::string file;                       // the compressed .glb, in the bench's work folder
   std::string error;                      // why there is no figure
 };
 
@@ -34,10 +36,16 @@ bool is_gltf_path(const std::string& path);
 size_t glb_geometry_bytes(const std::string& glb);
 
 // Positions at q bits, normals and tangents 8, texture coordinates 10,
-// colours 8 for all three tools; one thread; medians of `runs`.
-AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool quiet);
+// colours 8 for all three tools; one thread; medians of `runs`. The
+// compressed files are written into `work_dir` (the caller's, removed by it).
+AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool quiet, const std::string& work_dir);
 
-void print_asset_table(const std::vector<AssetRow>& rows);
+// Geometry decode times in headless Chromium (tsm's wasm decoder, draco3d,
+// meshoptimizer's decoder) of the rows' files, through the source tree's
+// web/test/gltf-bench.mjs; false and `error` when that cannot run.
+bool browser_times(std::vector<AssetRow>& rows, const std::string& work_dir, int runs, std::string& error);
+
+void print_asset_table(const std::vector<AssetRow>& rows, bool browser);
 nlohmann::ordered_json asset_rows_json(const std::vector<AssetRow>& rows);
 
 }  // namespace tsm::cli

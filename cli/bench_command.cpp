@@ -6,6 +6,8 @@
 // their own (bench_assets.cpp): whole assets through tsm, Draco and gltfpack.
 #include <nlohmann/json.hpp>
 
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -105,11 +107,21 @@ Mesh generated_sphere(int rings, int segments) {
 }  // namespace
 
 int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::vector<int>& qbits, int runs, int level,
-              bool quiet) {
+              bool quiet, bool browser) {
   std::vector<std::string> meshes = meshes_in.empty() ? default_meshes() : meshes_in;
   std::vector<Row> rows;
   std::vector<ReadRow> reads;
   std::vector<AssetRow> assets;
+  // The compressed glTF files, kept until the browser has decoded them.
+  std::string work_dir = (std::filesystem::temp_directory_path() / "tsm-bench-XXXXXX").string();
+  if (!mkdtemp(work_dir.data())) work_dir = ".";
+  struct RemoveAtExit {
+    std::string dir;
+    ~RemoveAtExit() {
+      std::error_code ec;
+      if (dir != ".") std::filesystem::remove_all(dir, ec);
+    }
+  } remove_work_dir{work_dir};
   std::vector<std::string> failures;
   const bool have_draco = bench::draco_available();
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -143,7 +155,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       reads.push_back(rr);
       if (is_gltf_path(path)) {
         for (int q : qbits) {
-          assets.push_back(bench_asset(path, q, level, runs, quiet));
+          assets.push_back(bench_asset(path, q, level, runs, quiet, work_dir));
           if (!assets.back().tsm.ok) failures.push_back(rr.mesh + ": " + assets.back().tsm.error);
         }
         continue;
@@ -218,6 +230,11 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
     }
   }
 
+  if (browser && !assets.empty()) {
+    if (!quiet) std::fprintf(stderr, "tsm bench: the glTF files in headless Chromium\n");
+    std::string why;
+    if (!browser_times(assets, work_dir, runs, why)) failures.push_back("--browser: " + why);
+  }
   auto bpv = [](size_t bytes, size_t v) { return v ? 8.0 * static_cast<double>(bytes) / static_cast<double>(v) : 0.0; };
   if (json) {
     // Built with the JSON library: a mesh name that is not UTF-8 still gives valid JSON (U+FFFD).
@@ -297,7 +314,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       std::printf("\n");
     }
   }
-  if (!assets.empty()) print_asset_table(assets);
+  if (!assets.empty()) print_asset_table(assets, browser);
   if (!reads.empty()) {
     std::printf("\n| mesh | tsm read ms | Draco read ms | Draco/tsm |\n|---|---:|---:|---:|\n");
     for (const ReadRow& r : reads)

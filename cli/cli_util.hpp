@@ -54,6 +54,6 @@ std::string default_corpus_dir();
 std::string default_mesh_path();
 
 int run_bench(const std::vector<std::string>& meshes, bool json, const std::vector<int>& qbits,
-              int runs, int level, bool quiet);
+              int runs, int level, bool quiet, bool browser);
 
 }  // namespace tsm::cli

@@ -258,7 +258,7 @@ int main(int argc, char** argv) {
       "  tsm encode bunny.ply -o - | tsm info -");
 
   std::vector<std::string> bench_meshes;
-  bool bench_json = false, bench_quiet = false;
+  bool bench_json = false, bench_quiet = false, bench_browser = false;
   std::vector<int> bench_q{11, 14};
   int bench_runs = 3, bench_level = kDefaultLevel;
   CLI::App* ben = app.add_subcommand(
@@ -269,6 +269,9 @@ int main(int argc, char** argv) {
   ben->add_option("-l,--level", bench_level, "tsm level")->check(CLI::Range(0, 9));
   ben->add_flag("--json", bench_json, "Print JSON instead of the Markdown table");
   ben->add_flag("--quiet", bench_quiet, "No progress lines on stderr");
+  ben->add_flag("--browser", bench_browser,
+                "glTF assets: also decode time in headless Chromium beside draco3d and meshopt (needs the source "
+                "tree's web/ set up: bash web/test.sh)");
   ben->footer(
       "Examples:\n"
       "  tsm bench ../shared/corpus/bun_zipper.ply -q 11 -q 14 --runs 5\n"
@@ -324,7 +327,7 @@ int main(int argc, char** argv) {
     if (*inf) return cmd_info(ia);
     if (*cmp) return cmd_compare(ca);
     if (*sim) return cmd_simplify(sa);
-    if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet);
+    if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet, bench_browser);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "tsm: error: out of memory\n");
     return kExitInternal;

@@ -1226,6 +1226,17 @@ TEST_F(Cli, BenchComparesGltfAssets) {
   ASSERT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("| ball.glb | 642 | 1,280 | 11 |"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("| mesh | V | q |"), std::string::npos) << "no empty scans table: " << r.out;
+
+  // --browser: the browser columns, or (web/ not set up here) a failure that says what to do.
+  r = tsm("bench " + quote(file("ball.glb")) + " --runs 1 -q 11 --quiet --browser");
+  EXPECT_NE(r.out.find("| tsm browser ms | draco3d browser ms | meshopt browser ms |"), std::string::npos) << r.out;
+  if (r.code == 0) {
+    EXPECT_EQ(r.out.find("| - | - | - |\n"), std::string::npos) << "browser figures: " << r.out;
+  } else {
+    EXPECT_EQ(r.code, 3) << r.out << r.err;
+    EXPECT_NE(r.out.find("failed: --browser: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("bash web/test.sh"), std::string::npos) << r.out;
+  }
 }
 
 }  // namespace

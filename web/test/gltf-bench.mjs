@@ -7,6 +7,11 @@
 // (gltfpack -cc -vp 14 -vt 12 -vn 10 -vc 10, EXT_meshopt_compression).
 // Writes build/web/gltf-bench.md and .json.
 //   node web/test/gltf-bench.mjs [--reps N]
+//   node web/test/gltf-bench.mjs --index FILE [--reps N]
+// With --index (how `tsm bench --browser` calls it), the files are given:
+// FILE is [{"name": ..., "files": {"tsm": path, "draco": path, "meshopt":
+// path}}, ...] (any of the three), nothing is compressed here, and the
+// result is printed as JSON on stdout, nothing else.
 // Env: TSM (the native CLI), CORPUS (../shared/corpus).
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -26,41 +31,65 @@ const out = path.join(root, 'build/web/data/gltf-bench');
 const arg = (name, d) => { const i = process.argv.indexOf(name); return i > 0 ? process.argv[i + 1] : d; };
 fs.mkdirSync(out, { recursive: true });
 
-const io = new NodeIO().registerExtensions(ALL_EXTENSIONS).registerDependencies({
-  'draco3d.decoder': await draco3d.createDecoderModule(), 'draco3d.encoder': await draco3d.createEncoderModule() });
+// The corpus's assets compressed by tsm (levels 6 and 0), glTF-Transform +
+// draco3d and gltfpack, into `out`, listed in `index`.
+async function prepare() {
+  const io = new NodeIO().registerExtensions(ALL_EXTENSIONS).registerDependencies({
+    'draco3d.decoder': await draco3d.createDecoderModule(), 'draco3d.encoder': await draco3d.createEncoderModule() });
 
-const index = [];
-for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruck.gltf', 'assets/2CylinderEngine.glb']) {
-  const src = path.join(CORPUS, rel);
-  if (!fs.existsSync(src)) { console.log(`note: ${src} missing, left out`); continue; }
-  const name = path.basename(rel).replace(/\.gl(b|tf)$/, '');
-  const files = { tsm: `${name}.tsm.glb`, tsm_l0: `${name}.tsm-l0.glb`, draco: `${name}.draco.glb`, meshopt: `${name}.meshopt.glb` };
-  const dest = (k) => path.join(out, files[k]);
-  execFileSync(TSM, ['encode', src, '-o', dest('tsm'), '-f', '--quiet']);
-  execFileSync(TSM, ['encode', src, '-o', dest('tsm_l0'), '-f', '--quiet', '-l', '0']);
-  const doc = await io.read(src);
-  // glTF-Transform's Draco writer skips primitives without indices (Fox's): give them 0, 1, 2, ...
-  for (const mesh of doc.getRoot().listMeshes()) {
-    for (const prim of mesh.listPrimitives()) {
-      if (prim.getIndices()) continue;
-      const count = prim.getAttribute('POSITION').getCount();
-      prim.setIndices(doc.createAccessor().setType('SCALAR').setBuffer(doc.getRoot().listBuffers()[0])
-        .setArray(count < 65536 ? Uint16Array.from({ length: count }, (_, i) => i) : Uint32Array.from({ length: count }, (_, i) => i)));
+  for (const rel of ['assets/Fox/Fox.gltf', 'assets/CesiumMilkTruck/CesiumMilkTruck.gltf', 'assets/2CylinderEngine.glb']) {
+    const src = path.join(CORPUS, rel);
+    if (!fs.existsSync(src)) { console.log(`note: ${src} missing, left out`); continue; }
+    const name = path.basename(rel).replace(/\.gl(b|tf)$/, '');
+    const files = { tsm: `${name}.tsm.glb`, tsm_l0: `${name}.tsm-l0.glb`, draco: `${name}.draco.glb`, meshopt: `${name}.meshopt.glb` };
+    const dest = (k) => path.join(out, files[k]);
+    execFileSync(TSM, ['encode', src, '-o', dest('tsm'), '-f', '--quiet']);
+    execFileSync(TSM, ['encode', src, '-o', dest('tsm_l0'), '-f', '--quiet', '-l', '0']);
+    const doc = await io.read(src);
+    // glTF-Transform's Draco writer skips primitives without indices (Fox's): give them 0, 1, 2, ...
+    for (const mesh of doc.getRoot().listMeshes()) {
+      for (const prim of mesh.listPrimitives()) {
+        if (prim.getIndices()) continue;
+        const count = prim.getAttribute('POSITION').getCount();
+        prim.setIndices(doc.createAccessor().setType('SCALAR').setBuffer(doc.getRoot().listBuffers()[0])
+          .setArray(count < 65536 ? Uint16Array.from({ length: count }, (_, i) => i) : Uint32Array.from({ length: count }, (_, i) => i)));
+      }
     }
+    doc.createExtension(KHRDracoMeshCompression).setRequired(true).setEncoderOptions({
+      method: KHRDracoMeshCompression.EncoderMethod.EDGEBREAKER, encodeSpeed: 0, decodeSpeed: 5,
+      quantizationBits: { POSITION: 14, NORMAL: 10, TEX_COORD: 12, COLOR: 10, GENERIC: 16 } });
+    await io.write(dest('draco'), doc);
+    execFileSync(process.execPath, [path.join(web, 'node_modules/gltfpack/cli.js'), '-i', src, '-o', dest('meshopt'),
+      '-cc', '-vp', '14', '-vt', '12', '-vn', '10', '-vc', '10'], { stdio: ['ignore', 'ignore', 'pipe'] });
+    index.push({ name, files: Object.fromEntries(Object.entries(files).map(([k, f]) => [k, `/data/gltf-bench/${f}`])) });
+    console.log(`gltf-bench: ${name}: ` + Object.keys(files).map((k) => `${k} ${fs.statSync(dest(k)).size} bytes`).join(', '));
   }
-  doc.createExtension(KHRDracoMeshCompression).setRequired(true).setEncoderOptions({
-    method: KHRDracoMeshCompression.EncoderMethod.EDGEBREAKER, encodeSpeed: 0, decodeSpeed: 5,
-    quantizationBits: { POSITION: 14, NORMAL: 10, TEX_COORD: 12, COLOR: 10, GENERIC: 16 } });
-  await io.write(dest('draco'), doc);
-  execFileSync(process.execPath, [path.join(web, 'node_modules/gltfpack/cli.js'), '-i', src, '-o', dest('meshopt'),
-    '-cc', '-vp', '14', '-vt', '12', '-vn', '10', '-vc', '10'], { stdio: ['ignore', 'ignore', 'pipe'] });
-  index.push({ name, files: Object.fromEntries(Object.entries(files).map(([k, f]) => [k, `/data/gltf-bench/${f}`])) });
-  console.log(`gltf-bench: ${name}: ` + Object.keys(files).map((k) => `${k} ${fs.statSync(dest(k)).size} bytes`).join(', '));
+}
+
+const given = arg('--index', null);
+const index = [];
+if (given) {
+  // Copied under web/'s server root, where the page fetches them.
+  for (const [i, asset] of JSON.parse(fs.readFileSync(given, 'utf8')).entries()) {
+    const files = {};
+    for (const [codec, file] of Object.entries(asset.files)) {
+      const name = `given-${i}-${codec}.glb`;
+      fs.copyFileSync(file, path.join(out, name));
+      files[codec] = `/data/gltf-bench/${name}`;
+    }
+    index.push({ name: asset.name, files });
+  }
+} else {
+  await prepare();
 }
 fs.writeFileSync(path.join(out, 'index.json'), JSON.stringify(index, null, 1));
 
 const r = await runBenchPage(`gltf-bench.html?reps=${arg('--reps', '15')}`, 600000);
 if (r.state !== 'done') { console.error('gltf bench failed:', r.error); process.exit(1); }
+if (given) {
+  console.log(JSON.stringify(r));
+  process.exit(0);
+}
 const n = (x) => x.toLocaleString('en-US');
 const lines = [`Chromium ${r.chromium}, headless, this machine; geometry of each file decoded into typed arrays, ` +
   `median of ${r.reps} runs after 2 warm-up runs, the three decoders taking turns.`, '',
