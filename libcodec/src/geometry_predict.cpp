@@ -37,6 +37,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <type_traits>
 
 #include "byte_io.hpp"
@@ -120,33 +121,58 @@ __attribute__((always_inline)) inline int64_t div_round(int64_t sum, int64_t n) 
   return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
+// N residual models, each set up on the first use of its context: a set
+// of many contexts (about 8.7 KB each) then costs nothing to create, so a
+// small mesh, a segment or one of the encoder's trial codings pays only for
+// the contexts it codes. Allocated on the heap by its owner (not zeroed).
+template <int N>
+class LazyModels {
+ public:
+  LazyModels() {}
+  ResidualModel& operator[](int i) {
+    const uint64_t bit = uint64_t{1} << (i & 63);
+    if (!(ready_[i >> 6] & bit)) {
+      new (&slot_[i].m) ResidualModel;  // default-initialized: the mantissa rows set themselves up lazily
+      ready_[i >> 6] |= bit;
+    }
+    return slot_[i].m;
+  }
+
+ private:
+  union Slot {
+    Slot() {}  // not constructed until first used
+    ResidualModel m;
+  };
+  uint64_t ready_[(N + 63) / 64] = {};
+  Slot slot_[N];
+};
+
+// Residual contexts: (coding position i * kClasses + predictor class) *
+// kActivity + activity context, as the tables number them.
+constexpr int kTableContexts = 3 * kClasses * kActivity;
+
 // Residual mixing (kMixFlag): the second model of each residual
-// decision, by the second context, and the mixing weights by coding
-// position and first context (capped at kMixCtx - 1). Only allocated for a
-// mixed stream (about 1.8 MB of mostly untouched lazy rows).
+// decision, by the second context (numbered as the surface models), and the
+// mixing weights by coding position and first context (capped at
+// kMixCtx - 1). Only allocated for a mixed stream.
 struct MixModels {
-  MixModels() {}  // as ResidualModels
-  ResidualModel m2[3][kClasses][kActivity];
+  MixModels() {}  // user-provided: make_unique does not zero the models first
+  LazyModels<kTableContexts> m2;
   MixWeights w[3][kMixCtx][kMixKinds<kMantissa>];
 };
 
-// The surface residuals' adaptive models, one per context (coding position,
-// predictor class, activity), numbered as the tables number them (context
-// (i * kClasses + cls) * kActivity + ctx). Not allocated when the residuals
-// go through tables (about 1.8 MB that the decoder would otherwise set up).
-constexpr int kTableContexts = 3 * kClasses * kActivity;
-struct SurfaceModels {
-  SurfaceModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
-  ResidualModel m[kTableContexts];
-};
+// The surface residuals' adaptive models, one per context. Not allocated
+// when the residuals go through tables.
+using SurfaceModels = LazyModels<kTableContexts>;
 
 // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
-// then the lattice index offset from the plane nearest the prediction.
+// then the lattice index offset from the plane nearest the prediction, by
+// (axis * 3 + axes on the lattice so far) * kActivity + activity context.
 // Allocated on the first lattice decision.
 struct LatticeModels {
-  LatticeModels() {}  // as SurfaceModels
+  LatticeModels() {}  // as MixModels
   Prob on[3][3];
-  ResidualModel index[3][3][kActivity];
+  LazyModels<3 * 3 * kActivity> index;
 };
 
 // The encoder's and decoder's view of the coded symbols; everything else in
@@ -164,7 +190,7 @@ struct EncodeSink {
     return static_cast<int32_t>(v);
   }
   // A surface residual (context: Coder::vertex's, numbered for the tables).
-  int32_t residual(SurfaceModels* m, int ctx, int64_t v) { return sint(m->m[ctx], v); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t v) { return sint((*m)[ctx], v); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t v) {
     MixEncodeOp op{e};
     return code_mixed_sint(op, a, b, w, static_cast<int32_t>(v));
@@ -207,7 +233,7 @@ struct DecodeSink {
   RangeDecoder d;
   int bit(Prob& p, int) { return d.bit(p); }
   int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
-  int32_t residual(SurfaceModels* m, int ctx, int64_t) { return m->m[ctx].decode(d); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t) { return (*m)[ctx].decode(d); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t) {
     MixDecodeOp op{d};
     return code_mixed_sint(op, a, b, w, 0);
@@ -364,7 +390,8 @@ struct Coder {
         LatticeModels& lm = lat();
         on = s.bit(lm.on[a][on_count], on);
         if (on) {
-          int64_t d = s.sint(lm.index[a][on_count][ctx], static_cast<int64_t>(jx) - static_cast<int64_t>(j));
+          int64_t d = s.sint(lm.index[(a * 3 + on_count) * kActivity + ctx],
+                             static_cast<int64_t>(jx) - static_cast<int64_t>(j));
           int64_t k = static_cast<int64_t>(j) + d;
           if (k < 0 || k >= static_cast<int64_t>(L.size())) return false;
           x = L[static_cast<size_t>(k)];
@@ -377,8 +404,8 @@ struct Coder {
         const int rctx = (i * kClasses + cls) * kActivity + ctx;  // SurfaceModels' and the tables' numbering
         if (!kPlain && mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
-          r = s.sint_mixed(surface->m[rctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
-                           static_cast<int64_t>(x) - p);
+          r = s.sint_mixed((*surface)[rctx], mix->m2[(i * kClasses + cls) * kActivity + ctx2],
+                           mix->w[i][std::min(ctx, kMixCtx - 1)], static_cast<int64_t>(x) - p);
         } else {
           r = s.residual(surface.get(), rctx, static_cast<int64_t>(x) - p);
         }
@@ -684,7 +711,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
       const std::vector<uint32_t>* L = kLattice ? &c.lattice.values[a] : nullptr;
       if (kLattice && !L->empty() && s.d.bit(lm->on[a][on_count])) {  // on a plane: its offset from the nearest
         const int64_t k = static_cast<int64_t>(c.nearest_plane(a, static_cast<uint32_t>(p))) +
-                          lm->index[a][on_count][ctx].decode(s.d);
+                          lm->index[(a * 3 + on_count) * kActivity + ctx].decode(s.d);
         if (k < 0 || k >= static_cast<int64_t>(L->size())) return false;
         X[a] = (*L)[static_cast<size_t>(k)];
         ++on_count;

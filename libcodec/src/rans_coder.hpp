@@ -51,8 +51,11 @@ struct RansTableModels {
 class RansEncoder {
  public:
   explicit RansEncoder(int contexts)
-      : count_(static_cast<size_t>(contexts)), freq_(count_.size()), top_(count_.size(), 0) {}
-  void count(int ctx, int64_t r) { ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)]; }
+      : count_(static_cast<size_t>(contexts)), total_(count_.size(), 0), freq_(count_.size()), top_(count_.size(), 0) {}
+  void count(int ctx, int64_t r) {
+    ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)];
+    ++total_[static_cast<size_t>(ctx)];
+  }
   void build();
   void write_tables(RangeEncoder& e) const;
   void put(BitWriter& bits, int ctx, int64_t r);
@@ -61,6 +64,7 @@ class RansEncoder {
 
  private:
   std::vector<std::array<uint32_t, kRansSymbols>> count_;
+  std::vector<uint64_t> total_;              // per context: residuals counted
   std::vector<std::vector<uint16_t>> freq_;  // per context: frequencies of symbols 0..S-1 (empty: unused)
   std::vector<std::vector<uint16_t>> start_;
   std::vector<uint8_t> share_;   // per context: 1 if it uses the previous table
