@@ -739,13 +739,14 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   return true;
 }
 
-// Level 1-2's decoder (predictor fan: every triangle around the vertex,
-// spread contexts, optionally the tangent step and lattice planes; no mixing;
-// residuals from tables): SurfaceCoder::code with multi true, the fan walk
-// written out as one loop (the general walk calls a lambda per half-edge),
-// then the general Coder::vertex. Same arithmetic as the general walk,
-// which the encoder runs (the level-1 and level-2 round trips in the tests
-// compare the two).
+// The decoder of the predictors that walk every triangle around the vertex
+// (fan in march order: levels 1-2; parallelograms and spread in greedy
+// order: levels 3-6) without mixing, residuals from tables: SurfaceCoder::
+// code with multi true, the fan walk written out as one loop (the general
+// walk calls a lambda per half-edge), then the general Coder::vertex. Same
+// arithmetic as the general walk, which the encoder runs (the round trips
+// in the tests at levels 1-6 compare the two). first: the half-edges to
+// code, in order.
 bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
                        const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
   const uint32_t* cv = g.corners().data();
@@ -812,7 +813,8 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
       normal = ns.finish();
     }
     const int activity = nnb ? (actsum + nnb / 2) / nnb : last_act;
-    if (!c.vertex<false>(s, q, v, pred, cls, activity, npara >= 2 ? spread : nullptr, normal)) return false;
+    if (!c.vertex<false>(s, q, v, pred, cls, activity, c.spread_ctx && npara >= 2 ? spread : nullptr, normal))
+      return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = act[v];
     if ((i & 4095) == 0 && s.truncated()) return false;
@@ -868,101 +870,125 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   return sc.isolated();
 }
 
-// The greedy order (below) depends on the connectivity alone: which
-// vertices are decoded, never their values. The encoder's passes over one
-// layout (fits and trial encodes) record it on the first and replay it on
-// the others.
-struct GreedyOrder {
-  std::vector<uint32_t> vertices;
-  bool recorded = false;
-};
-
 // Greedy order: next the vertex with the most complete parallelograms (then
-// the most decoded neighbours); ties first-in first-out. Counts are kept
-// incrementally: a parallelogram completes when the last of its three known
-// corners is decoded. A new component starts at the first undecoded corner
-// in march order. order (encoder only): recorded, or replayed if it was.
-template <class Sink>
-bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
-  SurfaceCoder<Sink> sc(g, c, s, q);
+// the most decoded neighbours), each counted up to 3; ties first-in
+// first-out. Counts are kept incrementally: a parallelogram completes when
+// the last of its three known corners is decoded. A new component starts at
+// the first undecoded corner in march order. The order depends on the
+// connectivity alone, so it is found before any vertex is coded: the
+// vertices in order into `out`. first_he: per vertex, its smallest
+// half-edge (the fan the coder walks).
+void greedy_vertices(const GeometryLayout& g, const std::vector<uint32_t>& first_he, std::vector<uint32_t>& out) {
   const uint32_t n = g.vertex_count;
+  const uint32_t* cv = g.corners().data();
+  const uint32_t* twin = g.twin.data();
   const uint32_t H = static_cast<uint32_t>(g.corners().size());
-  const std::vector<uint32_t>& first_he = sc.first_half_edges();
-  if (order && order->recorded) {
-    for (uint32_t v : order->vertices)
-      if (!sc.code(first_he[v], true)) return false;
-    return sc.isolated();
-  }
-  if (order) order->vertices.clear();
-  std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
-  constexpr int kBuckets = 16;
-  std::vector<uint32_t> bucket[kBuckets];
-  size_t head[kBuckets] = {};
-  auto priority = [&](uint32_t x) { return std::min<int>(npara[x], 3) * 4 + std::min<int>(nnb[x], 3); };
-  auto bump = [&](uint32_t x) {
-    int p = priority(x);
-    if (p != prio[x]) {
-      prio[x] = static_cast<uint8_t>(p);
-      bucket[p].push_back(x);
-    }
+  out.clear();
+  out.reserve(n);
+  // Per vertex: kDone once ordered, else its priority 4 min(parallelograms,
+  // 3) + min(neighbours, 3). Bucket b (1..15) lists the vertices of priority
+  // b in the order they reached it (doubly linked: a vertex leaves its
+  // bucket when its priority rises).
+  constexpr uint8_t kDone = 0xFF;
+  std::vector<uint8_t> prio(n, 0);
+  std::unique_ptr<uint32_t[]> next(new uint32_t[n]), prev(new uint32_t[n]);  // set when a vertex joins a bucket
+  uint32_t head[16], tail[16];
+  std::fill(head, head + 16, kNone);
+  std::fill(tail, tail + 16, kNone);
+  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
+  auto unlink = [&](uint32_t x, int b) {
+    const uint32_t p = prev[x], nx = next[x];
+    (p == kNone ? head[b] : next[p]) = nx;
+    (nx == kNone ? tail[b] : prev[nx]) = p;
+    if (head[b] == kNone) nonempty &= ~(1u << b);
   };
-  auto decoded = [&](uint32_t v) {  // update counts around the vertex just coded
-    sc.fan(first_he[v], [&](uint32_t h) {
-      const uint32_t hn = he_next(h), hp = he_prev(h);
-      const uint32_t xu = sc.cv[hn], xw = sc.cv[hp];
-      const uint32_t u = sc.known(hn), w = sc.known(hp);
-      // v as a neighbour of u.
-      if (u == kNone && xu != kNone) {
-        uint32_t x = xu;
-        if (nnb[x] < 255) ++nnb[x];
-        // Parallelogram of u in triangle (u, w, v), across w-v.
-        if (w != kNone && sc.known(he_prev(g.twin[hp])) != kNone && npara[x] < 255) ++npara[x];
-        bump(x);
-      }
-      // Parallelogram of w in triangle (w, v, u), across v-u.
-      if (w == kNone && xw != kNone && u != kNone && sc.known(he_prev(g.twin[h])) != kNone) {
-        uint32_t x = xw;
-        if (npara[x] < 255) ++npara[x];
-        bump(x);
-      }
-      // v as the far corner o of the vertex across u-w.
-      if (u != kNone && w != kNone) {
-        uint32_t hx = he_prev(g.twin[hn]);
-        uint32_t x = sc.cv[hx];
-        if (x != kNone && sc.known(hx) == kNone) {
-          if (npara[x] < 255) ++npara[x];
-          bump(x);
-        }
-      }
-    });
+  // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
+  // undecoded vertex x.
+  auto raise = [&](uint32_t x, int dp, int dn) {
+    const int p = prio[x];
+    const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
+    if (np == p) return;
+    if (p) unlink(x, p);
+    prio[x] = static_cast<uint8_t>(np);
+    prev[x] = tail[np];
+    next[x] = kNone;
+    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
+    tail[np] = x;
+    nonempty |= 1u << np;
+  };
+  auto known = [&](uint32_t h) {
+    const uint32_t x = cv[h];
+    return x != kNone && prio[x] == kDone;
   };
   uint32_t scan = 0;
   for (;;) {
-    uint32_t v = kNone;
-    for (int b = kBuckets - 1; b >= 1 && v == kNone; --b) {
-      while (head[b] < bucket[b].size()) {
-        uint32_t x = bucket[b][head[b]++];
-        if (c.act[x] == kUnknown && prio[x] == b) {
-          v = x;
-          break;
-        }
-      }
-      if (head[b] == bucket[b].size()) {
-        bucket[b].clear();
-        head[b] = 0;
-      }
-    }
-    if (v == kNone) {  // a new component: first undecoded corner in march order
-      while (scan < H && (sc.cv[scan] == kNone || sc.known(scan) != kNone)) ++scan;
+    uint32_t v;
+    if (nonempty) {
+      const int b = 31 - __builtin_clz(nonempty);
+      v = head[b];
+      unlink(v, b);
+    } else {  // a new component (every undecoded vertex has priority 0)
+      while (scan < H && (cv[scan] == kNone || prio[cv[scan]] == kDone)) ++scan;
       if (scan == H) break;
-      v = sc.cv[scan];
+      v = cv[scan];
     }
-    if (!sc.code(first_he[v], true)) return false;
-    if (order) order->vertices.push_back(v);
-    decoded(v);
-    if ((v & 4095) == 0 && s.truncated()) return false;
+    prio[v] = kDone;
+    out.push_back(v);
+    // The counts around v: each triangle (v, u, w) of its fan.
+    const uint32_t h0 = first_he[v];
+    uint32_t h = h0;
+    size_t guard = 0;
+    do {
+      const uint32_t hn = he_next(h), hp = he_prev(h);
+      const uint32_t xu = cv[hn], xw = cv[hp];
+      const bool u = known(hn), w = known(hp);
+      // v as a neighbour of u, and the parallelogram of u across w-v.
+      if (!u && xu != kNone) raise(xu, w && known(he_prev(twin[hp])), 1);
+      // The parallelogram of w across v-u.
+      if (!w && xw != kNone && u && known(he_prev(twin[h]))) raise(xw, 1, 0);
+      // v as the far corner of the vertex across u-w.
+      if (u && w) {
+        const uint32_t hx = he_prev(twin[hn]), x = cv[hx];
+        if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
+      }
+      h = he_next(twin[h]);
+    } while (h != h0 && ++guard < H);
   }
-  if (order) order->recorded = true;
+}
+
+// The greedy order is the same for every pass over one layout: the
+// encoder's passes (fits and trial encodes) find it once.
+struct GreedyOrder {
+  std::vector<uint32_t> vertices;
+  bool found = false;
+};
+
+// Codes the vertices in greedy order (order: the encoder's, found on the
+// first pass; null: found here).
+template <class Sink>
+bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
+  SurfaceCoder<Sink> sc(g, c, s, q);
+  const std::vector<uint32_t>& first_he = sc.first_half_edges();
+  GreedyOrder own;
+  if (!order) order = &own;
+  if (!order->found) {
+    greedy_vertices(g, first_he, order->vertices);
+    order->found = true;
+  }
+  const std::vector<uint32_t>& vs = order->vertices;
+  const uint32_t nv = static_cast<uint32_t>(vs.size());
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
+    if (!c.mix) {
+      std::unique_ptr<uint32_t[]> hs(new uint32_t[nv]);
+      for (uint32_t i = 0; i < nv; ++i) hs[i] = first_he[vs[i]];
+      if (!decode_fan_tables(g, c, s, q, hs.get(), nv, sc.last, sc.last_act)) return false;
+      return sc.isolated();
+    }
+  }
+  for (uint32_t i = 0; i < nv; ++i) {
+    if (!sc.code(first_he[vs[i]], true)) return false;
+    if ((i & 4095) == 0 && s.truncated()) return false;
+  }
   return sc.isolated();
 }
 
@@ -1219,7 +1245,7 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
   return true;
 }
 
-// encode_geometry_as with the greedy order recorded or replayed (null: neither).
+// encode_geometry_as with the greedy order shared between passes (null: found on each).
 std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                  int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent,
                                  bool mix, bool top, bool tables, GreedyOrder* order) {
