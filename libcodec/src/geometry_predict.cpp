@@ -1117,22 +1117,23 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
     return t;
   }();
   const size_t stride = std::max<size_t>(1, samples.size() / 200000);
-  int32_t best = kAlphaOne;
-  double best_cost = -1;
-  for (int32_t a16 = 0; a16 <= 24; ++a16) {
-    const int32_t alpha = a16 << (kAlphaShift - 4);
-    double cost = 0;
-    for (size_t i = 0; i < samples.size(); i += stride) {
-      int64_t r = samples[i].second - floor_shift(alpha * samples[i].first + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+  // Every weight's cost in one pass over the samples (each sum still adds
+  // its terms in sample order, so the costs are those of a pass per weight).
+  constexpr int kWeights = 25;  // a16 = 0 .. 24
+  double cost[kWeights] = {};
+  for (size_t i = 0; i < samples.size(); i += stride) {
+    const int64_t d = samples[i].first, y = samples[i].second;
+    for (int a16 = 0; a16 < kWeights; ++a16) {
+      const int64_t alpha = int64_t{a16} << (kAlphaShift - 4);
+      const int64_t r = y - floor_shift(alpha * d + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
       const int64_t m = r < 0 ? -r : r;
-      cost += m < 4096 ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
-    }
-    if (best_cost < 0 || cost < best_cost) {
-      best_cost = cost;
-      best = alpha;
+      cost[a16] += m < 4096 ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
     }
   }
-  return best;
+  int best = 0;
+  for (int a16 = 1; a16 < kWeights; ++a16)
+    if (cost[a16] < cost[best]) best = a16;
+  return best << (kAlphaShift - 4);
 }
 
 // A statistics pass in a surface predictor's order: nothing coded, the
