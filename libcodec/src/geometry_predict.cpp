@@ -739,28 +739,110 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   return true;
 }
 
+// The greedy order's state (greedy_vertices below): per vertex kDone once
+// ordered, else its priority 4 min(parallelograms, 3) + min(neighbours, 3);
+// bucket b (1..15) lists the vertices of priority b in the order they
+// reached it (doubly linked: a vertex leaves its bucket when its priority
+// rises), the next vertex is the first of the highest non-empty bucket.
+struct GreedyQueue {
+  static constexpr uint8_t kDone = 0xFF;
+  explicit GreedyQueue(uint32_t n) : prio(n, 0), next(new uint32_t[n]), prev(new uint32_t[n]) {
+    std::fill(head, head + 16, kNone);
+    std::fill(tail, tail + 16, kNone);
+  }
+  std::vector<uint8_t> prio;
+  std::unique_ptr<uint32_t[]> next, prev;  // set when a vertex joins a bucket
+  uint32_t head[16], tail[16];
+  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
+
+  bool done(uint32_t x) const { return x != kNone && prio[x] == kDone; }
+  void unlink(uint32_t x, int b) {
+    const uint32_t p = prev[x], nx = next[x];
+    (p == kNone ? head[b] : next[p]) = nx;
+    (nx == kNone ? tail[b] : prev[nx]) = p;
+    if (head[b] == kNone) nonempty &= ~(1u << b);
+  }
+  // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
+  // vertex x (not ordered yet).
+  void raise(uint32_t x, int dp, int dn) {
+    const int p = prio[x];
+    const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
+    if (np == p) return;
+    if (p) unlink(x, p);
+    prio[x] = static_cast<uint8_t>(np);
+    prev[x] = tail[np];
+    next[x] = kNone;
+    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
+    tail[np] = x;
+    nonempty |= 1u << np;
+  }
+  // The next vertex (marked done), or kNone when every bucket is empty.
+  uint32_t pop() {
+    if (!nonempty) return kNone;
+    const int b = 31 - __builtin_clz(nonempty);
+    const uint32_t v = head[b];
+    unlink(v, b);
+    prio[v] = kDone;
+    return v;
+  }
+  // After vertex v (done) at the origin of half-edge h: the counts that
+  // its triangle (v, u, w) completes (u at hn = he_next(h), w at hp).
+  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
+                                            uint32_t hp) {
+    const uint32_t xu = cv[hn], xw = cv[hp];
+    const bool u = done(xu), w = done(xw);
+    // v as a neighbour of u, and the parallelogram of u across w-v.
+    if (!u && xu != kNone) raise(xu, w && done(cv[he_prev(twin[hp])]), 1);
+    // The parallelogram of w across v-u.
+    if (!w && xw != kNone && u && done(cv[he_prev(twin[h])])) raise(xw, 1, 0);
+    // v as the far corner of the vertex across u-w.
+    if (u && w) {
+      const uint32_t x = cv[he_prev(twin[hn])];
+      if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
+    }
+  }
+};
+
 // The decoder of the predictors that walk every triangle around the vertex
 // (fan in march order: levels 1-2; parallelograms and spread in greedy
 // order: levels 3-6) without mixing, residuals from tables: SurfaceCoder::
 // code with multi true, the fan walk written out as one loop (the general
 // walk calls a lambda per half-edge), then the general Coder::vertex. Same
 // arithmetic as the general walk, which the encoder runs (the round trips
-// in the tests at levels 1-6 compare the two). first: the half-edges to
-// code, in order.
-bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
-                       const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
-  const uint32_t* cv = g.corners().data();
-  const uint32_t* twin = g.twin.data();
-  const uint8_t* act = c.act.data();
-  const size_t H = g.corners().size();
-  auto known = [&](uint32_t h) {
+// in the tests at levels 1-6 compare the two).
+struct FanTableDecoder {
+  const uint32_t* cv;
+  const uint32_t* twin;
+  const uint8_t* act;
+  size_t H;
+  Coder& c;
+  TableDecodeSink& s;
+  std::vector<uint32_t>& q;
+  int64_t* last;
+  int& last_act;
+
+  FanTableDecoder(const GeometryLayout& g, Coder& coder, TableDecodeSink& sink, std::vector<uint32_t>& qs,
+                  int64_t* last_, int& last_act_)
+      : cv(g.corners().data()),
+        twin(g.twin.data()),
+        act(coder.act.data()),
+        H(g.corners().size()),
+        c(coder),
+        s(sink),
+        q(qs),
+        last(last_),
+        last_act(last_act_) {}
+  uint32_t known(uint32_t h) const {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
-  };
-  auto at = [&](uint32_t v) { return &q[3 * size_t{v}]; };
-  constexpr int kPairs = 16;
-  for (uint32_t i = 0; i < nfirst; ++i) {
-    const uint32_t h0 = first[i], v = cv[h0];
+  }
+  const uint32_t* at(uint32_t v) const { return &q[3 * size_t{v}]; }
+
+  // Decodes the vertex at the origin of half-edge h0; greedy: the order's
+  // counts around it are updated in the same walk (null in march order).
+  __attribute__((always_inline)) bool vertex(uint32_t h0, GreedyQueue* greedy) {
+    constexpr int kPairs = 16;
+    const uint32_t v = cv[h0];
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, pred[3];
     int npara = 0, nnb = 0, actsum = 0, npair = 0;
     uint32_t pu[kPairs], pw[kPairs];
@@ -790,6 +872,7 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
           }
         }
       }
+      if (greedy) greedy->count(cv, twin, h, hn, he_prev(h));
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
@@ -817,9 +900,41 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
       return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = act[v];
+    return true;
+  }
+};
+
+// March order. first: the half-edges to code, in order.
+bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                       const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
+  FanTableDecoder fd(g, c, s, q, last, last_act);
+  for (uint32_t i = 0; i < nfirst; ++i) {
+    if (!fd.vertex(first[i], nullptr)) return false;
     if ((i & 4095) == 0 && s.truncated()) return false;
   }
   return true;
+}
+
+// Greedy order (greedy_vertices below), found as the vertices are decoded:
+// the walk that predicts a vertex also counts what it completes.
+// first_he: per vertex, its smallest half-edge.
+bool decode_greedy_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                          const std::vector<uint32_t>& first_he, int64_t last[3], int& last_act) {
+  FanTableDecoder fd(g, c, s, q, last, last_act);
+  GreedyQueue greedy(g.vertex_count);
+  const uint32_t H = static_cast<uint32_t>(fd.H);
+  uint32_t scan = 0;
+  for (uint32_t i = 0;; ++i) {
+    uint32_t v = greedy.pop();
+    if (v == kNone) {  // a new component: the first undecoded corner in march order
+      while (scan < H && (fd.cv[scan] == kNone || greedy.prio[fd.cv[scan]] == GreedyQueue::kDone)) ++scan;
+      if (scan == H) return true;
+      v = fd.cv[scan];
+      greedy.prio[v] = GreedyQueue::kDone;
+    }
+    if (!fd.vertex(first_he[v], &greedy)) return false;
+    if ((i & 4095) == 0 && s.truncated()) return false;
+  }
 }
 
 // March order: vertices as the triangle tree first reaches them.
@@ -875,82 +990,33 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
 // first-out. Counts are kept incrementally: a parallelogram completes when
 // the last of its three known corners is decoded. A new component starts at
 // the first undecoded corner in march order. The order depends on the
-// connectivity alone, so it is found before any vertex is coded: the
+// connectivity alone, so the encoder finds it once per layout, before
+// coding (the table decoder as it decodes: decode_greedy_tables): the
 // vertices in order into `out`. first_he: per vertex, its smallest
 // half-edge (the fan the coder walks).
 void greedy_vertices(const GeometryLayout& g, const std::vector<uint32_t>& first_he, std::vector<uint32_t>& out) {
-  const uint32_t n = g.vertex_count;
   const uint32_t* cv = g.corners().data();
   const uint32_t* twin = g.twin.data();
   const uint32_t H = static_cast<uint32_t>(g.corners().size());
   out.clear();
-  out.reserve(n);
-  // Per vertex: kDone once ordered, else its priority 4 min(parallelograms,
-  // 3) + min(neighbours, 3). Bucket b (1..15) lists the vertices of priority
-  // b in the order they reached it (doubly linked: a vertex leaves its
-  // bucket when its priority rises).
-  constexpr uint8_t kDone = 0xFF;
-  std::vector<uint8_t> prio(n, 0);
-  std::unique_ptr<uint32_t[]> next(new uint32_t[n]), prev(new uint32_t[n]);  // set when a vertex joins a bucket
-  uint32_t head[16], tail[16];
-  std::fill(head, head + 16, kNone);
-  std::fill(tail, tail + 16, kNone);
-  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
-  auto unlink = [&](uint32_t x, int b) {
-    const uint32_t p = prev[x], nx = next[x];
-    (p == kNone ? head[b] : next[p]) = nx;
-    (nx == kNone ? tail[b] : prev[nx]) = p;
-    if (head[b] == kNone) nonempty &= ~(1u << b);
-  };
-  // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
-  // undecoded vertex x.
-  auto raise = [&](uint32_t x, int dp, int dn) {
-    const int p = prio[x];
-    const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
-    if (np == p) return;
-    if (p) unlink(x, p);
-    prio[x] = static_cast<uint8_t>(np);
-    prev[x] = tail[np];
-    next[x] = kNone;
-    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
-    tail[np] = x;
-    nonempty |= 1u << np;
-  };
-  auto known = [&](uint32_t h) {
-    const uint32_t x = cv[h];
-    return x != kNone && prio[x] == kDone;
-  };
+  out.reserve(g.vertex_count);
+  GreedyQueue greedy(g.vertex_count);
   uint32_t scan = 0;
   for (;;) {
-    uint32_t v;
-    if (nonempty) {
-      const int b = 31 - __builtin_clz(nonempty);
-      v = head[b];
-      unlink(v, b);
-    } else {  // a new component (every undecoded vertex has priority 0)
-      while (scan < H && (cv[scan] == kNone || prio[cv[scan]] == kDone)) ++scan;
+    uint32_t v = greedy.pop();
+    if (v == kNone) {  // a new component (every vertex not ordered has priority 0)
+      while (scan < H && (cv[scan] == kNone || greedy.prio[cv[scan]] == GreedyQueue::kDone)) ++scan;
       if (scan == H) break;
       v = cv[scan];
+      greedy.prio[v] = GreedyQueue::kDone;
     }
-    prio[v] = kDone;
     out.push_back(v);
     // The counts around v: each triangle (v, u, w) of its fan.
     const uint32_t h0 = first_he[v];
     uint32_t h = h0;
     size_t guard = 0;
     do {
-      const uint32_t hn = he_next(h), hp = he_prev(h);
-      const uint32_t xu = cv[hn], xw = cv[hp];
-      const bool u = known(hn), w = known(hp);
-      // v as a neighbour of u, and the parallelogram of u across w-v.
-      if (!u && xu != kNone) raise(xu, w && known(he_prev(twin[hp])), 1);
-      // The parallelogram of w across v-u.
-      if (!w && xw != kNone && u && known(he_prev(twin[h]))) raise(xw, 1, 0);
-      // v as the far corner of the vertex across u-w.
-      if (u && w) {
-        const uint32_t hx = he_prev(twin[hn]), x = cv[hx];
-        if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
-      }
+      greedy.count(cv, twin, h, he_next(h), he_prev(h));
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
   }
@@ -969,6 +1035,8 @@ template <class Sink>
 bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
   SurfaceCoder<Sink> sc(g, c, s, q);
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
+    if (!c.mix) return decode_greedy_tables(g, c, s, q, first_he, sc.last, sc.last_act) && sc.isolated();
   GreedyOrder own;
   if (!order) order = &own;
   if (!order->found) {
@@ -977,14 +1045,6 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   }
   const std::vector<uint32_t>& vs = order->vertices;
   const uint32_t nv = static_cast<uint32_t>(vs.size());
-  if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
-    if (!c.mix) {
-      std::unique_ptr<uint32_t[]> hs(new uint32_t[nv]);
-      for (uint32_t i = 0; i < nv; ++i) hs[i] = first_he[vs[i]];
-      if (!decode_fan_tables(g, c, s, q, hs.get(), nv, sc.last, sc.last_act)) return false;
-      return sc.isolated();
-    }
-  }
   for (uint32_t i = 0; i < nv; ++i) {
     if (!sc.code(first_he[vs[i]], true)) return false;
     if ((i & 4095) == 0 && s.truncated()) return false;
