@@ -222,8 +222,7 @@ struct TableEncodeSink : EncodeSink {
   BitWriter bits;
   explicit TableEncodeSink(RansEncoder& t) : tables(t) {}
   int32_t residual(SurfaceModels*, int ctx, int64_t v) {
-    tables.count(ctx, v);
-    tables.put(bits, ctx, v);
+    tables.count_and_put(bits, ctx, v);
     return static_cast<int32_t>(v);
   }
 };

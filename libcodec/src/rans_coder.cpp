@@ -11,15 +11,6 @@
 
 namespace tsm {
 
-RansSymbol rans_symbol(int64_t r) {
-  if (r >= -kRansDirect && r <= kRansDirect) return {static_cast<int>(r + kRansDirect), 0, 0};
-  const uint64_t mag = static_cast<uint64_t>(r < 0 ? -r : r);
-  const int n = bit_length(mag);  // 4..30
-  const int t = static_cast<int>((mag >> (n - 3)) & 3);
-  const int symbol = 2 * kRansDirect + 1 + 8 * (n - 4) + 4 * (r < 0) + t;
-  return {symbol, n - 3, static_cast<uint32_t>(mag & ((uint64_t{1} << (n - 3)) - 1))};
-}
-
 RansDecoder::SymbolTable::SymbolTable() : s() {
   for (int k = 0; k < kRansSymbols; ++k) {
     if (k <= 2 * kRansDirect) {

@@ -36,7 +36,14 @@ struct RansSymbol {
   uint32_t raw;
 };
 // |r| < 2^30.
-RansSymbol rans_symbol(int64_t r);
+inline RansSymbol rans_symbol(int64_t r) {
+  if (r >= -kRansDirect && r <= kRansDirect) return {static_cast<int>(r + kRansDirect), 0, 0};
+  const uint64_t mag = static_cast<uint64_t>(r < 0 ? -r : r);
+  const int n = bit_length(mag);  // 4..30
+  const int t = static_cast<int>((mag >> (n - 3)) & 3);
+  const int symbol = 2 * kRansDirect + 1 + 8 * (n - 4) + 4 * (r < 0) + t;
+  return {symbol, n - 3, static_cast<uint32_t>(mag & ((uint64_t{1} << (n - 3)) - 1))};
+}
 
 // The frequency tables' models in the range-coded stream (FORMAT.md §8.5.12).
 struct RansTableModels {
@@ -59,6 +66,14 @@ class RansEncoder {
   void build();
   void write_tables(RangeEncoder& e) const;
   void put(BitWriter& bits, int ctx, int64_t r);
+  // count() and put() at once (one pass: the encoder keeps what it puts).
+  void count_and_put(BitWriter& bits, int ctx, int64_t r) {
+    const RansSymbol s = rans_symbol(r);
+    ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(s.symbol)];
+    ++total_[static_cast<size_t>(ctx)];
+    coded_.push_back(static_cast<uint32_t>(ctx) << 8 | static_cast<uint32_t>(s.symbol));
+    if (s.raw_bits) bits.put(s.raw, s.raw_bits);
+  }
   // The rANS stream: the two final states (u32 each), then 16-bit words.
   std::string finish();
 
