@@ -485,6 +485,21 @@ __attribute__((always_inline)) inline int blend_prediction(const int32_t alpha[3
   return nnb ? 1 : 0;
 }
 
+// What the walk around a vertex found (SurfaceCoder::code with multi):
+// the encoder's passes in one greedy order see the same decoded vertices
+// around each vertex at the same positions, so the first pass keeps its
+// walks and the others read them instead of walking again.
+struct FanWalk {
+  int64_t para[3], nb[3], spread[3];
+  int npara, nnb, npair;
+  uint32_t ids;  // FanWalks::ids[ids ..]: the nnb neighbours, then min(npair, 16) (u, w) pairs
+};
+struct FanWalks {
+  std::vector<FanWalk> fans;  // per vertex in coding order
+  std::vector<uint32_t> ids;
+  bool ready = false;
+};
+
 // Prediction from the triangles around a vertex (march, greedy and gate
 // orders share it).
 template <class Sink>
@@ -496,6 +511,8 @@ struct SurfaceCoder {
   int64_t last[3];
   int last_act = 0;
   const std::vector<uint32_t>& cv;  // per half-edge: the output vertex at its origin (kNone: virtual)
+  FanWalks* walks = nullptr;        // the encoder's walks in greedy order: kept on its first pass, then read
+  size_t walk_step = 0;
 
   SurfaceCoder(const GeometryLayout& layout, Coder& coder, Sink& sink, std::vector<uint32_t>& qs)
       : g(layout), c(coder), s(sink), q(qs), cv(layout.corners()) {
@@ -546,10 +563,12 @@ struct SurfaceCoder {
     constexpr int kPairs = 16;  // triangles with u and w decoded, kept for the tangent step's normal
     uint32_t pu[kPairs], pw[kPairs];
     int npair = 0;
+    FanWalks* const kept = multi ? walks : nullptr;
     auto neighbour = [&](uint32_t u) {
       for (int a = 0; a < 3; ++a) nb[a] += at(u)[a];
       ++nnb;
       actsum += c.act[u];
+      if (kept) kept->ids.push_back(u);  // (only while the first pass walks)
     };
     auto visit = [&](uint32_t h) {
       uint32_t u = known(he_next(h));
@@ -575,18 +594,41 @@ struct SurfaceCoder {
       else
         f(h0);
     };
-    walk(visit);
-    if (!multi) {
-      uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
-      if (w != kNone && npara == 0) neighbour(w);
+    int64_t spread[3];
+    if (kept && kept->ready) {  // this vertex's walk on the first pass
+      const FanWalk& f = kept->fans[walk_step++];
+      std::copy(f.para, f.para + 3, para);
+      std::copy(f.nb, f.nb + 3, nb);
+      std::copy(f.spread, f.spread + 3, spread);
+      npara = f.npara, nnb = f.nnb, npair = f.npair;
+      const uint32_t* id = &kept->ids[f.ids];
+      for (int i = 0; i < nnb; ++i) actsum += c.act[id[i]];
+      id += nnb;
+      for (int i = 0; i < std::min(npair, kPairs); ++i) pu[i] = id[2 * i], pw[i] = id[2 * i + 1];
+    } else {
+      const size_t first_id = kept ? kept->ids.size() : 0;
+      walk(visit);
+      if (!multi) {
+        uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
+        if (w != kNone && npara == 0) neighbour(w);
+      }
+      for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+      if (kept) {
+        for (int i = 0; i < std::min(npair, kPairs); ++i) kept->ids.push_back(pu[i]), kept->ids.push_back(pw[i]);
+        FanWalk f;
+        std::copy(para, para + 3, f.para);
+        std::copy(nb, nb + 3, f.nb);
+        std::copy(spread, spread + 3, f.spread);
+        f.npara = npara, f.nnb = nnb, f.npair = npair;
+        f.ids = static_cast<uint32_t>(first_id);
+        kept->fans.push_back(f);
+      }
     }
     int64_t d[3], n[3];
     const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
     if constexpr (Sink::kEncoder)
       if (c.collect && npara)
         for (int a = 0; a < 3; ++a) c.samples[cls - 2].push_back({d[a], static_cast<int64_t>(at(v)[a]) - n[a]});
-    int64_t spread[3];
-    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
     NormalSum ns;
     if (!kPlain && c.tangent && npara > 0) {
@@ -1026,6 +1068,7 @@ void greedy_vertices(const GeometryLayout& g, const std::vector<uint32_t>& first
 struct GreedyOrder {
   std::vector<uint32_t> vertices;
   bool found = false;
+  FanWalks walks;  // what the first pass's walks found (SurfaceCoder::code)
 };
 
 // Codes the vertices in greedy order (order: the encoder's, found on the
@@ -1044,10 +1087,12 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   }
   const std::vector<uint32_t>& vs = order->vertices;
   const uint32_t nv = static_cast<uint32_t>(vs.size());
+  if (order != &own) sc.walks = &order->walks;  // the encoder's passes share them
   for (uint32_t i = 0; i < nv; ++i) {
     if (!sc.code(first_he[vs[i]], true)) return false;
     if ((i & 4095) == 0 && s.truncated()) return false;
   }
+  if (sc.walks) sc.walks->ready = true;
   return sc.isolated();
 }
 
