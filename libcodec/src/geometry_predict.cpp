@@ -37,6 +37,7 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <type_traits>
 
 #include "byte_io.hpp"
@@ -120,33 +121,58 @@ __attribute__((always_inline)) inline int64_t div_round(int64_t sum, int64_t n) 
   return num >= 0 ? num / den : -((-num + den - 1) / den);
 }
 
+// N residual models, each set up on the first use of its context: a set
+// of many contexts (about 8.7 KB each) then costs nothing to create, so a
+// small mesh, a segment or one of the encoder's trial codings pays only for
+// the contexts it codes. Allocated on the heap by its owner (not zeroed).
+template <int N>
+class LazyModels {
+ public:
+  LazyModels() {}
+  ResidualModel& operator[](int i) {
+    const uint64_t bit = uint64_t{1} << (i & 63);
+    if (!(ready_[i >> 6] & bit)) {
+      new (&slot_[i].m) ResidualModel;  // default-initialized: the mantissa rows set themselves up lazily
+      ready_[i >> 6] |= bit;
+    }
+    return slot_[i].m;
+  }
+
+ private:
+  union Slot {
+    Slot() {}  // not constructed until first used
+    ResidualModel m;
+  };
+  uint64_t ready_[(N + 63) / 64] = {};
+  Slot slot_[N];
+};
+
+// Residual contexts: (coding position i * kClasses + predictor class) *
+// kActivity + activity context, as the tables number them.
+constexpr int kTableContexts = 3 * kClasses * kActivity;
+
 // Residual mixing (kMixFlag): the second model of each residual
-// decision, by the second context, and the mixing weights by coding
-// position and first context (capped at kMixCtx - 1). Only allocated for a
-// mixed stream (about 1.8 MB of mostly untouched lazy rows).
+// decision, by the second context (numbered as the surface models), and the
+// mixing weights by coding position and first context (capped at
+// kMixCtx - 1). Only allocated for a mixed stream.
 struct MixModels {
-  MixModels() {}  // as ResidualModels
-  ResidualModel m2[3][kClasses][kActivity];
+  MixModels() {}  // user-provided: make_unique does not zero the models first
+  LazyModels<kTableContexts> m2;
   MixWeights w[3][kMixCtx][kMixKinds<kMantissa>];
 };
 
-// The surface residuals' adaptive models, one per context (coding position,
-// predictor class, activity), numbered as the tables number them (context
-// (i * kClasses + cls) * kActivity + ctx). Not allocated when the residuals
-// go through tables (about 1.8 MB that the decoder would otherwise set up).
-constexpr int kTableContexts = 3 * kClasses * kActivity;
-struct SurfaceModels {
-  SurfaceModels() {}  // user-provided: no zeroing on make_unique (the models set themselves up lazily)
-  ResidualModel m[kTableContexts];
-};
+// The surface residuals' adaptive models, one per context. Not allocated
+// when the residuals go through tables.
+using SurfaceModels = LazyModels<kTableContexts>;
 
 // Lattice coding: on-lattice flag by [axis][axes on the lattice so far],
-// then the lattice index offset from the plane nearest the prediction.
+// then the lattice index offset from the plane nearest the prediction, by
+// (axis * 3 + axes on the lattice so far) * kActivity + activity context.
 // Allocated on the first lattice decision.
 struct LatticeModels {
-  LatticeModels() {}  // as SurfaceModels
+  LatticeModels() {}  // as MixModels
   Prob on[3][3];
-  ResidualModel index[3][3][kActivity];
+  LazyModels<3 * 3 * kActivity> index;
 };
 
 // The encoder's and decoder's view of the coded symbols; everything else in
@@ -164,7 +190,7 @@ struct EncodeSink {
     return static_cast<int32_t>(v);
   }
   // A surface residual (context: Coder::vertex's, numbered for the tables).
-  int32_t residual(SurfaceModels* m, int ctx, int64_t v) { return sint(m->m[ctx], v); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t v) { return sint((*m)[ctx], v); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t v) {
     MixEncodeOp op{e};
     return code_mixed_sint(op, a, b, w, static_cast<int32_t>(v));
@@ -196,8 +222,7 @@ struct TableEncodeSink : EncodeSink {
   BitWriter bits;
   explicit TableEncodeSink(RansEncoder& t) : tables(t) {}
   int32_t residual(SurfaceModels*, int ctx, int64_t v) {
-    tables.count(ctx, v);
-    tables.put(bits, ctx, v);
+    tables.count_and_put(bits, ctx, v);
     return static_cast<int32_t>(v);
   }
 };
@@ -207,7 +232,7 @@ struct DecodeSink {
   RangeDecoder d;
   int bit(Prob& p, int) { return d.bit(p); }
   int32_t sint(ResidualModel& m, int64_t) { return m.decode(d); }
-  int32_t residual(SurfaceModels* m, int ctx, int64_t) { return m->m[ctx].decode(d); }
+  int32_t residual(SurfaceModels* m, int ctx, int64_t) { return (*m)[ctx].decode(d); }
   int32_t sint_mixed(ResidualModel& a, ResidualModel& b, MixWeights* w, int64_t) {
     MixDecodeOp op{d};
     return code_mixed_sint(op, a, b, w, 0);
@@ -364,7 +389,8 @@ struct Coder {
         LatticeModels& lm = lat();
         on = s.bit(lm.on[a][on_count], on);
         if (on) {
-          int64_t d = s.sint(lm.index[a][on_count][ctx], static_cast<int64_t>(jx) - static_cast<int64_t>(j));
+          int64_t d = s.sint(lm.index[(a * 3 + on_count) * kActivity + ctx],
+                             static_cast<int64_t>(jx) - static_cast<int64_t>(j));
           int64_t k = static_cast<int64_t>(j) + d;
           if (k < 0 || k >= static_cast<int64_t>(L.size())) return false;
           x = L[static_cast<size_t>(k)];
@@ -377,8 +403,8 @@ struct Coder {
         const int rctx = (i * kClasses + cls) * kActivity + ctx;  // SurfaceModels' and the tables' numbering
         if (!kPlain && mix) {
           const int ctx2 = std::min(i ? bit_length(top) : spread ? activity : prev_act, kActivity - 1);
-          r = s.sint_mixed(surface->m[rctx], mix->m2[i][cls][ctx2], mix->w[i][std::min(ctx, kMixCtx - 1)],
-                           static_cast<int64_t>(x) - p);
+          r = s.sint_mixed((*surface)[rctx], mix->m2[(i * kClasses + cls) * kActivity + ctx2],
+                           mix->w[i][std::min(ctx, kMixCtx - 1)], static_cast<int64_t>(x) - p);
         } else {
           r = s.residual(surface.get(), rctx, static_cast<int64_t>(x) - p);
         }
@@ -459,6 +485,21 @@ __attribute__((always_inline)) inline int blend_prediction(const int32_t alpha[3
   return nnb ? 1 : 0;
 }
 
+// What the walk around a vertex found (SurfaceCoder::code with multi):
+// the encoder's passes in one greedy order see the same decoded vertices
+// around each vertex at the same positions, so the first pass keeps its
+// walks and the others read them instead of walking again.
+struct FanWalk {
+  int64_t para[3], nb[3], spread[3];
+  int npara, nnb, npair;
+  uint32_t ids;  // FanWalks::ids[ids ..]: the nnb neighbours, then min(npair, 16) (u, w) pairs
+};
+struct FanWalks {
+  std::vector<FanWalk> fans;  // per vertex in coding order
+  std::vector<uint32_t> ids;
+  bool ready = false;
+};
+
 // Prediction from the triangles around a vertex (march, greedy and gate
 // orders share it).
 template <class Sink>
@@ -470,6 +511,8 @@ struct SurfaceCoder {
   int64_t last[3];
   int last_act = 0;
   const std::vector<uint32_t>& cv;  // per half-edge: the output vertex at its origin (kNone: virtual)
+  FanWalks* walks = nullptr;        // the encoder's walks in greedy order: kept on its first pass, then read
+  size_t walk_step = 0;
 
   SurfaceCoder(const GeometryLayout& layout, Coder& coder, Sink& sink, std::vector<uint32_t>& qs)
       : g(layout), c(coder), s(sink), q(qs), cv(layout.corners()) {
@@ -520,10 +563,12 @@ struct SurfaceCoder {
     constexpr int kPairs = 16;  // triangles with u and w decoded, kept for the tangent step's normal
     uint32_t pu[kPairs], pw[kPairs];
     int npair = 0;
+    FanWalks* const kept = multi ? walks : nullptr;
     auto neighbour = [&](uint32_t u) {
       for (int a = 0; a < 3; ++a) nb[a] += at(u)[a];
       ++nnb;
       actsum += c.act[u];
+      if (kept) kept->ids.push_back(u);  // (only while the first pass walks)
     };
     auto visit = [&](uint32_t h) {
       uint32_t u = known(he_next(h));
@@ -549,18 +594,41 @@ struct SurfaceCoder {
       else
         f(h0);
     };
-    walk(visit);
-    if (!multi) {
-      uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
-      if (w != kNone && npara == 0) neighbour(w);
+    int64_t spread[3];
+    if (kept && kept->ready) {  // this vertex's walk on the first pass
+      const FanWalk& f = kept->fans[walk_step++];
+      std::copy(f.para, f.para + 3, para);
+      std::copy(f.nb, f.nb + 3, nb);
+      std::copy(f.spread, f.spread + 3, spread);
+      npara = f.npara, nnb = f.nnb, npair = f.npair;
+      const uint32_t* id = &kept->ids[f.ids];
+      for (int i = 0; i < nnb; ++i) actsum += c.act[id[i]];
+      id += nnb;
+      for (int i = 0; i < std::min(npair, kPairs); ++i) pu[i] = id[2 * i], pw[i] = id[2 * i + 1];
+    } else {
+      const size_t first_id = kept ? kept->ids.size() : 0;
+      walk(visit);
+      if (!multi) {
+        uint32_t w = known(he_prev(h0));  // the root triangle's third corner sees two
+        if (w != kNone && npara == 0) neighbour(w);
+      }
+      for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+      if (kept) {
+        for (int i = 0; i < std::min(npair, kPairs); ++i) kept->ids.push_back(pu[i]), kept->ids.push_back(pw[i]);
+        FanWalk f;
+        std::copy(para, para + 3, f.para);
+        std::copy(nb, nb + 3, f.nb);
+        std::copy(spread, spread + 3, f.spread);
+        f.npara = npara, f.nnb = nnb, f.npair = npair;
+        f.ids = static_cast<uint32_t>(first_id);
+        kept->fans.push_back(f);
+      }
     }
     int64_t d[3], n[3];
     const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
     if constexpr (Sink::kEncoder)
       if (c.collect && npara)
         for (int a = 0; a < 3; ++a) c.samples[cls - 2].push_back({d[a], static_cast<int64_t>(at(v)[a]) - n[a]});
-    int64_t spread[3];
-    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
     NormalSum ns;
     if (!kPlain && c.tangent && npara > 0) {
@@ -684,7 +752,7 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
       const std::vector<uint32_t>* L = kLattice ? &c.lattice.values[a] : nullptr;
       if (kLattice && !L->empty() && s.d.bit(lm->on[a][on_count])) {  // on a plane: its offset from the nearest
         const int64_t k = static_cast<int64_t>(c.nearest_plane(a, static_cast<uint32_t>(p))) +
-                          lm->index[a][on_count][ctx].decode(s.d);
+                          lm->index[(a * 3 + on_count) * kActivity + ctx].decode(s.d);
         if (k < 0 || k >= static_cast<int64_t>(L->size())) return false;
         X[a] = (*L)[static_cast<size_t>(k)];
         ++on_count;
@@ -712,27 +780,110 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
   return true;
 }
 
-// Level 1-2's decoder (predictor fan: every triangle around the vertex,
-// spread contexts, optionally the tangent step and lattice planes; no mixing;
-// residuals from tables): SurfaceCoder::code with multi true, the fan walk
-// written out as one loop (the general walk calls a lambda per half-edge),
-// then the general Coder::vertex. Same arithmetic as the general walk,
-// which the encoder runs (the level-1 and level-2 round trips in the tests
-// compare the two).
-bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
-                       const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
-  const uint32_t* cv = g.corners().data();
-  const uint32_t* twin = g.twin.data();
-  const uint8_t* act = c.act.data();
-  const size_t H = g.corners().size();
-  auto known = [&](uint32_t h) {
+// The greedy order's state (greedy_vertices below): per vertex kDone once
+// ordered, else its priority 4 min(parallelograms, 3) + min(neighbours, 3);
+// bucket b (1..15) lists the vertices of priority b in the order they
+// reached it (doubly linked: a vertex leaves its bucket when its priority
+// rises), the next vertex is the first of the highest non-empty bucket.
+struct GreedyQueue {
+  static constexpr uint8_t kDone = 0xFF;
+  explicit GreedyQueue(uint32_t n) : prio(n, 0), next(new uint32_t[n]), prev(new uint32_t[n]) {
+    std::fill(head, head + 16, kNone);
+    std::fill(tail, tail + 16, kNone);
+  }
+  std::vector<uint8_t> prio;
+  std::unique_ptr<uint32_t[]> next, prev;  // set when a vertex joins a bucket
+  uint32_t head[16], tail[16];
+  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
+
+  bool done(uint32_t x) const { return x != kNone && prio[x] == kDone; }
+  void unlink(uint32_t x, int b) {
+    const uint32_t p = prev[x], nx = next[x];
+    (p == kNone ? head[b] : next[p]) = nx;
+    (nx == kNone ? tail[b] : prev[nx]) = p;
+    if (head[b] == kNone) nonempty &= ~(1u << b);
+  }
+  // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
+  // vertex x (not ordered yet).
+  void raise(uint32_t x, int dp, int dn) {
+    const int p = prio[x];
+    const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
+    if (np == p) return;
+    if (p) unlink(x, p);
+    prio[x] = static_cast<uint8_t>(np);
+    prev[x] = tail[np];
+    next[x] = kNone;
+    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
+    tail[np] = x;
+    nonempty |= 1u << np;
+  }
+  // The next vertex (marked done), or kNone when every bucket is empty.
+  uint32_t pop() {
+    if (!nonempty) return kNone;
+    const int b = 31 - __builtin_clz(nonempty);
+    const uint32_t v = head[b];
+    unlink(v, b);
+    prio[v] = kDone;
+    return v;
+  }
+  // After vertex v (done) at the origin of half-edge h: the counts that
+  // its triangle (v, u, w) completes (u at hn = he_next(h), w at hp).
+  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
+                                            uint32_t hp) {
+    const uint32_t xu = cv[hn], xw = cv[hp];
+    const bool u = done(xu), w = done(xw);
+    // v as a neighbour of u, and the parallelogram of u across w-v.
+    if (!u && xu != kNone) raise(xu, w && done(cv[he_prev(twin[hp])]), 1);
+    // The parallelogram of w across v-u.
+    if (!w && xw != kNone && u && done(cv[he_prev(twin[h])])) raise(xw, 1, 0);
+    // v as the far corner of the vertex across u-w.
+    if (u && w) {
+      const uint32_t x = cv[he_prev(twin[hn])];
+      if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
+    }
+  }
+};
+
+// The decoder of the predictors that walk every triangle around the vertex
+// (fan in march order: levels 1-2; parallelograms and spread in greedy
+// order: levels 3-6) without mixing, residuals from tables: SurfaceCoder::
+// code with multi true, the fan walk written out as one loop (the general
+// walk calls a lambda per half-edge), then the general Coder::vertex. Same
+// arithmetic as the general walk, which the encoder runs (the round trips
+// in the tests at levels 1-6 compare the two).
+struct FanTableDecoder {
+  const uint32_t* cv;
+  const uint32_t* twin;
+  const uint8_t* act;
+  size_t H;
+  Coder& c;
+  TableDecodeSink& s;
+  std::vector<uint32_t>& q;
+  int64_t* last;
+  int& last_act;
+
+  FanTableDecoder(const GeometryLayout& g, Coder& coder, TableDecodeSink& sink, std::vector<uint32_t>& qs,
+                  int64_t* last_, int& last_act_)
+      : cv(g.corners().data()),
+        twin(g.twin.data()),
+        act(coder.act.data()),
+        H(g.corners().size()),
+        c(coder),
+        s(sink),
+        q(qs),
+        last(last_),
+        last_act(last_act_) {}
+  uint32_t known(uint32_t h) const {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
-  };
-  auto at = [&](uint32_t v) { return &q[3 * size_t{v}]; };
-  constexpr int kPairs = 16;
-  for (uint32_t i = 0; i < nfirst; ++i) {
-    const uint32_t h0 = first[i], v = cv[h0];
+  }
+  const uint32_t* at(uint32_t v) const { return &q[3 * size_t{v}]; }
+
+  // Decodes the vertex at the origin of half-edge h0; greedy: the order's
+  // counts around it are updated in the same walk (null in march order).
+  __attribute__((always_inline)) bool vertex(uint32_t h0, GreedyQueue* greedy) {
+    constexpr int kPairs = 16;
+    const uint32_t v = cv[h0];
     int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, pred[3];
     int npara = 0, nnb = 0, actsum = 0, npair = 0;
     uint32_t pu[kPairs], pw[kPairs];
@@ -762,6 +913,7 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
           }
         }
       }
+      if (greedy) greedy->count(cv, twin, h, hn, he_prev(h));
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
@@ -785,12 +937,45 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
       normal = ns.finish();
     }
     const int activity = nnb ? (actsum + nnb / 2) / nnb : last_act;
-    if (!c.vertex<false>(s, q, v, pred, cls, activity, npara >= 2 ? spread : nullptr, normal)) return false;
+    if (!c.vertex<false>(s, q, v, pred, cls, activity, c.spread_ctx && npara >= 2 ? spread : nullptr, normal))
+      return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = act[v];
+    return true;
+  }
+};
+
+// March order. first: the half-edges to code, in order.
+bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                       const uint32_t* first, uint32_t nfirst, int64_t last[3], int& last_act) {
+  FanTableDecoder fd(g, c, s, q, last, last_act);
+  for (uint32_t i = 0; i < nfirst; ++i) {
+    if (!fd.vertex(first[i], nullptr)) return false;
     if ((i & 4095) == 0 && s.truncated()) return false;
   }
   return true;
+}
+
+// Greedy order (greedy_vertices below), found as the vertices are decoded:
+// the walk that predicts a vertex also counts what it completes.
+// first_he: per vertex, its smallest half-edge.
+bool decode_greedy_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
+                          const std::vector<uint32_t>& first_he, int64_t last[3], int& last_act) {
+  FanTableDecoder fd(g, c, s, q, last, last_act);
+  GreedyQueue greedy(g.vertex_count);
+  const uint32_t H = static_cast<uint32_t>(fd.H);
+  uint32_t scan = 0;
+  for (uint32_t i = 0;; ++i) {
+    uint32_t v = greedy.pop();
+    if (v == kNone) {  // a new component: the first undecoded corner in march order
+      while (scan < H && (fd.cv[scan] == kNone || greedy.prio[fd.cv[scan]] == GreedyQueue::kDone)) ++scan;
+      if (scan == H) return true;
+      v = fd.cv[scan];
+      greedy.prio[v] = GreedyQueue::kDone;
+    }
+    if (!fd.vertex(first_he[v], &greedy)) return false;
+    if ((i & 4095) == 0 && s.truncated()) return false;
+  }
 }
 
 // March order: vertices as the triangle tree first reaches them.
@@ -841,101 +1026,73 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
   return sc.isolated();
 }
 
-// The greedy order (below) depends on the connectivity alone: which
-// vertices are decoded, never their values. The encoder's passes over one
-// layout (fits and trial encodes) record it on the first and replay it on
-// the others.
+// Greedy order: next the vertex with the most complete parallelograms (then
+// the most decoded neighbours), each counted up to 3; ties first-in
+// first-out. Counts are kept incrementally: a parallelogram completes when
+// the last of its three known corners is decoded. A new component starts at
+// the first undecoded corner in march order. The order depends on the
+// connectivity alone, so the encoder finds it once per layout, before
+// coding (the table decoder as it decodes: decode_greedy_tables): the
+// vertices in order into `out`. first_he: per vertex, its smallest
+// half-edge (the fan the coder walks).
+void greedy_vertices(const GeometryLayout& g, const std::vector<uint32_t>& first_he, std::vector<uint32_t>& out) {
+  const uint32_t* cv = g.corners().data();
+  const uint32_t* twin = g.twin.data();
+  const uint32_t H = static_cast<uint32_t>(g.corners().size());
+  out.clear();
+  out.reserve(g.vertex_count);
+  GreedyQueue greedy(g.vertex_count);
+  uint32_t scan = 0;
+  for (;;) {
+    uint32_t v = greedy.pop();
+    if (v == kNone) {  // a new component (every vertex not ordered has priority 0)
+      while (scan < H && (cv[scan] == kNone || greedy.prio[cv[scan]] == GreedyQueue::kDone)) ++scan;
+      if (scan == H) break;
+      v = cv[scan];
+      greedy.prio[v] = GreedyQueue::kDone;
+    }
+    out.push_back(v);
+    // The counts around v: each triangle (v, u, w) of its fan.
+    const uint32_t h0 = first_he[v];
+    uint32_t h = h0;
+    size_t guard = 0;
+    do {
+      greedy.count(cv, twin, h, he_next(h), he_prev(h));
+      h = he_next(twin[h]);
+    } while (h != h0 && ++guard < H);
+  }
+}
+
+// The greedy order is the same for every pass over one layout: the
+// encoder's passes (fits and trial encodes) find it once.
 struct GreedyOrder {
   std::vector<uint32_t> vertices;
-  bool recorded = false;
+  bool found = false;
+  FanWalks walks;  // what the first pass's walks found (SurfaceCoder::code)
 };
 
-// Greedy order: next the vertex with the most complete parallelograms (then
-// the most decoded neighbours); ties first-in first-out. Counts are kept
-// incrementally: a parallelogram completes when the last of its three known
-// corners is decoded. A new component starts at the first undecoded corner
-// in march order. order (encoder only): recorded, or replayed if it was.
+// Codes the vertices in greedy order (order: the encoder's, found on the
+// first pass; null: found here).
 template <class Sink>
 bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
   SurfaceCoder<Sink> sc(g, c, s, q);
-  const uint32_t n = g.vertex_count;
-  const uint32_t H = static_cast<uint32_t>(g.corners().size());
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
-  if (order && order->recorded) {
-    for (uint32_t v : order->vertices)
-      if (!sc.code(first_he[v], true)) return false;
-    return sc.isolated();
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
+    if (!c.mix) return decode_greedy_tables(g, c, s, q, first_he, sc.last, sc.last_act) && sc.isolated();
+  GreedyOrder own;
+  if (!order) order = &own;
+  if (!order->found) {
+    greedy_vertices(g, first_he, order->vertices);
+    order->found = true;
   }
-  if (order) order->vertices.clear();
-  std::vector<uint8_t> npara(n, 0), nnb(n, 0), prio(n, 0);
-  constexpr int kBuckets = 16;
-  std::vector<uint32_t> bucket[kBuckets];
-  size_t head[kBuckets] = {};
-  auto priority = [&](uint32_t x) { return std::min<int>(npara[x], 3) * 4 + std::min<int>(nnb[x], 3); };
-  auto bump = [&](uint32_t x) {
-    int p = priority(x);
-    if (p != prio[x]) {
-      prio[x] = static_cast<uint8_t>(p);
-      bucket[p].push_back(x);
-    }
-  };
-  auto decoded = [&](uint32_t v) {  // update counts around the vertex just coded
-    sc.fan(first_he[v], [&](uint32_t h) {
-      const uint32_t hn = he_next(h), hp = he_prev(h);
-      const uint32_t xu = sc.cv[hn], xw = sc.cv[hp];
-      const uint32_t u = sc.known(hn), w = sc.known(hp);
-      // v as a neighbour of u.
-      if (u == kNone && xu != kNone) {
-        uint32_t x = xu;
-        if (nnb[x] < 255) ++nnb[x];
-        // Parallelogram of u in triangle (u, w, v), across w-v.
-        if (w != kNone && sc.known(he_prev(g.twin[hp])) != kNone && npara[x] < 255) ++npara[x];
-        bump(x);
-      }
-      // Parallelogram of w in triangle (w, v, u), across v-u.
-      if (w == kNone && xw != kNone && u != kNone && sc.known(he_prev(g.twin[h])) != kNone) {
-        uint32_t x = xw;
-        if (npara[x] < 255) ++npara[x];
-        bump(x);
-      }
-      // v as the far corner o of the vertex across u-w.
-      if (u != kNone && w != kNone) {
-        uint32_t hx = he_prev(g.twin[hn]);
-        uint32_t x = sc.cv[hx];
-        if (x != kNone && sc.known(hx) == kNone) {
-          if (npara[x] < 255) ++npara[x];
-          bump(x);
-        }
-      }
-    });
-  };
-  uint32_t scan = 0;
-  for (;;) {
-    uint32_t v = kNone;
-    for (int b = kBuckets - 1; b >= 1 && v == kNone; --b) {
-      while (head[b] < bucket[b].size()) {
-        uint32_t x = bucket[b][head[b]++];
-        if (c.act[x] == kUnknown && prio[x] == b) {
-          v = x;
-          break;
-        }
-      }
-      if (head[b] == bucket[b].size()) {
-        bucket[b].clear();
-        head[b] = 0;
-      }
-    }
-    if (v == kNone) {  // a new component: first undecoded corner in march order
-      while (scan < H && (sc.cv[scan] == kNone || sc.known(scan) != kNone)) ++scan;
-      if (scan == H) break;
-      v = sc.cv[scan];
-    }
-    if (!sc.code(first_he[v], true)) return false;
-    if (order) order->vertices.push_back(v);
-    decoded(v);
-    if ((v & 4095) == 0 && s.truncated()) return false;
+  const std::vector<uint32_t>& vs = order->vertices;
+  const uint32_t nv = static_cast<uint32_t>(vs.size());
+  if (order != &own) sc.walks = &order->walks;  // the encoder's passes share them
+  for (uint32_t i = 0; i < nv; ++i) {
+    if (!sc.code(first_he[vs[i]], true)) return false;
+    if ((i & 4095) == 0 && s.truncated()) return false;
   }
-  if (order) order->recorded = true;
+  if (sc.walks) sc.walks->ready = true;
   return sc.isolated();
 }
 
@@ -1064,22 +1221,23 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
     return t;
   }();
   const size_t stride = std::max<size_t>(1, samples.size() / 200000);
-  int32_t best = kAlphaOne;
-  double best_cost = -1;
-  for (int32_t a16 = 0; a16 <= 24; ++a16) {
-    const int32_t alpha = a16 << (kAlphaShift - 4);
-    double cost = 0;
-    for (size_t i = 0; i < samples.size(); i += stride) {
-      int64_t r = samples[i].second - floor_shift(alpha * samples[i].first + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
+  // Every weight's cost in one pass over the samples (each sum still adds
+  // its terms in sample order, so the costs are those of a pass per weight).
+  constexpr int kWeights = 25;  // a16 = 0 .. 24
+  double cost[kWeights] = {};
+  for (size_t i = 0; i < samples.size(); i += stride) {
+    const int64_t d = samples[i].first, y = samples[i].second;
+    for (int a16 = 0; a16 < kWeights; ++a16) {
+      const int64_t alpha = int64_t{a16} << (kAlphaShift - 4);
+      const int64_t r = y - floor_shift(alpha * d + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
       const int64_t m = r < 0 ? -r : r;
-      cost += m < 4096 ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
-    }
-    if (best_cost < 0 || cost < best_cost) {
-      best_cost = cost;
-      best = alpha;
+      cost[a16] += m < 4096 ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
     }
   }
-  return best;
+  int best = 0;
+  for (int a16 = 1; a16 < kWeights; ++a16)
+    if (cost[a16] < cost[best]) best = a16;
+  return best << (kAlphaShift - 4);
 }
 
 // A statistics pass in a surface predictor's order: nothing coded, the
@@ -1192,7 +1350,7 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
   return true;
 }
 
-// encode_geometry_as with the greedy order recorded or replayed (null: neither).
+// encode_geometry_as with the greedy order shared between passes (null: found on each).
 std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                  int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent,
                                  bool mix, bool top, bool tables, GreedyOrder* order) {

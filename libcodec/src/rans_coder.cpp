@@ -11,15 +11,6 @@
 
 namespace tsm {
 
-RansSymbol rans_symbol(int64_t r) {
-  if (r >= -kRansDirect && r <= kRansDirect) return {static_cast<int>(r + kRansDirect), 0, 0};
-  const uint64_t mag = static_cast<uint64_t>(r < 0 ? -r : r);
-  const int n = bit_length(mag);  // 4..30
-  const int t = static_cast<int>((mag >> (n - 3)) & 3);
-  const int symbol = 2 * kRansDirect + 1 + 8 * (n - 4) + 4 * (r < 0) + t;
-  return {symbol, n - 3, static_cast<uint32_t>(mag & ((uint64_t{1} << (n - 3)) - 1))};
-}
-
 RansDecoder::SymbolTable::SymbolTable() : s() {
   for (int k = 0; k < kRansSymbols; ++k) {
     if (k <= 2 * kRansDirect) {
@@ -114,10 +105,9 @@ void RansEncoder::build() {
   share_.assign(count_.size(), 0);
   std::vector<size_t> group_of(count_.size(), 0);
   std::vector<Counts> group;
+  std::vector<uint64_t> group_total;
   for (size_t c = 0; c < count_.size(); ++c) {
-    uint64_t total = 0;
-    for (uint32_t n : count_[c]) total += n;
-    if (total == 0) continue;
+    if (total_[c] == 0) continue;
     if (!group.empty()) {
       Counts merged = group.back();
       for (int s = 0; s < kRansSymbols; ++s) merged[static_cast<size_t>(s)] += count_[c][static_cast<size_t>(s)];
@@ -125,22 +115,21 @@ void RansEncoder::build() {
           entropy_bits(group.back()) + table_bits(group.back()) + entropy_bits(count_[c]) + table_bits(count_[c]);
       if (entropy_bits(merged) + table_bits(merged) + 1 < apart) {
         group.back() = merged;
+        group_total.back() += total_[c];
         group_of[c] = group.size() - 1;
         share_[c] = 1;
         continue;
       }
     }
     group.push_back(count_[c]);
+    group_total.push_back(total_[c]);
     group_of[c] = group.size() - 1;
   }
   for (size_t c = 0; c < count_.size(); ++c) {
     freq_[c].clear();
-    uint64_t total = 0;
-    for (uint32_t n : count_[c]) total += n;
-    if (total == 0) continue;
+    if (total_[c] == 0) continue;
     const Counts& g = group[group_of[c]];
-    uint64_t gt = 0;
-    for (uint32_t n : g) gt += n;
+    const uint64_t gt = group_total[group_of[c]];
     freq_[c] = normalize(g, gt, implied_symbol(g));
     top_[c] = implied_symbol(g);
     uint32_t at = 0;

@@ -36,7 +36,14 @@ struct RansSymbol {
   uint32_t raw;
 };
 // |r| < 2^30.
-RansSymbol rans_symbol(int64_t r);
+inline RansSymbol rans_symbol(int64_t r) {
+  if (r >= -kRansDirect && r <= kRansDirect) return {static_cast<int>(r + kRansDirect), 0, 0};
+  const uint64_t mag = static_cast<uint64_t>(r < 0 ? -r : r);
+  const int n = bit_length(mag);  // 4..30
+  const int t = static_cast<int>((mag >> (n - 3)) & 3);
+  const int symbol = 2 * kRansDirect + 1 + 8 * (n - 4) + 4 * (r < 0) + t;
+  return {symbol, n - 3, static_cast<uint32_t>(mag & ((uint64_t{1} << (n - 3)) - 1))};
+}
 
 // The frequency tables' models in the range-coded stream (FORMAT.md §8.5.12).
 struct RansTableModels {
@@ -51,16 +58,28 @@ struct RansTableModels {
 class RansEncoder {
  public:
   explicit RansEncoder(int contexts)
-      : count_(static_cast<size_t>(contexts)), freq_(count_.size()), top_(count_.size(), 0) {}
-  void count(int ctx, int64_t r) { ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)]; }
+      : count_(static_cast<size_t>(contexts)), total_(count_.size(), 0), freq_(count_.size()), top_(count_.size(), 0) {}
+  void count(int ctx, int64_t r) {
+    ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)];
+    ++total_[static_cast<size_t>(ctx)];
+  }
   void build();
   void write_tables(RangeEncoder& e) const;
   void put(BitWriter& bits, int ctx, int64_t r);
+  // count() and put() at once (one pass: the encoder keeps what it puts).
+  void count_and_put(BitWriter& bits, int ctx, int64_t r) {
+    const RansSymbol s = rans_symbol(r);
+    ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(s.symbol)];
+    ++total_[static_cast<size_t>(ctx)];
+    coded_.push_back(static_cast<uint32_t>(ctx) << 8 | static_cast<uint32_t>(s.symbol));
+    if (s.raw_bits) bits.put(s.raw, s.raw_bits);
+  }
   // The rANS stream: the two final states (u32 each), then 16-bit words.
   std::string finish();
 
  private:
   std::vector<std::array<uint32_t, kRansSymbols>> count_;
+  std::vector<uint64_t> total_;              // per context: residuals counted
   std::vector<std::vector<uint16_t>> freq_;  // per context: frequencies of symbols 0..S-1 (empty: unused)
   std::vector<std::vector<uint16_t>> start_;
   std::vector<uint8_t> share_;   // per context: 1 if it uses the previous table
