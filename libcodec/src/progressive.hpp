@@ -3,6 +3,7 @@
 // independent splits coded in the decoder's vertex order.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +16,8 @@ namespace tsm {
 
 // A grid index as a coordinate (FORMAT.md §5; defined in decode.cpp).
 float grid_value(const Header& h, double step, int axis, uint32_t q);
+
+struct BatchModels;  // progressive_split.cpp
 
 // The decoder's current level of detail: the mesh, the grid index of every
 // vertex and, per vertex, the faces that use it.
@@ -37,6 +40,8 @@ class LevelMesh {
   const uint32_t* q(uint32_t v) const { return &q_[3 * size_t{v}]; }
   size_t face_uses(uint32_t v) const { return vf_[v].size(); }
   Mesh& mesh() { return *mesh_; }
+  // The split coder's adaptive models: they carry over from batch to batch.
+  std::shared_ptr<BatchModels>& models() { return models_; }
 
  private:
   Mesh* mesh_ = nullptr;
@@ -44,6 +49,7 @@ class LevelMesh {
   double step_ = 0;
   std::vector<uint32_t> q_;
   std::vector<std::vector<uint32_t>> vf_;
+  std::shared_ptr<BatchModels> models_;
 };
 
 // One vertex split as the encoder hands it to encode_batch (level ids): v is

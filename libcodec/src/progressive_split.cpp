@@ -16,17 +16,29 @@
 
 namespace tsm {
 
-namespace {
-
-Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, "refinement batch: " + what); }
-
 constexpr int kFlagContexts = 8;
+constexpr int kScaleContexts = 24;
 
 struct BatchModels {
   Prob flag[kFlagContexts];
   UIntModelT<2> start, dist;
-  SIntModelT<3> residual[3];
+  SIntModelT<3> residual[kScaleContexts][3];
 };
+
+namespace {
+
+Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, "refinement batch: " + what); }
+
+// The residual's model set: the bit length of the largest coordinate
+// difference between v and the new vertex's ring (the local edge length).
+int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist) {
+  int64_t span = 0;
+  for (uint32_t k = 0; k <= dist; ++k) {
+    const uint32_t* p = level.q(ring[(ia + k) % ring.size()]);
+    for (int a = 0; a < 3; ++a) span = std::max<int64_t>(span, std::abs(int64_t{p[a]} - int64_t{level.q(v)[a]}));
+  }
+  return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
+}
 
 int flag_context(size_t degree) { return static_cast<int>(std::min<size_t>(degree, kFlagContexts + 2) - 3); }
 
@@ -147,7 +159,8 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
   std::vector<uint8_t> marked(n, 0);
   std::vector<const VertexSplit*> by_vertex(n, nullptr);
   for (const VertexSplit& s : splits) by_vertex[s.v] = &s;
-  auto m = std::make_unique<BatchModels>();
+  if (!level.models()) level.models() = std::make_shared<BatchModels>();
+  BatchModels* m = level.models().get();
   RangeEncoder e;
   std::vector<uint32_t> ring;
   size_t ones = 0;
@@ -174,7 +187,8 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     m->dist.encode(e, dist - 1);
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
-    for (int a = 0; a < 3; ++a) m->residual[a].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
+    const int sc = scale_context(level, v, ring, ia, dist);
+    for (int a = 0; a < 3; ++a) m->residual[sc][a].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
     ids[v] = level.split(v, ring, ia, dist, s.q);
   }
   for (const VertexSplit& s : splits) new_ids.push_back(ids[s.v]);
@@ -216,7 +230,8 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
       (limits.max_faces && mesh.face_count() + 2 * splits > limits.max_faces))
     return Status(ErrorCode::limit_exceeded, "refinement batch: the mesh would exceed the decoder's limits");
   std::vector<uint8_t> marked(n, 0);
-  auto m = std::make_unique<BatchModels>();
+  if (!level.models()) level.models() = std::make_shared<BatchModels>();
+  BatchModels* m = level.models().get();
   RangeDecoder dec(stream);
   std::vector<uint32_t> ring;
   uint64_t ones = 0;
@@ -237,9 +252,10 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     if (ia >= d || dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
+    const int sc = scale_context(level, v, ring, ia, dist);
     uint32_t q[3];
     for (int a = 0; a < 3; ++a) {
-      const int64_t x = p[a] + m->residual[a].decode(dec);
+      const int64_t x = p[a] + m->residual[sc][a].decode(dec);
       if (x < 0 || x > qmax) return corrupt("a new vertex off the grid");
       q[a] = static_cast<uint32_t>(x);
     }
