@@ -32,6 +32,7 @@ enum SectionId : uint16_t {
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
   kSectionRefinement = 12,    // a progressive file's batch of vertex splits (FORMAT.md §4.8); repeats
+  kSectionLoose = 13,         // a progressive file's vertices no face uses, after its batches (FORMAT.md §4.8)
 };
 const char* section_name(uint16_t id);
 

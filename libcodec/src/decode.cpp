@@ -644,6 +644,8 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(segment(s));
       else if (s.id == kSectionRefinement)
         TSM_RETURN_IF_ERROR(refinement(s));
+      else if (s.id == kSectionLoose && batches > 0)
+        TSM_RETURN_IF_ERROR(decode_loose(s.data, level, BatchLimits{options.max_vertices, options.max_faces}));
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));
     }

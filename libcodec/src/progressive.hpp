@@ -35,6 +35,8 @@ class LevelMesh {
   // ia + dist - 1 (mod d) go to a new vertex u at grid index q, and the
   // faces (v, u, r_{ia+dist}) and (v, r_ia, u) are added. Returns u.
   uint32_t split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist, const uint32_t q[3]);
+  // Appends a vertex no face uses, at grid index q.
+  void add_point(const uint32_t q[3]);
   size_t vertex_count() const { return q_.size() / 3; }
   int bits() const { return h_.quantization_bits; }
   const uint32_t* q(uint32_t v) const { return &q_[3 * size_t{v}]; }
@@ -81,5 +83,10 @@ struct BatchLimits {
 };
 // Decodes one refinement payload and applies it to `level`.
 Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
+
+// The loose section (id 13, FORMAT.md §4.8): vertices no face uses, after
+// the last batch. q: 3 grid indices per vertex (any order; coded sorted).
+std::string encode_loose(std::vector<uint32_t> q);
+Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
 
 }  // namespace tsm

@@ -36,7 +36,9 @@ double quadric_at(const Quadric& q, const double p[3]) {
 struct Candidate {
   double cost;
   uint32_t u, v;
-  bool operator<(const Candidate& o) const { return cost < o.cost || (cost == o.cost && u < o.u); }
+  bool operator<(const Candidate& o) const {
+    return cost < o.cost || (cost == o.cost && (u < o.u || (u == o.u && v < o.v)));
+  }
 };
 
 class Collapser {
@@ -66,7 +68,7 @@ class Collapser {
   uint32_t batch_no_ = 0;
   std::vector<uint32_t> other_faces_;  // faces the collapses leave alone (polygons, degenerate)
   std::vector<std::vector<uint32_t>> vf_;
-  std::vector<uint8_t> locked_, dup_, removed_;
+  std::vector<uint8_t> locked_, dup_, extreme_, removed_, used_;
   std::vector<Quadric> quadric_;
   std::vector<uint32_t> merged_into_;  // per removed vertex: v of its collapse
   size_t vertices_left_ = 0;
@@ -78,11 +80,14 @@ void Collapser::build() {
   vf_.assign(n, {});
   locked_.assign(n, 0);
   dup_.assign(n, 0);
+  extreme_.assign(n, 0);
+  used_.assign(n, 0);
   removed_.assign(n, 0);
   merged_into_.assign(n, 0);
   quadric_.assign(n, Quadric{});
   for (size_t f = 0; f < mesh_.face_count(); ++f) {
     const uint32_t* c = mesh_.face(f);
+    for (uint32_t k = 0; k < mesh_.face_size(f); ++k) used_[c[k]] = 1;
     if (mesh_.face_size(f) != 3 || c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
       other_faces_.push_back(static_cast<uint32_t>(f));
       for (uint32_t k = 0; k < mesh_.face_size(f); ++k) locked_[c[k]] = 1;
@@ -131,7 +136,7 @@ void Collapser::lock_special() {
       if (mesh_.positions[3 * size_t{i} + a] < mesh_.positions[3 * size_t{lo} + a]) lo = i;
       if (mesh_.positions[3 * size_t{i} + a] > mesh_.positions[3 * size_t{hi} + a]) hi = i;
     }
-    if (n) locked_[lo] = locked_[hi] = 1;
+    if (n) locked_[lo] = locked_[hi] = extreme_[lo] = extreme_[hi] = 1;
   }
 }
 
@@ -234,23 +239,21 @@ void Collapser::collapse(const CollapseRecord& rec) {
   --vertices_left_;
 }
 
-// Per removable vertex, its cheapest merge into a neighbour.
+// Every half-edge u -> v whose u may go, by its quadric cost (a vertex
+// whose cheapest merge is refused may still take another).
 std::vector<Candidate> Collapser::candidates() {
   std::vector<Candidate> out;
   std::vector<uint32_t> r;
   for (uint32_t u = 0; u < vf_.size(); ++u) {
     if (removed_[u] || locked_[u] || !ring(u, r)) continue;
-    Candidate best{INFINITY, u, u};
     for (uint32_t v : r) {
       if (locked_[v]) continue;
       Quadric q = quadric_[u];
       for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
       const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
                            static_cast<double>(q_[3 * size_t{v} + 2])};
-      const double c = quadric_at(q, p);
-      if (c < best.cost) best = {c, u, v};
+      out.push_back({quadric_at(q, p), u, v});
     }
-    if (best.v != u) out.push_back(best);
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -282,8 +285,13 @@ void Collapser::write_base(CollapsePlan& plan) const {
   Mesh& base = plan.base;
   base.clear();
   plan.base_id.assign(n, kNotInBase);
+  plan.loose.clear();
   for (uint32_t i = 0; i < n; ++i) {
     if (removed_[i]) continue;
+    if (!used_[i] && !extreme_[i] && !plan.batches.empty()) {
+      plan.loose.push_back(i);
+      continue;
+    }
     plan.base_id[i] = static_cast<uint32_t>(base.vertex_count());
     base.add_vertex(mesh_.positions[3 * size_t{i}], mesh_.positions[3 * size_t{i} + 1],
                     mesh_.positions[3 * size_t{i} + 2]);

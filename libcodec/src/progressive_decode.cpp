@@ -16,9 +16,9 @@ Status apply_refinements(const Header& h, const std::vector<Section>& sections, 
   BatchLimits limits{options.max_vertices, options.max_faces};
   uint32_t k = 0;
   for (const Section& s : sections) {
-    if (s.id != kSectionRefinement) continue;
+    if (s.id != kSectionRefinement && s.id != kSectionLoose) continue;
     if (!ready) level.init(mesh, h), ready = true;
-    Status st = decode_batch(s.data, level, limits);
+    Status st = s.id == kSectionLoose ? decode_loose(s.data, level, limits) : decode_batch(s.data, level, limits);
     if (!st.ok()) return Status(st.code(), "batch " + std::to_string(k) + ": " + st.message());
     ++k;
   }

@@ -97,6 +97,12 @@ Status encode_progressive(const Mesh& mesh, const EncodeOptions& options, std::s
     append_raw_section(out, kSectionRefinement, write_batch(bh, stream));
     before = bh.error_after;
   }
+  if (!plan.loose.empty()) {
+    std::vector<uint32_t> lq;
+    for (uint32_t i : plan.loose)
+      for (int a = 0; a < 3; ++a) lq.push_back(q[3 * size_t{i} + a]);
+    append_raw_section(out, kSectionLoose, encode_loose(std::move(lq)));
+  }
   out.push_back('\0');
   out.push_back('\0');
   return Status::Ok();

@@ -29,7 +29,10 @@ struct CollapsePlan {
   // merged into (following later merges); errors.back() is the base's.
   std::vector<double> errors;
   Mesh base;                      // the coarsest level: input positions, remaining faces
-  std::vector<uint32_t> base_id;  // input vertex -> base vertex (kNotInBase when collapsed)
+  std::vector<uint32_t> base_id;  // input vertex -> base vertex (kNotInBase when collapsed or loose)
+  // Vertices no face uses, left out of the base when there are batches (the
+  // loose section codes them after the last; FORMAT.md §4.8).
+  std::vector<uint32_t> loose;
 };
 
 // q: the input's grid indices, 3 per vertex.

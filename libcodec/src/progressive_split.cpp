@@ -6,6 +6,7 @@
 // ring neighbours bounding the faces that move to the new vertex, and the
 // new vertex's grid position as a residual from the centroid of its ring.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -121,6 +122,12 @@ bool LevelMesh::adjacent_to_marked(uint32_t v, const std::vector<uint8_t>& marke
       if (c[k] < marked.size() && marked[c[k]]) return true;
   }
   return false;
+}
+
+void LevelMesh::add_point(const uint32_t q[3]) {
+  for (int a = 0; a < 3; ++a) q_.push_back(q[a]);
+  mesh_->add_vertex(grid_value(h_, step_, 0, q[0]), grid_value(h_, step_, 1, q[1]), grid_value(h_, step_, 2, q[2]));
+  vf_.emplace_back();
 }
 
 uint32_t LevelMesh::split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
@@ -261,6 +268,52 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     }
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the splits");
     level.split(v, ring, ia, dist, q);
+  }
+  return Status::Ok();
+}
+
+std::string encode_loose(std::vector<uint32_t> q) {
+  const size_t n = q.size() / 3;
+  std::vector<std::array<uint32_t, 3>> points(n);
+  for (size_t i = 0; i < n; ++i) points[i] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
+  std::sort(points.begin(), points.end());
+  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  RangeEncoder e;
+  uint32_t prev[3] = {0, 0, 0};
+  for (const auto& p : points)
+    for (int a = 0; a < 3; ++a) {
+      m[a].encode(e, static_cast<int32_t>(int64_t{p[a]} - int64_t{prev[a]}));
+      prev[a] = p[a];
+    }
+  std::string out;
+  ByteWriter w(out);
+  w.varint(n);
+  w.bytes(e.finish());
+  return out;
+}
+
+Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits) {
+  ByteReader r(payload);
+  uint64_t n = 0;
+  if (!r.varint(n)) return corrupt("loose vertices: truncated");
+  std::string_view stream;
+  r.bytes(r.remaining(), stream);
+  if (n == 0 || n > max_decisions(stream.size()) / 3) return corrupt("loose vertex count out of range");
+  if (limits.max_vertices && level.vertex_count() + n > limits.max_vertices)
+    return Status(ErrorCode::limit_exceeded, "loose vertices: the mesh would exceed the decoder's limits");
+  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  RangeDecoder dec(stream);
+  const int64_t qmax = (int64_t{1} << level.bits()) - 1;
+  int64_t prev[3] = {0, 0, 0};
+  for (uint64_t i = 0; i < n; ++i) {
+    uint32_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      prev[a] += m[a].decode(dec);
+      if (prev[a] < 0 || prev[a] > qmax) return corrupt("a loose vertex off the grid");
+      q[a] = static_cast<uint32_t>(prev[a]);
+    }
+    if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the loose vertices' stream ends early");
+    level.add_point(q);
   }
   return Status::Ok();
 }
