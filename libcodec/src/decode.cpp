@@ -446,6 +446,10 @@ uint64_t varint_bytes(uint64_t v) {
 Status inspect_batches(const Header& h, const std::vector<Section>& sections, FileInfo& info) {
   uint64_t vertices = h.vertex_count, faces = h.face_count;
   for (const Section& s : sections) {
+    if (s.id == kSectionLoose) {
+      ByteReader r(s.data);
+      if (!r.varint(info.loose_vertices)) return corrupt("loose vertices: truncated");
+    }
     if (s.id != kSectionRefinement) continue;
     BatchHeader bh;
     std::string_view stream;

@@ -57,6 +57,32 @@ void predict(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ri
   for (int a = 0; a < 3; ++a) out[a] = (sum[a] + n / 2) / n;
 }
 
+// Per axis, its rank by the size of the ring's normal component on it (0 =
+// the axis closest to the normal): residuals along the normal are smaller
+// than across it, so each rank has its models.
+void axis_ranks(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, int rank[3]) {
+  double n[3] = {0, 0, 0};
+  const uint32_t* c = level.q(v);
+  const size_t d = ring.size();
+  for (size_t i = 0; i < d; ++i) {
+    const uint32_t* a = level.q(ring[i]);
+    const uint32_t* b = level.q(ring[(i + 1) % d]);
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      e1[k] = static_cast<double>(a[k]) - static_cast<double>(c[k]);
+      e2[k] = static_cast<double>(b[k]) - static_cast<double>(c[k]);
+    }
+    n[0] += e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] += e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] += e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  for (int a = 0; a < 3; ++a) {
+    rank[a] = 0;
+    for (int b = 0; b < 3; ++b)
+      if (std::fabs(n[b]) > std::fabs(n[a]) || (std::fabs(n[b]) == std::fabs(n[a]) && b < a)) ++rank[a];
+  }
+}
+
 uint32_t position_in(const std::vector<uint32_t>& ring, uint32_t x) {
   return static_cast<uint32_t>(std::find(ring.begin(), ring.end(), x) - ring.begin());
 }
@@ -195,7 +221,9 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
-    for (int a = 0; a < 3; ++a) m->residual[sc][a].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
+    int rank[3];
+    axis_ranks(level, v, ring, rank);
+    for (int a = 0; a < 3; ++a) m->residual[sc][rank[a]].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
     ids[v] = level.split(v, ring, ia, dist, s.q);
   }
   for (const VertexSplit& s : splits) new_ids.push_back(ids[s.v]);
@@ -260,9 +288,11 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
+    int rank[3];
+    axis_ranks(level, v, ring, rank);
     uint32_t q[3];
     for (int a = 0; a < 3; ++a) {
-      const int64_t x = p[a] + m->residual[sc][a].decode(dec);
+      const int64_t x = p[a] + m->residual[sc][rank[a]].decode(dec);
       if (x < 0 || x > qmax) return corrupt("a new vertex off the grid");
       q[a] = static_cast<uint32_t>(x);
     }
