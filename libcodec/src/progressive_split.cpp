@@ -19,10 +19,12 @@ namespace tsm {
 
 constexpr int kFlagContexts = 8;
 constexpr int kScaleContexts = 24;
+constexpr int kRingContexts = 16;
 
 struct BatchModels {
   Prob flag[kFlagContexts];
-  UIntModelT<2> start, dist;
+  UIntModelT<2> start;
+  UIntModelT<2> dist[kRingContexts];  // by ring size
   SIntModelT<3> residual[kScaleContexts][3];
 };
 
@@ -217,7 +219,7 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     const uint32_t dist = (ix + d - ia) % d;
     if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
     m->start.encode(e, ia);
-    m->dist.encode(e, dist - 1);
+    m->dist[std::min<uint32_t>(d, kRingContexts - 1)].encode(e, dist - 1);
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
@@ -283,7 +285,8 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     if (!marked[v]) continue;
     level.ring(v, ring);
     const uint32_t d = static_cast<uint32_t>(ring.size());
-    const uint32_t ia = m->start.decode(dec), dist = m->dist.decode(dec) + 1;
+    const uint32_t ia = m->start.decode(dec);
+    const uint32_t dist = m->dist[std::min<uint32_t>(d, kRingContexts - 1)].decode(dec) + 1;
     if (ia >= d || dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
