@@ -451,6 +451,7 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
     mesh = std::move(small);
   }
 
+  if (a.drop_attributes) mesh.attributes.clear();
   phase.set("encoding");
   sw.reset();
   EncodeOptions eo;
@@ -458,6 +459,7 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   eo.level = a.level;
   eo.segment_faces = a.segment_faces;
   eo.attribute_bits = a.attribute_bits;
+  eo.progressive = a.progressive;
   // One file: its segments use the -j threads; several: the files do.
   eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
   std::string bytes;
@@ -538,7 +540,14 @@ FileResult decode_one(const DecodeArgs& a, const Job& j, MeshFormat format, Phas
     read_ms = sw.ms();
     phase.set("decoding");
     sw.reset();
-    s = decode(bytes, mesh, d);
+    if (a.partial || a.max_bytes || a.stop_error >= 0) {
+      PartialOptions po;
+      po.max_bytes = a.max_bytes;
+      po.max_error = a.stop_error;
+      s = decode_partial(bytes, mesh, po, nullptr, d);
+    } else {
+      s = decode(bytes, mesh, d);
+    }
     if (!s.ok()) return finish(Status(s.code(), shown_input(j.input) + ": " + s.message()));
     decode_ms = sw.ms();
   }
@@ -741,6 +750,16 @@ FileResult info_one(const std::string& input) {
       t += strf("%s '%s' (%s bytes)", k ? "," : "", key.c_str(), thousands(mesh.metadata[k].value.size()).c_str());
     }
     t += "\n";
+  }
+  if (!fi.batches.empty()) {
+    t += strf("  progressive: base %s vertices, %s faces, error %.6g; %zu refinement batches:\n",
+              thousands(fi.vertex_count).c_str(), thousands(fi.face_count).c_str(), fi.base_error, fi.batches.size());
+    t += strf("  %8s %12s %12s %12s %12s\n", "batch", "bytes", "vertices", "faces", "error");
+    for (size_t k = 0; k < fi.batches.size(); ++k) {
+      const FileInfo::Batch& b = fi.batches[k];
+      t += strf("  %8zu %12s %12s %12s %12.6g\n", k, thousands(b.bytes).c_str(), thousands(b.vertices).c_str(),
+                thousands(b.faces).c_str(), b.error);
+    }
   }
   t += strf("  %-18s %-6s %12s %12s", "section", "codec", "stored", "raw");
   for (const SectionInfo& si : fi.sections)

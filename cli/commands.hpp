@@ -28,6 +28,8 @@ struct EncodeArgs : BatchArgs {
   // "E%" of the bounding-box diagonal; "" = no simplification).
   std::string max_error;
   bool fallback = false;  // glTF output: an uncompressed copy beside each stream
+  bool progressive = false;  // a progressive file (base mesh, then batches of vertex splits)
+  bool drop_attributes = false;  // code positions and faces only
 };
 
 struct DecodeArgs : BatchArgs {
@@ -35,6 +37,12 @@ struct DecodeArgs : BatchArgs {
   std::string format;               // "" or one of output_format_names()
   bool ascii = false, force = false;
   uint64_t max_vertices = 0, max_faces = 0, max_corners = 0;
+  // Progressive files: the finest level a truncated file holds (partial),
+  // the levels within the first max_bytes bytes, or the first level within
+  // stop_error (model units; negative = none).
+  bool partial = false;
+  uint64_t max_bytes = 0;
+  double stop_error = -1;
 };
 
 struct InfoArgs : BatchArgs {};

@@ -202,6 +202,12 @@ int main(int argc, char** argv) {
   enc->add_option("--max-error", ea.max_error,
                   "Simplify first (tsm simplify): the result stays within this distance of the input, in model units "
                   "or E% of the bounding-box diagonal");
+  enc->add_flag("--progressive", ea.progressive,
+                "A progressive file: a coarse base mesh, then batches of vertex splits, so that any prefix decodes to "
+                "the whole shape at some level of detail (positions and faces only)");
+  enc->add_flag("--drop-attributes", ea.drop_attributes,
+                "Code positions and faces only, leaving out normals, colours, texture coordinates and the like "
+                "(progressive files carry none)");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--fallback", ea.fallback,
                 "glTF output: keep an uncompressed copy of each compressed primitive, for viewers without "
@@ -237,6 +243,15 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   dec->add_option("--max-corners", da.max_corners,
                   "Refuse files with more face corners (default with --max-faces: 16 x that)")
+      ->check(CLI::NonNegativeNumber);
+  dec->add_flag("--partial", da.partial,
+                "Progressive files: write the finest level of detail a truncated file holds instead of failing");
+  dec->add_option("--max-bytes", da.max_bytes,
+                  "Progressive files: decode only the levels within the first N bytes")
+      ->check(CLI::NonNegativeNumber);
+  dec->add_option("--max-error", da.stop_error,
+                  "Progressive files: stop at the first level within this distance of the full mesh (model units, "
+                  "as the encoder measured it; tsm info lists them)")
       ->check(CLI::NonNegativeNumber);
   add_batch_options(dec, da, true);
   dec->footer(

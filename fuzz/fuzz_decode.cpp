@@ -68,8 +68,12 @@ void check(std::string_view bytes) {
   if (!mesh.valid(&why)) fail(("decoded an invalid mesh: " + why).c_str(), s);
   if (!mesh.all_finite()) fail("decoded non-finite positions", s);
   if (!si.ok()) fail("decode accepted what inspect refuses", si);
-  if (info.vertex_count != mesh.vertex_count() || info.face_count != mesh.face_count() ||
-      info.corner_count != mesh.corner_count())
+  // A progressive file's header counts the base; its batches the levels.
+  const bool progressive = !info.batches.empty();
+  const uint64_t vertices = (progressive ? info.batches.back().vertices : info.vertex_count) + info.loose_vertices;
+  const uint64_t faces = progressive ? info.batches.back().faces : info.face_count;
+  if (vertices != mesh.vertex_count() || faces != mesh.face_count() ||
+      (!progressive && info.corner_count != mesh.corner_count()))
     fail("inspect's counts differ from the decoded mesh", s);
   if (mesh.vertex_count() > (1u << 14) || mesh.corner_count() > (1u << 16)) return;  // keep executions fast
   // At level 0: the connectivity coder (the same at every level) sees the

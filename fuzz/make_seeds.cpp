@@ -358,6 +358,11 @@ void corpus_seeds(const fs::path& corpus, const fs::path& decode_dir, const fs::
     if (!tsm::read_mesh_from_memory(bytes, p.string(), m).ok()) continue;
     std::string enc;
     if (tsm::encode(m, tsm::EncodeOptions{}, enc).ok() && enc.size() <= 16384) put(decode_dir, base + ".tsm", enc);
+    // Progressive files (FORMAT.md §4.8): the refinement and loose sections.
+    tsm::EncodeOptions po;
+    po.progressive = true;
+    m.attributes.clear();
+    if (tsm::encode(m, po, enc).ok() && enc.size() <= 16384) put(decode_dir, base + ".progressive.tsm", enc);
   }
 }
 

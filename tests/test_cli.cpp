@@ -1239,4 +1239,23 @@ TEST_F(Cli, BenchComparesGltfAssets) {
   }
 }
 
+// A progressive file: info lists its batches; a truncated copy fails to
+// decode, except with --partial, which writes a coarser level.
+TEST_F(Cli, ProgressiveEncodePartialDecodeAndInfo) {
+  tsm::Mesh m = tsm_test::icosphere(5);
+  ASSERT_TRUE(tsm::write_mesh(file("in.ply"), m).ok());
+  ASSERT_EQ(tsm("encode " + q("in.ply") + " --progressive -o " + q("p.tsm")).code, 0);
+  Result r = tsm("info " + q("p.tsm"));
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(tsm_test::contains(r.out, "refinement batches"));
+  const std::string bytes = slurp(file("p.tsm"));
+  spit(file("cut.tsm"), bytes.substr(0, bytes.size() * 6 / 10));
+  EXPECT_NE(tsm("decode " + q("cut.tsm") + " -o " + q("whole.ply")).code, 0);
+  ASSERT_EQ(tsm("decode " + q("cut.tsm") + " --partial -o " + q("part.ply")).code, 0);
+  tsm::Mesh part;
+  ASSERT_TRUE(tsm::read_mesh(file("part.ply"), part).ok());
+  EXPECT_GT(part.face_count(), 0u);
+  EXPECT_LT(part.face_count(), m.face_count());
+}
+
 }  // namespace

@@ -31,6 +31,8 @@ enum SectionId : uint16_t {
   kSectionReserved8 = 8,      // reserved
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
+  kSectionRefinement = 12,    // a progressive file's batch of vertex splits (FORMAT.md §4.8); repeats
+  kSectionLoose = 13,         // a progressive file's vertices no face uses, after its batches (FORMAT.md §4.8)
 };
 const char* section_name(uint16_t id);
 
@@ -67,6 +69,10 @@ class ContainerWriter {
   std::string out_;
 };
 
+// Appends a raw section (FORMAT.md §4.1) to a file's bytes (for sections
+// added after the end marker is taken off).
+void append_raw_section(std::string& file, uint16_t id, std::string_view payload);
+
 // Incremental reading, for bytes that may still be arriving: each reads one
 // piece starting at `offset` of the bytes received so far and advances
 // `offset` past it. When the bytes end inside the piece, `missing` says what
@@ -82,9 +88,11 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
 // file of several segments, at most segment_count of them; the mesh section
 // only in a file of one; the reserved ids 3-6 and 8 never; any other id at
 // most once.
+constexpr uint32_t kMaxRefinements = 4096;
 struct SectionRules {
   std::vector<uint16_t> seen;
   uint32_t segments = 0;
+  uint32_t refinements = 0;  // refinement sections (id 12): after the base, any number up to kMaxRefinements
   Status admit(const Section& s, const Header& h);
 };
 

@@ -27,6 +27,8 @@ const char* section_name(uint16_t id) {
     case kSectionReserved8: return "reserved";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
+    case kSectionRefinement: return "refinement";
+    case kSectionLoose: return "loose";
   }
   return id >= kSectionReservedFirst && id <= kSectionReservedLast ? "reserved" : "unknown";
 }
@@ -178,6 +180,16 @@ Status SectionRules::admit(const Section& s, const Header& h) {
                                     " (a mesh's streams belong in the mesh or segment sections)");
   if (segment_count > 1 && s.id == kSectionMesh)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
+  if (s.id == kSectionLoose && refinements == 0) return corrupt_at(at, s.id, "loose vertices before any refinement");
+  if (s.id == kSectionRefinement) {
+    if (std::find(seen.begin(), seen.end(), kSectionLoose) != seen.end())
+      return corrupt_at(at, s.id, "a refinement after the loose vertices");
+    const bool base_in = segment_count == 1 ? std::find(seen.begin(), seen.end(), kSectionMesh) != seen.end()
+                                            : segments == segment_count;
+    if (!base_in) return corrupt_at(at, s.id, "a refinement before the base mesh's last section");
+    if (++refinements > kMaxRefinements) return corrupt_at(at, s.id, "too many refinement sections");
+    return Status::Ok();
+  }
   for (uint16_t prev : seen)
     if (prev == s.id) return corrupt_at(at, s.id, "appears twice");
   seen.push_back(s.id);

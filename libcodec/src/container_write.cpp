@@ -61,6 +61,16 @@ void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zst
   w.bytes(stored);
 }
 
+void append_raw_section(std::string& file, uint16_t id, std::string_view payload) {
+  ByteWriter w(file);
+  w.u16(id);
+  w.u8(static_cast<uint8_t>(SectionCodec::raw));
+  w.varint(payload.size());
+  w.varint(payload.size());
+  w.u32(checksum32(payload));
+  w.bytes(payload);
+}
+
 std::string ContainerWriter::finish() {
   ByteWriter w(out_);
   w.u16(kSectionEnd);

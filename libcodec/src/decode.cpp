@@ -13,6 +13,8 @@
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
+#include "progressive.hpp"
+#include "progressive_decode.hpp"
 #include "geometry_predict.hpp"
 #include "parallel.hpp"
 #include "range_coder.hpp"
@@ -270,6 +272,8 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
   return Status::Ok();
 }
 
+}  // namespace
+
 // A grid index as a coordinate (FORMAT.md §5).
 float grid_value(const Header& h, double step, int axis, uint32_t q) {
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
@@ -286,6 +290,8 @@ float grid_value(const Header& h, double step, int axis, uint32_t q) {
   while (static_cast<double>(c) - o > h.extent) c = std::nextafter(c, -std::numeric_limits<float>::infinity());
   return c;
 }
+
+namespace {
 
 // The parts of a file carry the same attributes (names, kinds, domains,
 // types, components), each with its own values.
@@ -398,7 +404,7 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
   for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
   if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
-  return Status::Ok();
+  return apply_refinements(h, sections, out, options);
 }
 
 namespace {
@@ -423,6 +429,42 @@ void add_attribute_costs(const std::vector<AttributeCost>& costs, std::vector<At
     out[i].tables = out[i].tables || costs[i].tables;
     out[i].coded_bytes += (costs[i].coded_bits + 7) / 8;
   }
+}
+
+}  // namespace
+
+namespace {
+
+uint64_t varint_bytes(uint64_t v) {
+  uint64_t n = 1;
+  for (; v >= 0x80; v >>= 7) ++n;
+  return n;
+}
+
+// A progressive file's batches (FORMAT.md §4.8): their headers (the
+// counts follow from the split counts; decode() checks the splits).
+Status inspect_batches(const Header& h, const std::vector<Section>& sections, FileInfo& info) {
+  uint64_t vertices = h.vertex_count, faces = h.face_count;
+  for (const Section& s : sections) {
+    if (s.id == kSectionLoose) {
+      ByteReader r(s.data);
+      if (!r.varint(info.loose_vertices)) return corrupt("loose vertices: truncated");
+    }
+    if (s.id != kSectionRefinement) continue;
+    BatchHeader bh;
+    std::string_view stream;
+    TSM_RETURN_IF_ERROR(read_batch(s.data, bh, stream));
+    if (info.batches.empty()) info.base_error = bh.error_before;
+    vertices += bh.splits;
+    faces += 2 * bh.splits;
+    FileInfo::Batch b;
+    b.bytes = 7 + varint_bytes(s.stored_bytes) + varint_bytes(s.raw_bytes) + s.stored_bytes;
+    b.vertices = vertices;
+    b.faces = faces;
+    b.error = bh.error_after;
+    info.batches.push_back(b);
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -495,7 +537,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   if (gs.tables) info.geometry_predictor += "+tables";
   info.ancestors = gs.ancestors;
   for (int a = 0; a < 3; ++a) info.lattice_planes[a] = gs.lattice_planes[a];
-  return Status::Ok();
+  return inspect_batches(h, sections, info);
 }
 
 // Streaming: sections are read as their bytes arrive; a segment is decoded
@@ -511,6 +553,8 @@ struct StreamDecoder::Impl {
   Mesh mesh;
   uint32_t done = 0;
   uint64_t faces = 0, corners = 0;
+  LevelMesh level;      // progressive files: the level the batches refine
+  uint32_t batches = 0;
   Status failed;
 
   Status part_done(DecodedPart& part, const PartStreams& s) {
@@ -538,8 +582,9 @@ struct StreamDecoder::Impl {
     return Status::Ok();
   }
 
-  Status end() {
-    ended = true;
+  // The base mesh is whole: a file of one segment decodes its sections
+  // now; a file of several checks the segments' sums.
+  Status base_done() {
     if (h.segment_count == 1) {
       std::vector<DecodedPart> parts;
       std::vector<PartStreams> streams;
@@ -553,6 +598,24 @@ struct StreamDecoder::Impl {
                      std::to_string(done));
     if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
       return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
+    return Status::Ok();
+  }
+
+  Status end() {
+    ended = true;
+    return batches == 0 ? base_done() : Status::Ok();
+  }
+
+  // A progressive file's batch of vertex splits (FORMAT.md §4.8), applied
+  // at once: mesh() is the next level of detail.
+  Status refinement(const Section& s) {
+    if (batches == 0) {
+      TSM_RETURN_IF_ERROR(base_done());
+      level.init(mesh, h);
+    }
+    Status st = decode_batch(s.data, level, BatchLimits{options.max_vertices, options.max_faces});
+    if (!st.ok()) return Status(st.code(), "batch " + std::to_string(batches) + ": " + st.message());
+    ++batches;
     return Status::Ok();
   }
 
@@ -583,6 +646,10 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
       else if (s.id == kSectionSegment)
         TSM_RETURN_IF_ERROR(segment(s));
+      else if (s.id == kSectionRefinement)
+        TSM_RETURN_IF_ERROR(refinement(s));
+      else if (s.id == kSectionLoose && batches > 0)
+        TSM_RETURN_IF_ERROR(decode_loose(s.data, level, BatchLimits{options.max_vertices, options.max_faces}));
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));
     }
@@ -624,6 +691,7 @@ Status StreamDecoder::finish() {
 
 uint32_t StreamDecoder::segment_count() const { return impl_->have_header ? impl_->h.segment_count : 0; }
 uint32_t StreamDecoder::segments_done() const { return impl_->done; }
+uint32_t StreamDecoder::batches_done() const { return impl_->batches; }
 bool StreamDecoder::done() const { return impl_->ended && impl_->failed.ok(); }
 const Mesh& StreamDecoder::mesh() const { return impl_->mesh; }
 Mesh StreamDecoder::take_mesh() { return std::move(impl_->mesh); }

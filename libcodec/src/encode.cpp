@@ -17,6 +17,7 @@
 #include "container.hpp"
 #include "geometry_predict.hpp"
 #include "parallel.hpp"
+#include "progressive_encode.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
 #include "split_layout.hpp"
@@ -918,6 +919,8 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "mesh is invalid: " + why);
+  if (options.progressive && options.quantization_bits >= 1 && options.quantization_bits <= 30 && mesh.all_finite())
+    return encode_progressive(mesh, options, out);
   if (options.quantization_bits < 1 || options.quantization_bits > 30)
     return Status(ErrorCode::invalid_argument,
                   "quantization bits must be 1..30, got " + std::to_string(options.quantization_bits));

@@ -34,6 +34,11 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
+  // A progressive file (FORMAT.md §4.8): a coarse base mesh, then batches of
+  // vertex splits, so that any prefix decodes to a level of detail of the
+  // whole shape and the full file to the input. Positions and faces only
+  // (a mesh with attributes is refused).
+  bool progressive = false;
 };
 
 struct DecodeOptions {
@@ -67,6 +72,7 @@ class StreamDecoder {
   Status finish();
   uint32_t segment_count() const;  // 0 until the header is in
   uint32_t segments_done() const;
+  uint32_t batches_done() const;   // progressive files: refinement batches applied
   bool done() const;               // the end marker was read, no error
   const Mesh& mesh() const;
   Mesh take_mesh();                // moves the mesh out (call when done)
@@ -75,6 +81,25 @@ class StreamDecoder {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Progressive files (FORMAT.md §4.8): decoding a prefix. Stops after the
+// last refinement batch that is whole within the bytes (and within
+// max_bytes), or at the first level whose error is at most max_error.
+struct PartialOptions {
+  uint64_t max_bytes = 0;  // 0 = all the bytes given
+  double max_error = -1;   // model units; negative = refine as far as the bytes go
+};
+struct PartialReport {
+  uint32_t batches = 0;        // refinement batches applied
+  uint64_t bytes_used = 0;     // bytes of the file those levels needed
+  double error = 0;            // the encoder's error of the level decoded (model units)
+  bool complete = false;       // the whole file was there and decoded
+};
+// Ok with the finest level the bytes hold once the base mesh is whole
+// (a single-rate file decodes only whole); an error when even the base is
+// cut off or any byte in use is damaged.
+Status decode_partial(std::string_view bytes, Mesh& out, const PartialOptions& partial = {},
+                      PartialReport* report = nullptr, const DecodeOptions& options = {});
 
 // What `tsm info` shows: header fields and the sections with their sizes.
 struct SectionInfo {
@@ -132,6 +157,16 @@ struct FileInfo {
   std::vector<AttributeInfo> attributes;
   uint64_t references = 0;       // vertices shared across segment borders (coded once, referenced after)
   std::vector<SegmentSummary> segments;
+  // Progressive files: the refinement batches, coarsest first, and the
+  // error of the base mesh (the encoder's measure, model units).
+  struct Batch {
+    uint64_t bytes = 0;              // the section, framing included
+    uint64_t vertices = 0, faces = 0;  // of the level after it
+    double error = 0;
+  };
+  std::vector<Batch> batches;
+  double base_error = 0;
+  uint64_t loose_vertices = 0;  // the loose section's: vertices no face uses, after the batches
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
   // "gate", "fan", "ancestors" (with K) or "raw", followed by "+tangent" (tangent
   // step), "+mix" (residual mixing), "+top" (lattice planes from the top),

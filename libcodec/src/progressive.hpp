@@ -1,0 +1,92 @@
+// Internal: progressive files (FORMAT.md §4.8): a base mesh, then batches
+// of vertex splits (refinement sections, id 12), each batch a set of
+// independent splits coded in the decoder's vertex order.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "container.hpp"
+#include "tsm/mesh.hpp"
+#include "tsm/status.hpp"
+
+namespace tsm {
+
+// A grid index as a coordinate (FORMAT.md §5; defined in decode.cpp).
+float grid_value(const Header& h, double step, int axis, uint32_t q);
+
+struct BatchModels;  // progressive_split.cpp
+
+// The decoder's current level of detail: the mesh, the grid index of every
+// vertex and, per vertex, the faces that use it.
+class LevelMesh {
+ public:
+  // Takes the decoded base mesh (its positions lie on the header's grid).
+  void init(Mesh& mesh, const Header& h);
+  // The ordered neighbours r_0 .. r_{d-1} of v when its faces are d
+  // triangles forming one closed, consistently oriented fan (faces
+  // (v, r_i, r_{i+1 mod d})), starting at the neighbour of least id; false
+  // otherwise.
+  bool ring(uint32_t v, std::vector<uint32_t>& ring) const;
+  bool adjacent_to_marked(uint32_t v, const std::vector<uint8_t>& marked) const;
+  // Splits v (FORMAT.md §4.8): the faces (v, r_i, r_{i+1}) for i = ia ..
+  // ia + dist - 1 (mod d) go to a new vertex u at grid index q, and the
+  // faces (v, u, r_{ia+dist}) and (v, r_ia, u) are added. Returns u.
+  uint32_t split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist, const uint32_t q[3]);
+  // Appends a vertex no face uses, at grid index q.
+  void add_point(const uint32_t q[3]);
+  size_t vertex_count() const { return q_.size() / 3; }
+  int bits() const { return h_.quantization_bits; }
+  const uint32_t* q(uint32_t v) const { return &q_[3 * size_t{v}]; }
+  size_t face_uses(uint32_t v) const { return vf_[v].size(); }
+  Mesh& mesh() { return *mesh_; }
+  // The split coder's adaptive models: they carry over from batch to batch.
+  std::shared_ptr<BatchModels>& models() { return models_; }
+
+ private:
+  Mesh* mesh_ = nullptr;
+  Header h_;
+  double step_ = 0;
+  std::vector<uint32_t> q_;
+  std::vector<std::vector<uint32_t>> vf_;
+  std::shared_ptr<BatchModels> models_;
+};
+
+// One vertex split as the encoder hands it to encode_batch (level ids): v is
+// split, the faces from y to x (in v's ring order) go to the new vertex at
+// grid index q.
+struct VertexSplit {
+  uint32_t v = 0, y = 0, x = 0;
+  uint32_t q[3] = {0, 0, 0};
+};
+
+// A refinement payload (FORMAT.md §4.8): the error of the level before and
+// after the batch (symmetric Hausdorff distance to the input, model units),
+// the number of splits, then the range-coded splits.
+struct BatchHeader {
+  float error_before = 0, error_after = 0;
+  uint64_t splits = 0;
+};
+std::string write_batch(const BatchHeader& h, std::string_view stream);
+Status read_batch(std::string_view payload, BatchHeader& h, std::string_view& stream);
+
+// Codes a batch of splits (in any order, pairwise independent) and applies
+// them to `level`; appends the new vertices' ids (in the order of `splits`)
+// to `new_ids`.
+Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, std::string& stream,
+                    std::vector<uint32_t>& new_ids);
+
+struct BatchLimits {
+  uint64_t max_vertices = 0, max_faces = 0;  // 0 = none
+};
+// Decodes one refinement payload and applies it to `level`.
+Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
+
+// The loose section (id 13, FORMAT.md §4.8): vertices no face uses, after
+// the last batch. q: 3 grid indices per vertex (any order; coded sorted).
+std::string encode_loose(std::vector<uint32_t> q);
+Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
+
+}  // namespace tsm

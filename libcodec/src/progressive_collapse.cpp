@@ -1,0 +1,350 @@
+// Progressive meshes, encoder side (seed 003, Hoppe's edge collapses, in
+// batches as Compressed Progressive Meshes; FORMAT.md §4.8): the input,
+// already on the quantization grid, is coarsened by half-edge collapses
+// (a vertex u merged into a neighbour v, so every vertex keeps its grid
+// position and each split gives back one exactly), in quadric-error order,
+// grouped into batches of independent collapses (their faces pairwise
+// disjoint). What the collapses cannot handle (boundaries, non-manifold
+// vertices, polygons, degenerate faces, coincident grid points) stays in
+// the base mesh.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <unordered_map>
+
+#include "progressive_plan.hpp"
+
+namespace tsm {
+
+namespace {
+
+using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
+
+void add_plane(Quadric& q, const double n[3], double d, double w) {
+  const double p[4] = {n[0], n[1], n[2], d};
+  int k = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) q[k++] += w * p[i] * p[j];
+}
+
+double quadric_at(const Quadric& q, const double p[3]) {
+  const double x = p[0], y = p[1], z = p[2];
+  return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y + 2 * q[5] * y * z +
+         2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
+}
+
+struct Candidate {
+  double cost;
+  uint32_t u, v;
+  bool operator<(const Candidate& o) const {
+    return cost < o.cost || (cost == o.cost && (u < o.u || (u == o.u && v < o.v)));
+  }
+};
+
+class Collapser {
+ public:
+  Collapser(const Mesh& mesh, const std::vector<uint32_t>& q, const ProgressiveOptions& options)
+      : mesh_(mesh), q_(q), options_(options) {}
+  void run(CollapsePlan& plan);
+
+ private:
+  void build();
+  void lock_special();
+  bool ring(uint32_t v, std::vector<uint32_t>& out) const;
+  void cross(const uint32_t t[3], uint32_t from, uint32_t to, int64_t n[3]) const;
+  bool valid(uint32_t u, uint32_t v, CollapseRecord& rec);
+  void collapse(const CollapseRecord& rec);
+  std::vector<Candidate> candidates();
+  size_t batch(std::vector<CollapseRecord>& out);
+  void write_base(CollapsePlan& plan) const;
+  double level_error() const;
+
+  const Mesh& mesh_;
+  const std::vector<uint32_t>& q_;
+  ProgressiveOptions options_;
+  std::vector<std::array<uint32_t, 3>> tri_;
+  std::vector<uint8_t> alive_;
+  std::vector<uint32_t> stamp_;  // per triangle: the batch that touched it last (+1)
+  uint32_t batch_no_ = 0;
+  std::vector<uint32_t> other_faces_;  // faces the collapses leave alone (polygons, degenerate)
+  std::vector<std::vector<uint32_t>> vf_;
+  std::vector<uint8_t> locked_, dup_, extreme_, removed_, used_;
+  std::vector<Quadric> quadric_;
+  std::vector<uint32_t> merged_into_;  // per removed vertex: v of its collapse
+  size_t vertices_left_ = 0;
+  std::vector<uint32_t> ring_u_, ring_v_;
+};
+
+void Collapser::build() {
+  const size_t n = mesh_.vertex_count();
+  vf_.assign(n, {});
+  locked_.assign(n, 0);
+  dup_.assign(n, 0);
+  extreme_.assign(n, 0);
+  used_.assign(n, 0);
+  removed_.assign(n, 0);
+  merged_into_.assign(n, 0);
+  quadric_.assign(n, Quadric{});
+  for (size_t f = 0; f < mesh_.face_count(); ++f) {
+    const uint32_t* c = mesh_.face(f);
+    for (uint32_t k = 0; k < mesh_.face_size(f); ++k) used_[c[k]] = 1;
+    if (mesh_.face_size(f) != 3 || c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      other_faces_.push_back(static_cast<uint32_t>(f));
+      for (uint32_t k = 0; k < mesh_.face_size(f); ++k) locked_[c[k]] = 1;
+      continue;
+    }
+    const uint32_t t = static_cast<uint32_t>(tri_.size());
+    tri_.push_back({c[0], c[1], c[2]});
+    for (int k = 0; k < 3; ++k) vf_[c[k]].push_back(t);
+    double p[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p[k][a] = q_[3 * size_t{c[k]} + a];
+    double e1[3], e2[3], nrm[3];
+    for (int a = 0; a < 3; ++a) e1[a] = p[1][a] - p[0][a], e2[a] = p[2][a] - p[0][a];
+    nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const double len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (len == 0) continue;
+    for (double& x : nrm) x /= len;
+    const double d = -(nrm[0] * p[0][0] + nrm[1] * p[0][1] + nrm[2] * p[0][2]);
+    for (int k = 0; k < 3; ++k) add_plane(quadric_[c[k]], nrm, d, 0.5 * len);
+  }
+  alive_.assign(tri_.size(), 1);
+  stamp_.assign(tri_.size(), 0);
+  vertices_left_ = n;
+}
+
+// Vertices that must stay: those of the faces above, those sharing a grid
+// point with another (the encoder finds base vertices in the decoded base
+// by their grid point), and one vertex at each side of the bounding box
+// (so the base mesh has the input's box, hence its grid).
+void Collapser::lock_special() {
+  const size_t n = mesh_.vertex_count();
+  std::unordered_map<uint64_t, uint32_t> seen;
+  seen.reserve(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint64_t key = (uint64_t{q_[3 * size_t{i}]} * 0x9E3779B97F4A7C15ull) ^
+                         (uint64_t{q_[3 * size_t{i} + 1]} << 32) ^
+                         (uint64_t{q_[3 * size_t{i} + 2]} * 0xC2B2AE3D27D4EB4Full);
+    auto [it, fresh] = seen.emplace(key, i);
+    if (!fresh) locked_[i] = locked_[it->second] = dup_[i] = dup_[it->second] = 1;
+  }
+  for (int a = 0; a < 3; ++a) {
+    uint32_t lo = 0, hi = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (mesh_.positions[3 * size_t{i} + a] < mesh_.positions[3 * size_t{lo} + a]) lo = i;
+      if (mesh_.positions[3 * size_t{i} + a] > mesh_.positions[3 * size_t{hi} + a]) hi = i;
+    }
+    if (n) locked_[lo] = locked_[hi] = extreme_[lo] = extreme_[hi] = 1;
+  }
+}
+
+// As LevelMesh::ring (the decoder's), over the live triangles.
+bool Collapser::ring(uint32_t v, std::vector<uint32_t>& out) const {
+  const std::vector<uint32_t>& faces = vf_[v];
+  const size_t d = faces.size();
+  out.clear();
+  if (d < 3) return false;
+  std::vector<std::pair<uint32_t, uint32_t>> edge(d);
+  for (size_t i = 0; i < d; ++i) {
+    const auto& c = tri_[faces[i]];
+    const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+    edge[i] = {c[(k + 1) % 3], c[(k + 2) % 3]};
+  }
+  std::sort(edge.begin(), edge.end());
+  for (size_t i = 1; i < d; ++i)
+    if (edge[i].first == edge[i - 1].first) return false;
+  uint32_t at = edge[0].first;
+  for (size_t i = 0; i < d; ++i) {
+    out.push_back(at);
+    auto it = std::lower_bound(edge.begin(), edge.end(), std::make_pair(at, uint32_t{0}));
+    if (it == edge.end() || it->first != at) return false;
+    at = it->second;
+  }
+  if (at != out[0]) return false;
+  std::vector<uint32_t> sorted = out;
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end();
+}
+
+// Normal of triangle t with vertex `from` moved to `to`'s grid point.
+void Collapser::cross(const uint32_t t[3], uint32_t from, uint32_t to, int64_t n[3]) const {
+  int64_t p[3][3];
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t w = t[k] == from ? to : t[k];
+    for (int a = 0; a < 3; ++a) p[k][a] = q_[3 * size_t{w} + a];
+  }
+  int64_t e1[3], e2[3];
+  for (int a = 0; a < 3; ++a) e1[a] = p[1][a] - p[0][a], e2[a] = p[2][a] - p[0][a];
+  n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+  n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+  n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
+// u merged into v keeps both fans manifold, the link condition, and turns
+// no triangle over or flat.
+bool Collapser::valid(uint32_t u, uint32_t v, CollapseRecord& rec) {
+  if (!ring(u, ring_u_) || !ring(v, ring_v_)) return false;
+  const size_t du = ring_u_.size(), dv = ring_v_.size();
+  if (du + dv < 7) return false;
+  const size_t j = static_cast<size_t>(std::find(ring_v_.begin(), ring_v_.end(), u) - ring_v_.begin());
+  if (j == dv) return false;
+  rec = {u, v, ring_v_[(j + dv - 1) % dv], ring_v_[(j + 1) % dv]};
+  std::vector<uint32_t> a = ring_u_, b = ring_v_;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::vector<uint32_t> common;
+  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+  if (common.size() != 2) return false;
+  for (uint32_t w : {rec.x, rec.y})
+    if (vf_[w].size() < 4 || dup_[w]) return false;
+  for (uint32_t t : vf_[u]) {
+    const auto& c = tri_[t];
+    if (c[0] == v || c[1] == v || c[2] == v) continue;
+    int64_t before[3], after[3];
+    cross(c.data(), u, u, before);
+    cross(c.data(), u, v, after);
+    if (after[0] == 0 && after[1] == 0 && after[2] == 0) return false;
+    const double dot = static_cast<double>(before[0]) * static_cast<double>(after[0]) +
+                       static_cast<double>(before[1]) * static_cast<double>(after[1]) +
+                       static_cast<double>(before[2]) * static_cast<double>(after[2]);
+    if (!(dot > 0)) return false;
+  }
+  return true;
+}
+
+void Collapser::collapse(const CollapseRecord& rec) {
+  const uint32_t u = rec.u, v = rec.v;
+  auto drop = [&](uint32_t w, uint32_t t) {
+    std::vector<uint32_t>& f = vf_[w];
+    f.erase(std::find(f.begin(), f.end(), t));
+  };
+  for (uint32_t t : vf_[u]) {
+    auto& c = tri_[t];
+    if (c[0] == v || c[1] == v || c[2] == v) {
+      alive_[t] = 0;
+      for (uint32_t w : c)
+        if (w != u) drop(w, t);
+      continue;
+    }
+    for (uint32_t& w : c)
+      if (w == u) w = v;
+    vf_[v].push_back(t);
+  }
+  vf_[u].clear();
+  for (int k = 0; k < 10; ++k) quadric_[v][k] += quadric_[u][k];
+  removed_[u] = 1;
+  merged_into_[u] = v;
+  --vertices_left_;
+}
+
+// Every half-edge u -> v whose u may go, by its quadric cost (a vertex
+// whose cheapest merge is refused may still take another).
+std::vector<Candidate> Collapser::candidates() {
+  std::vector<Candidate> out;
+  std::vector<uint32_t> r;
+  for (uint32_t u = 0; u < vf_.size(); ++u) {
+    if (removed_[u] || locked_[u] || !ring(u, r)) continue;
+    for (uint32_t v : r) {
+      if (locked_[v]) continue;
+      Quadric q = quadric_[u];
+      for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
+      const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
+                           static_cast<double>(q_[3 * size_t{v} + 2])};
+      out.push_back({quadric_at(q, p), u, v});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// One batch: the cheapest collapses whose faces no other collapse of the
+// batch touches, at most a third of the vertices (+50% on refinement).
+size_t Collapser::batch(std::vector<CollapseRecord>& out) {
+  ++batch_no_;
+  const size_t limit = vertices_left_ / 3;
+  CollapseRecord rec;
+  for (const Candidate& c : candidates()) {
+    if (out.size() >= limit) break;
+    if (removed_[c.u] || removed_[c.v]) continue;
+    bool free = true;
+    for (uint32_t w : {c.u, c.v})
+      for (uint32_t t : vf_[w]) free = free && stamp_[t] != batch_no_;
+    if (!free || !valid(c.u, c.v, rec)) continue;
+    for (uint32_t w : {c.u, c.v})
+      for (uint32_t t : vf_[w]) stamp_[t] = batch_no_;
+    collapse(rec);
+    out.push_back(rec);
+  }
+  return out.size();
+}
+
+void Collapser::write_base(CollapsePlan& plan) const {
+  const size_t n = mesh_.vertex_count();
+  Mesh& base = plan.base;
+  base.clear();
+  plan.base_id.assign(n, kNotInBase);
+  plan.loose.clear();
+  for (uint32_t i = 0; i < n; ++i) {
+    if (removed_[i]) continue;
+    if (!used_[i] && !extreme_[i] && !plan.batches.empty()) {
+      plan.loose.push_back(i);
+      continue;
+    }
+    plan.base_id[i] = static_cast<uint32_t>(base.vertex_count());
+    base.add_vertex(mesh_.positions[3 * size_t{i}], mesh_.positions[3 * size_t{i} + 1],
+                    mesh_.positions[3 * size_t{i} + 2]);
+  }
+  std::vector<uint32_t> corners;
+  for (uint32_t f : other_faces_) {
+    corners.clear();
+    for (uint32_t k = 0; k < mesh_.face_size(f); ++k) corners.push_back(plan.base_id[mesh_.face(f)[k]]);
+    base.add_face(corners.data(), corners.size());
+  }
+  for (size_t t = 0; t < tri_.size(); ++t)
+    if (alive_[t]) base.add_triangle(plan.base_id[tri_[t][0]], plan.base_id[tri_[t][1]], plan.base_id[tri_[t][2]]);
+  base.metadata = mesh_.metadata;
+}
+
+double Collapser::level_error() const {
+  double worst = 0;
+  for (uint32_t u = 0; u < removed_.size(); ++u) {
+    if (!removed_[u]) continue;
+    uint32_t r = merged_into_[u];
+    while (removed_[r]) r = merged_into_[r];
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = static_cast<double>(q_[3 * size_t{u} + a]) - static_cast<double>(q_[3 * size_t{r} + a]);
+      d2 += d * d;
+    }
+    worst = std::max(worst, d2);
+  }
+  return std::sqrt(worst);
+}
+
+void Collapser::run(CollapsePlan& plan) {
+  build();
+  lock_special();
+  plan.batches.clear();
+  plan.errors.clear();
+  while (plan.batches.size() < options_.max_batches && vertices_left_ > options_.min_base_vertices) {
+    std::vector<CollapseRecord> b;
+    if (batch(b) < options_.min_batch_splits) {
+      if (!b.empty()) plan.batches.push_back(std::move(b)), plan.errors.push_back(level_error());
+      break;
+    }
+    plan.batches.push_back(std::move(b));
+    plan.errors.push_back(level_error());
+  }
+  write_base(plan);
+}
+
+}  // namespace
+
+void plan_collapses(const Mesh& mesh, const std::vector<uint32_t>& q, const ProgressiveOptions& options,
+                    CollapsePlan& plan) {
+  Collapser(mesh, q, options).run(plan);
+}
+
+}  // namespace tsm

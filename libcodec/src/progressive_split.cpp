@@ -1,0 +1,354 @@
+// Progressive meshes (seed 003, Hoppe's vertex splits, in batches as
+// Pajarola and Rossignac's Compressed Progressive Meshes; FORMAT.md §4.8):
+// one batch of vertex splits, coded and decoded. Per vertex of the current
+// level, in id order, a split flag (left out where the batch's independence
+// or the vertex's fan already rules a split out); per split vertex, the two
+// ring neighbours bounding the faces that move to the new vertex, and the
+// new vertex's grid position as a residual from the centroid of its ring.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+
+#include "byte_io.hpp"
+#include "codec_shared.hpp"
+#include "progressive.hpp"
+#include "range_coder.hpp"
+
+namespace tsm {
+
+constexpr int kFlagContexts = 8;
+constexpr int kScaleContexts = 24;
+constexpr int kRingContexts = 16;
+
+struct BatchModels {
+  Prob flag[kFlagContexts];
+  UIntModelT<2> start;
+  UIntModelT<2> dist[kRingContexts];  // by ring size
+  SIntModelT<3> residual[kScaleContexts][3];
+};
+
+namespace {
+
+Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, "refinement batch: " + what); }
+
+// The residual's model set: the bit length of the largest coordinate
+// difference between v and the new vertex's ring (the local edge length).
+int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist) {
+  int64_t span = 0;
+  for (uint32_t k = 0; k <= dist; ++k) {
+    const uint32_t* p = level.q(ring[(ia + k) % ring.size()]);
+    for (int a = 0; a < 3; ++a) span = std::max<int64_t>(span, std::abs(int64_t{p[a]} - int64_t{level.q(v)[a]}));
+  }
+  return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
+}
+
+int flag_context(size_t degree) { return static_cast<int>(std::min<size_t>(degree, kFlagContexts + 2) - 3); }
+
+// The grid position the decoder predicts for the new vertex: the centroid
+// of v and the ring neighbours r_ia .. r_{ia+dist} (the new vertex's ring).
+void predict(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
+             int64_t out[3]) {
+  int64_t sum[3] = {level.q(v)[0], level.q(v)[1], level.q(v)[2]};
+  const size_t d = ring.size();
+  for (uint32_t k = 0; k <= dist; ++k) {
+    const uint32_t* p = level.q(ring[(ia + k) % d]);
+    for (int a = 0; a < 3; ++a) sum[a] += p[a];
+  }
+  const int64_t n = dist + 2;
+  for (int a = 0; a < 3; ++a) out[a] = (sum[a] + n / 2) / n;
+}
+
+// Per axis, its rank by the size of the ring's normal component on it (0 =
+// the axis closest to the normal): residuals along the normal are smaller
+// than across it, so each rank has its models.
+void axis_ranks(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, int rank[3]) {
+  double n[3] = {0, 0, 0};
+  const uint32_t* c = level.q(v);
+  const size_t d = ring.size();
+  for (size_t i = 0; i < d; ++i) {
+    const uint32_t* a = level.q(ring[i]);
+    const uint32_t* b = level.q(ring[(i + 1) % d]);
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      e1[k] = static_cast<double>(a[k]) - static_cast<double>(c[k]);
+      e2[k] = static_cast<double>(b[k]) - static_cast<double>(c[k]);
+    }
+    n[0] += e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] += e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] += e1[0] * e2[1] - e1[1] * e2[0];
+  }
+  for (int a = 0; a < 3; ++a) {
+    rank[a] = 0;
+    for (int b = 0; b < 3; ++b)
+      if (std::fabs(n[b]) > std::fabs(n[a]) || (std::fabs(n[b]) == std::fabs(n[a]) && b < a)) ++rank[a];
+  }
+}
+
+uint32_t position_in(const std::vector<uint32_t>& ring, uint32_t x) {
+  return static_cast<uint32_t>(std::find(ring.begin(), ring.end(), x) - ring.begin());
+}
+
+}  // namespace
+
+void LevelMesh::init(Mesh& mesh, const Header& h) {
+  mesh_ = &mesh;
+  h_ = h;
+  step_ = grid_step(h);
+  // The grid index of a decoded coordinate (FORMAT.md §5: it quantizes
+  // back to the index it was decoded from).
+  const double qmax = std::ldexp(1.0, h.quantization_bits) - 1.0;
+  q_.resize(mesh.positions.size());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const double o = static_cast<double>(h.origin[i % 3]);
+    const double x = step_ > 0 ? std::floor((static_cast<double>(mesh.positions[i]) - o) / step_ + 0.5) : 0.0;
+    q_[i] = static_cast<uint32_t>(std::min(std::max(x, 0.0), qmax));
+  }
+  vf_.assign(mesh.vertex_count(), {});
+  for (size_t f = 0; f < mesh.face_count(); ++f)
+    for (uint32_t k = 0; k < mesh.face_size(f); ++k) {
+      std::vector<uint32_t>& uses = vf_[mesh.face(f)[k]];
+      if (uses.empty() || uses.back() != f) uses.push_back(static_cast<uint32_t>(f));
+    }
+}
+
+bool LevelMesh::ring(uint32_t v, std::vector<uint32_t>& ring) const {
+  const std::vector<uint32_t>& faces = vf_[v];
+  const size_t d = faces.size();
+  ring.clear();
+  if (d < 3) return false;
+  // next[i]: the corner after v in face i, to the one after that.
+  std::vector<std::pair<uint32_t, uint32_t>> edge(d);
+  for (size_t i = 0; i < d; ++i) {
+    const uint32_t f = faces[i];
+    if (mesh_->face_size(f) != 3) return false;
+    const uint32_t* c = mesh_->face(f);
+    const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+    edge[i] = {c[(k + 1) % 3], c[(k + 2) % 3]};
+    if (edge[i].first == v || edge[i].second == v || edge[i].first == edge[i].second) return false;
+  }
+  std::sort(edge.begin(), edge.end());
+  for (size_t i = 1; i < d; ++i)
+    if (edge[i].first == edge[i - 1].first) return false;
+  uint32_t at = edge[0].first;
+  for (size_t i = 0; i < d; ++i) {
+    ring.push_back(at);
+    auto it = std::lower_bound(edge.begin(), edge.end(), std::make_pair(at, uint32_t{0}));
+    if (it == edge.end() || it->first != at) return false;
+    at = it->second;
+  }
+  if (at != ring[0]) return false;
+  std::vector<uint32_t> sorted = ring;
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end();
+}
+
+bool LevelMesh::adjacent_to_marked(uint32_t v, const std::vector<uint8_t>& marked) const {
+  for (uint32_t f : vf_[v]) {
+    const uint32_t* c = mesh_->face(f);
+    for (uint32_t k = 0; k < mesh_->face_size(f); ++k)
+      if (c[k] < marked.size() && marked[c[k]]) return true;
+  }
+  return false;
+}
+
+void LevelMesh::add_point(const uint32_t q[3]) {
+  for (int a = 0; a < 3; ++a) q_.push_back(q[a]);
+  mesh_->add_vertex(grid_value(h_, step_, 0, q[0]), grid_value(h_, step_, 1, q[1]), grid_value(h_, step_, 2, q[2]));
+  vf_.emplace_back();
+}
+
+uint32_t LevelMesh::split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
+                          const uint32_t q[3]) {
+  const uint32_t u = static_cast<uint32_t>(vertex_count());
+  const size_t d = ring.size();
+  for (int a = 0; a < 3; ++a) q_.push_back(q[a]);
+  mesh_->add_vertex(grid_value(h_, step_, 0, q[0]), grid_value(h_, step_, 1, q[1]), grid_value(h_, step_, 2, q[2]));
+  vf_.emplace_back();
+  // The faces (v, r_i, r_{i+1}) of the arc move to u.
+  std::vector<uint32_t> keep;
+  for (uint32_t f : vf_[v]) {
+    uint32_t* c = mesh_->indices.data() + mesh_->face_offsets[f];
+    const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+    const uint32_t first = position_in(ring, c[(k + 1) % 3]);
+    if ((first + d - ia) % d < dist) {
+      c[k] = u;
+      vf_[u].push_back(f);
+    } else {
+      keep.push_back(f);
+    }
+  }
+  vf_[v] = std::move(keep);
+  const uint32_t y = ring[ia], x = ring[(ia + dist) % d];
+  const uint32_t f1 = static_cast<uint32_t>(mesh_->face_count());
+  mesh_->add_triangle(v, u, x);
+  mesh_->add_triangle(v, y, u);
+  for (uint32_t w : {v, u, x}) vf_[w].push_back(f1);
+  for (uint32_t w : {v, y, u}) vf_[w].push_back(f1 + 1);
+  return u;
+}
+
+Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, std::string& stream,
+                    std::vector<uint32_t>& new_ids) {
+  const size_t n = level.vertex_count();
+  std::vector<uint8_t> marked(n, 0);
+  std::vector<const VertexSplit*> by_vertex(n, nullptr);
+  for (const VertexSplit& s : splits) by_vertex[s.v] = &s;
+  if (!level.models()) level.models() = std::make_shared<BatchModels>();
+  BatchModels* m = level.models().get();
+  RangeEncoder e;
+  std::vector<uint32_t> ring;
+  size_t ones = 0;
+  for (uint32_t i = 0; i < n && ones < splits.size(); ++i) {
+    if (level.adjacent_to_marked(i, marked) || !level.ring(i, ring)) {
+      if (by_vertex[i]) return Status(ErrorCode::internal, "progressive: a split the batch cannot code");
+      continue;
+    }
+    const int b = by_vertex[i] != nullptr;
+    e.bit(m->flag[flag_context(ring.size())], b);
+    marked[i] = static_cast<uint8_t>(b);
+    ones += static_cast<size_t>(b);
+  }
+  std::vector<uint32_t> ids(n, 0);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (!marked[v]) continue;
+    const VertexSplit& s = *by_vertex[v];
+    level.ring(v, ring);
+    const uint32_t d = static_cast<uint32_t>(ring.size());
+    const uint32_t ia = position_in(ring, s.y), ix = position_in(ring, s.x);
+    const uint32_t dist = (ix + d - ia) % d;
+    if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
+    m->start.encode(e, ia);
+    m->dist[std::min<uint32_t>(d, kRingContexts - 1)].encode(e, dist - 1);
+    int64_t p[3];
+    predict(level, v, ring, ia, dist, p);
+    const int sc = scale_context(level, v, ring, ia, dist);
+    int rank[3];
+    axis_ranks(level, v, ring, rank);
+    for (int a = 0; a < 3; ++a) m->residual[sc][rank[a]].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
+    ids[v] = level.split(v, ring, ia, dist, s.q);
+  }
+  for (const VertexSplit& s : splits) new_ids.push_back(ids[s.v]);
+  stream = e.finish();
+  return Status::Ok();
+}
+
+std::string write_batch(const BatchHeader& h, std::string_view stream) {
+  std::string out;
+  ByteWriter w(out);
+  w.f32(h.error_before);
+  w.f32(h.error_after);
+  w.varint(h.splits);
+  w.bytes(stream);
+  return out;
+}
+
+Status read_batch(std::string_view payload, BatchHeader& h, std::string_view& stream) {
+  ByteReader r(payload);
+  if (!r.f32(h.error_before) || !r.f32(h.error_after) || !r.varint(h.splits)) return corrupt("truncated");
+  for (float e : {h.error_before, h.error_after})
+    if (!(e >= 0) || !std::isfinite(e)) return corrupt("an error that is not a finite non-negative number");
+  r.bytes(r.remaining(), stream);
+  return Status::Ok();
+}
+
+Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimits& limits) {
+  BatchHeader bh;
+  std::string_view stream;
+  TSM_RETURN_IF_ERROR(read_batch(payload, bh, stream));
+  const uint64_t splits = bh.splits;
+  const size_t n = level.vertex_count();
+  // Each split codes at least one flag and its ring positions: a count the
+  // stream cannot hold is refused before anything grows.
+  if (splits == 0 || splits > n || splits > max_decisions(stream.size()) / 4)
+    return corrupt("split count " + std::to_string(splits) + " out of range");
+  Mesh& mesh = level.mesh();
+  if ((limits.max_vertices && n + splits > limits.max_vertices) ||
+      (limits.max_faces && mesh.face_count() + 2 * splits > limits.max_faces))
+    return Status(ErrorCode::limit_exceeded, "refinement batch: the mesh would exceed the decoder's limits");
+  std::vector<uint8_t> marked(n, 0);
+  if (!level.models()) level.models() = std::make_shared<BatchModels>();
+  BatchModels* m = level.models().get();
+  RangeDecoder dec(stream);
+  std::vector<uint32_t> ring;
+  uint64_t ones = 0;
+  for (uint32_t i = 0; i < n && ones < splits; ++i) {
+    if (level.adjacent_to_marked(i, marked) || !level.ring(i, ring)) continue;
+    const int b = dec.bit(m->flag[flag_context(ring.size())]);
+    marked[i] = static_cast<uint8_t>(b);
+    ones += static_cast<uint64_t>(b);
+    if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the split flags");
+  }
+  if (ones != splits) return corrupt("fewer split flags than the split count");
+  const uint32_t qmax = static_cast<uint32_t>((uint64_t{1} << level.bits()) - 1);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (!marked[v]) continue;
+    level.ring(v, ring);
+    const uint32_t d = static_cast<uint32_t>(ring.size());
+    const uint32_t ia = m->start.decode(dec);
+    const uint32_t dist = m->dist[std::min<uint32_t>(d, kRingContexts - 1)].decode(dec) + 1;
+    if (ia >= d || dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
+    int64_t p[3];
+    predict(level, v, ring, ia, dist, p);
+    const int sc = scale_context(level, v, ring, ia, dist);
+    int rank[3];
+    axis_ranks(level, v, ring, rank);
+    uint32_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      const int64_t x = p[a] + m->residual[sc][rank[a]].decode(dec);
+      if (x < 0 || x > qmax) return corrupt("a new vertex off the grid");
+      q[a] = static_cast<uint32_t>(x);
+    }
+    if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the splits");
+    level.split(v, ring, ia, dist, q);
+  }
+  return Status::Ok();
+}
+
+std::string encode_loose(std::vector<uint32_t> q) {
+  const size_t n = q.size() / 3;
+  std::vector<std::array<uint32_t, 3>> points(n);
+  for (size_t i = 0; i < n; ++i) points[i] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
+  std::sort(points.begin(), points.end());
+  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  RangeEncoder e;
+  uint32_t prev[3] = {0, 0, 0};
+  for (const auto& p : points)
+    for (int a = 0; a < 3; ++a) {
+      m[a].encode(e, static_cast<int32_t>(int64_t{p[a]} - int64_t{prev[a]}));
+      prev[a] = p[a];
+    }
+  std::string out;
+  ByteWriter w(out);
+  w.varint(n);
+  w.bytes(e.finish());
+  return out;
+}
+
+Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits) {
+  ByteReader r(payload);
+  uint64_t n = 0;
+  if (!r.varint(n)) return corrupt("loose vertices: truncated");
+  std::string_view stream;
+  r.bytes(r.remaining(), stream);
+  if (n == 0 || n > max_decisions(stream.size()) / 3) return corrupt("loose vertex count out of range");
+  if (limits.max_vertices && level.vertex_count() + n > limits.max_vertices)
+    return Status(ErrorCode::limit_exceeded, "loose vertices: the mesh would exceed the decoder's limits");
+  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  RangeDecoder dec(stream);
+  const int64_t qmax = (int64_t{1} << level.bits()) - 1;
+  int64_t prev[3] = {0, 0, 0};
+  for (uint64_t i = 0; i < n; ++i) {
+    uint32_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      prev[a] += m[a].decode(dec);
+      if (prev[a] < 0 || prev[a] > qmax) return corrupt("a loose vertex off the grid");
+      q[a] = static_cast<uint32_t>(prev[a]);
+    }
+    if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the loose vertices' stream ends early");
+    level.add_point(q);
+  }
+  return Status::Ok();
+}
+
+}  // namespace tsm

@@ -1,0 +1,220 @@
+// Progressive files (FORMAT.md §4.8): the full file decodes to the input,
+// every prefix holding the base decodes to a level of detail, levels grow
+// batch by batch, and hostile refinement bytes are refused.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "container.hpp"
+#include "mesh_gen.hpp"
+#include "test_util.hpp"
+#include "tsm/compare.hpp"
+#include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
+
+namespace {
+using namespace tsm_test;
+
+std::string encode_progressive(const tsm::Mesh& m) {
+  tsm::EncodeOptions o;
+  o.progressive = true;
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, o, bytes);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return bytes;
+}
+
+void expect_round_trip(const tsm::Mesh& m, size_t min_batches) {
+  const std::string bytes = encode_progressive(m);
+  tsm::Mesh back;
+  tsm::Status s = tsm::decode(bytes, back);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const tsm::CompareResult c = tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits);
+  EXPECT_TRUE(c.equal) << c.difference;
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  EXPECT_GE(fi.batches.size(), min_batches);
+  if (!fi.batches.empty()) {
+    // Vertices no face uses come after the batches (but for one on the box).
+    EXPECT_LE(fi.batches.back().vertices, m.vertex_count());
+    EXPECT_GE(fi.batches.back().vertices + m.unreferenced_vertex_count(), m.vertex_count());
+    EXPECT_EQ(fi.batches.back().faces, m.face_count());
+    EXPECT_LT(fi.vertex_count, m.vertex_count());
+  }
+}
+
+tsm::Mesh merged(const tsm::Mesh& a, const tsm::Mesh& b) {
+  tsm::Mesh m = a;
+  const uint32_t n = static_cast<uint32_t>(a.vertex_count());
+  m.positions.insert(m.positions.end(), b.positions.begin(), b.positions.end());
+  for (size_t f = 0; f < b.face_count(); ++f) {
+    std::vector<uint32_t> c(b.face(f), b.face(f) + b.face_size(f));
+    for (uint32_t& x : c) x += n;
+    m.add_face(c.data(), c.size());
+  }
+  return m;
+}
+
+TEST(Progressive, RoundTripSphere) { expect_round_trip(icosphere(5), 5); }
+TEST(Progressive, RoundTripTorus) { expect_round_trip(genus_surface(1, 4), 3); }
+TEST(Progressive, RoundTripGridWithHoles) { expect_round_trip(irregular_grid(40, 7), 1); }
+TEST(Progressive, RoundTripHolesAndNonManifold) {
+  // A book (pages on one edge) beside a jittered sphere, and a grid with holes.
+  expect_round_trip(merged(merged(book(5), jittered(icosphere(4), 0.01f, 3)), grid_with_holes(24, 3)), 3);
+}
+TEST(Progressive, RoundTripPolygonsStayInTheBase) { expect_round_trip(merged(cube_quads(), icosphere(4)), 3); }
+
+TEST(Progressive, LooseVerticesAfterTheBatches) {
+  tsm::Mesh m = icosphere(4);
+  for (int i = 0; i < 20; ++i) m.add_vertex(0.1f * static_cast<float>(i % 7), 0.05f * static_cast<float>(i), 0.3f);
+  const std::string bytes = encode_progressive(m);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  bool loose = false;
+  for (const tsm::SectionInfo& s : fi.sections) loose = loose || s.name == "loose";
+  EXPECT_TRUE(loose);
+  expect_round_trip(m, 3);
+}
+
+TEST(Progressive, AttributesAreRefusedWithAReason) {
+  tsm::Mesh m = icosphere(2);
+  tsm::Attribute a;
+  a.name = "intensity";
+  a.values.assign(m.vertex_count(), 1.0f);
+  m.attributes.push_back(a);
+  tsm::EncodeOptions o;
+  o.progressive = true;
+  std::string bytes;
+  tsm::Status s = tsm::encode(m, o, bytes);
+  EXPECT_EQ(s.code(), tsm::ErrorCode::unsupported);
+  EXPECT_TRUE(tsm_test::contains(s.message(), "attribute"));
+}
+
+TEST(Progressive, StreamGrowsBatchByBatch) {
+  const tsm::Mesh m = jittered(icosphere(5), 0.02f, 11);
+  const std::string bytes = encode_progressive(m);
+  tsm::StreamDecoder sd;
+  std::vector<size_t> faces;
+  for (size_t at = 0; at < bytes.size(); at += 97) {
+    ASSERT_TRUE(sd.feed(std::string_view(bytes).substr(at, 97)).ok());
+    if (sd.batches_done() > faces.size()) {
+      std::string why;
+      ASSERT_TRUE(sd.mesh().valid(&why)) << why;
+      faces.push_back(sd.mesh().face_count());
+    }
+  }
+  ASSERT_TRUE(sd.finish().ok());
+  ASSERT_GE(faces.size(), 3u);
+  for (size_t k = 1; k < faces.size(); ++k) EXPECT_GT(faces[k], faces[k - 1]);
+  EXPECT_TRUE(tsm::compare_meshes(m, sd.mesh(), tsm::kDefaultQuantizationBits).equal);
+}
+
+TEST(Progressive, PrefixesDecodeToGrowingLevels) {
+  const tsm::Mesh m = jittered(icosphere(5), 0.02f, 5);
+  const std::string bytes = encode_progressive(m);
+  size_t last_faces = 0;
+  bool base_seen = false;
+  for (size_t cut = 0; cut <= bytes.size(); cut += 211) {
+    tsm::Mesh level;
+    tsm::PartialReport rep;
+    tsm::Status s = tsm::decode_partial(std::string_view(bytes).substr(0, cut), level, {}, &rep);
+    if (!s.ok()) {
+      EXPECT_FALSE(base_seen) << "a longer prefix failed after a shorter one decoded: " << s.message();
+      continue;
+    }
+    base_seen = true;
+    std::string why;
+    ASSERT_TRUE(level.valid(&why)) << why;
+    EXPECT_GE(level.face_count(), last_faces);
+    EXPECT_FALSE(rep.complete);
+    last_faces = level.face_count();
+  }
+  EXPECT_TRUE(base_seen);
+  tsm::Mesh full;
+  tsm::PartialReport rep;
+  ASSERT_TRUE(tsm::decode_partial(bytes, full, {}, &rep).ok());
+  EXPECT_TRUE(rep.complete);
+  EXPECT_EQ(full.face_count(), m.face_count());
+}
+
+TEST(Progressive, StopsAtMaxBytesAndMaxError) {
+  const tsm::Mesh m = jittered(icosphere(5), 0.02f, 9);
+  const std::string bytes = encode_progressive(m);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  ASSERT_GE(fi.batches.size(), 3u);
+  const size_t k = fi.batches.size() / 2;
+  tsm::PartialOptions po;
+  po.max_error = fi.batches[k].error;
+  tsm::Mesh level;
+  tsm::PartialReport rep;
+  ASSERT_TRUE(tsm::decode_partial(bytes, level, po, &rep).ok());
+  EXPECT_LE(rep.error, po.max_error);
+  EXPECT_LE(rep.batches, k + 1);
+  EXPECT_LT(level.face_count(), m.face_count());
+  tsm::PartialOptions pb;
+  pb.max_bytes = bytes.size() / 2;
+  ASSERT_TRUE(tsm::decode_partial(bytes, level, pb, &rep).ok());
+  EXPECT_LE(rep.bytes_used, pb.max_bytes);
+  EXPECT_GT(rep.batches, 0u);
+  EXPECT_LT(level.face_count(), m.face_count());
+}
+
+// Refinement sections with valid framing and checksums but random or
+// mutated payloads: refused or decoded, never a crash or hang.
+TEST(Progressive, HostileRefinementsAreRefused) {
+  const tsm::Mesh m = icosphere(4);
+  const std::string bytes = encode_progressive(m);
+  tsm::Header h;
+  std::vector<tsm::Section> sections;
+  ASSERT_TRUE(tsm::read_container(bytes, h, sections).ok());
+  std::string base;
+  size_t first_refinement = 0;
+  for (const tsm::Section& s : sections)
+    if (s.id == tsm::kSectionRefinement) {
+      first_refinement = s.offset;
+      break;
+    }
+  ASSERT_GT(first_refinement, 0u);
+  std::mt19937 rng(7);
+  int refused = 0;
+  for (int run = 0; run < tsm_test::property_runs(300); ++run) {
+    std::string file = bytes.substr(0, first_refinement);
+    for (const tsm::Section& s : sections) {
+      if (s.id != tsm::kSectionRefinement) continue;
+      std::string payload = s.data;
+      if (run % 2) {
+        payload = tsm_test::random_bytes(rng, rng() % 64);
+      } else {
+        for (int k = 0; k < 3 && !payload.empty(); ++k)
+          payload[rng() % payload.size()] ^= static_cast<char>(1 + rng() % 255);
+      }
+      tsm::append_raw_section(file, tsm::kSectionRefinement, payload);
+    }
+    file += std::string(2, '\0');
+    tsm::Mesh out;
+    tsm::DecodeOptions o;
+    o.max_vertices = 1u << 20;
+    tsm::Status s = tsm::decode(file, out, o);
+    if (!s.ok()) {
+      ++refused;
+      EXPECT_TRUE(s.code() == tsm::ErrorCode::corrupt_data || s.code() == tsm::ErrorCode::limit_exceeded)
+          << s.message();
+    } else {
+      std::string why;
+      EXPECT_TRUE(out.valid(&why)) << why;
+    }
+  }
+  EXPECT_GT(refused, 0);
+}
+
+TEST(Progressive, CorpusBunnyRoundTrip) {
+  if (tsm_test::kSanitized) GTEST_SKIP() << "the full bunny is for the plain build";
+  TSM_REQUIRE_CORPUS();
+  tsm::Mesh m;
+  ASSERT_TRUE(tsm::read_mesh(tsm_test::corpus_file("bun_zipper.ply"), m).ok());
+  m.attributes.clear();
+  expect_round_trip(m, 10);
+}
+
+}  // namespace
