@@ -88,7 +88,7 @@ Status read_section(std::string_view bytes, size_t& offset, Section& s, bool dec
 // file of several segments, at most segment_count of them; the mesh section
 // only in a file of one; the reserved ids 3-6 and 8 never; any other id at
 // most once.
-constexpr uint32_t kMaxRefinements = 4096;
+constexpr uint32_t kMaxRefinements = 64;  // each batch walks every vertex: bounds the decoder's work to 64 x the vertices
 struct SectionRules {
   std::vector<uint16_t> seen;
   uint32_t segments = 0;

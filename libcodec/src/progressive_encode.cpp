@@ -13,6 +13,8 @@
 
 namespace tsm {
 
+static_assert(ProgressiveOptions{}.max_batches <= kMaxRefinements, "the decoder refuses more refinement sections");
+
 namespace {
 
 uint64_t grid_key(const uint32_t* q) {
