@@ -473,6 +473,7 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   eo.level = a.level;
   eo.segment_faces = a.segment_faces;
   eo.attribute_bits = a.attribute_bits;
+  eo.keep_order = a.keep_order;
   // One file: its segments use the -j threads; several: the files do.
   eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
   std::string bytes;

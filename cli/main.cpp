@@ -202,6 +202,8 @@ int main(int argc, char** argv) {
   enc->add_option("--max-error", ea.max_error,
                   "Simplify first (tsm simplify): the result stays within this distance of the input, in model units "
                   "or E% of the bounding-box diagonal");
+  enc->add_flag("--keep-order", ea.keep_order,
+                "The decoded mesh keeps the input's vertex order, face order and first corners (costs bytes)");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--fallback", ea.fallback,
                 "glTF output: keep an uncompressed copy of each compressed primitive, for viewers without "

@@ -2700,7 +2700,127 @@ def decode(data, trace=None):
                 c = f32_below(c)
             pt.append(c)
         positions.append(pt)
+    if sections.get(11) is not None:                                 # step 31, §4.8
+        faces, q, positions = apply_order(sections[11], faces, q, positions, attrs)
     return h, faces, q, positions, info, attrs
+
+
+# ---------------------------------------------------------------- §4.8 the order section
+
+def decode_order(payload, faces, positions):
+    """§4.8: per input vertex its decoded vertex, per input face its decoded
+    face and first corner."""
+    vc, fc = len(positions), len(faces)
+    inc = [[] for _ in range(vc)]
+    for f, c in enumerate(faces):
+        for x in c:
+            if not inc[x] or inc[x][-1] != f:
+                inc[x].append(f)
+    nbr = [set() for _ in range(vc)]
+    for c in faces:
+        for k in range(len(c)):
+            a, b = c[k], c[(k + 1) % len(c)]
+            if a != b:
+                nbr[a].add(b)
+                nbr[b].add(a)
+    nbr = [sorted(x) for x in nbr]
+    d = RangeDecoder(payload)
+    vertex_pick = [UIntModel() for _ in range(5)]
+    corner_pick = [UIntModel() for _ in range(5)]
+    face_pick = [UIntModel() for _ in range(5)]
+    vertex_jump, corner_jump = SIntModel(), SIntModel()
+    used = [False] * vc
+    vertices, input_of = [], [0] * vc
+    for i in range(vc):
+        cand = []
+        if i:
+            p = vertices[-1]
+            cand = [u for u in nbr[p] if not used[u]][:16]
+            if i > 1 and len(cand) > 1:
+                p2 = vertices[-2]
+                key = []
+                for c in cand:
+                    dot = 0.0
+                    for a in range(3):
+                        dot += (positions[c][a] - positions[p][a]) * (positions[p][a] - positions[p2][a])
+                    key.append((-dot if math.isfinite(dot) else math.inf, c))
+                cand = [c for _, c in sorted(key)]
+        pick = vertex_pick[min(len(cand), 4)].decode(d) if cand else 0
+        if pick > len(cand):
+            reject('order section: vertex %d picks a candidate it does not have' % i)
+        if pick:
+            v = cand[pick - 1]
+        else:
+            v = (vertices[-1] + 1 if i else 0) + vertex_jump.decode(d)
+            if not 0 <= v < vc or used[v]:
+                reject('order section: vertex %d is not an unused vertex of the mesh' % i)
+        used[v] = True
+        vertices.append(v)
+        input_of[v] = i
+        if d.truncated():
+            reject('order section: cut off')
+    taken = [False] * fc
+    order, rot, new_faces = [], [], []
+    for j in range(fc):
+        cand = []
+        if j:
+            for x in new_faces[-1]:
+                if x not in cand:
+                    cand.append(x)
+        pick = corner_pick[min(len(cand), 4)].decode(d) if cand else 0
+        if pick > len(cand):
+            reject('order section: face %d picks a corner it does not have' % j)
+        if pick:
+            u = cand[pick - 1]
+        else:
+            u = (new_faces[-1][0] if j else 0) + corner_jump.decode(d)
+            if not 0 <= u < vc:
+                reject('order section: face %d: first corner out of range' % j)
+        x = vertices[u]
+        prev = set(faces[order[-1]]) if j else set()
+        first, later = [], []
+        for f in inc[x]:
+            if taken[f]:
+                continue
+            shared = len(set(faces[f]) & prev)
+            for k, y in enumerate(faces[f]):
+                if y == x:
+                    (first if shared >= 2 else later).append((f, k))
+        fcand = first + later
+        if not fcand:
+            reject('order section: face %d: no unused face at its first corner' % j)
+        k = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
+        if k >= len(fcand):
+            reject('order section: face %d picks a face it does not have' % j)
+        f, r = fcand[k]
+        taken[f] = True
+        order.append(f)
+        rot.append(r)
+        c = faces[f]
+        new_faces.append([input_of[c[(r + t) % len(c)]] for t in range(len(c))])
+        if d.truncated():
+            reject('order section: cut off')
+    return order, rot, vertices, new_faces
+
+
+def apply_order(payload, faces, q, positions, attrs):
+    """§4.8: the decoded mesh in the input's order."""
+    order, rot, vertices, new_faces = decode_order(payload, faces, positions)
+    start = [0]
+    for c in faces:
+        start.append(start[-1] + len(c))
+    for a in attrs:
+        dom = a['header'].domain
+        if a['indices'] is not None:
+            a['indices'] = [a['indices'][start[f] + (r + k) % len(faces[f])]
+                            for f, r in zip(order, rot) for k in range(len(faces[f]))]
+        elif dom == 0:
+            a['ints'] = [a['ints'][v] for v in vertices]
+            a['values'] = [a['values'][v] for v in vertices]
+        elif dom == 1:
+            a['ints'] = [a['ints'][f] for f in order]
+            a['values'] = [a['values'][f] for f in order]
+    return new_faces, [q[v] for v in vertices], [positions[v] for v in vertices]
 
 
 # ---------------------------------------------------------------- comparison with `tsm decode` output

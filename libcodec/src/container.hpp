@@ -24,13 +24,14 @@ constexpr uint64_t kMaxExpansion = 1024;
 enum SectionId : uint16_t {
   kSectionEnd = 0,
   // Ids 3-6 and 8 are reserved: a file that has one is refused
-  // (SectionRules); 1, 2 and 11 and up are unassigned: ignored.
+  // (SectionRules); 1, 2 and 12 and up are unassigned: ignored.
   kSectionReservedFirst = 3,  // 3-6: reserved
   kSectionReservedLast = 6,
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
   kSectionReserved8 = 8,      // reserved
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
+  kSectionOrder = 11,         // keep-order: the input's vertex and face order (order_coding.hpp)
 };
 const char* section_name(uint16_t id);
 

@@ -27,6 +27,7 @@ const char* section_name(uint16_t id) {
     case kSectionReserved8: return "reserved";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
+    case kSectionOrder: return "order";
   }
   return id >= kSectionReservedFirst && id <= kSectionReservedLast ? "reserved" : "unknown";
 }

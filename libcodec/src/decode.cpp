@@ -14,6 +14,7 @@
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
+#include "order_coding.hpp"
 #include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
@@ -398,6 +399,7 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
   for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
   if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
+  if (const Section* order = find_section(sections, kSectionOrder)) TSM_RETURN_IF_ERROR(decode_order(order->data, out));
   return Status::Ok();
 }
 
@@ -508,6 +510,7 @@ struct StreamDecoder::Impl {
   Header h;
   SectionRules rules;
   std::vector<Section> whole;  // a one-segment file's sections, until the end marker
+  Section order;               // the order section (id 0: none), applied at the end
   Mesh mesh;
   uint32_t done = 0;
   uint64_t faces = 0, corners = 0;
@@ -546,14 +549,15 @@ struct StreamDecoder::Impl {
       TSM_RETURN_IF_ERROR(collect_parts(h, whole, streams, parts));
       TSM_RETURN_IF_ERROR(part_done(parts[0], streams[0]));
       whole.clear();
-      return Status::Ok();
+    } else {
+      if (done != h.segment_count)
+        return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
+                       std::to_string(done));
+      if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
+        return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
     }
-    if (done != h.segment_count)
-      return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
-                     std::to_string(done));
-    if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
-      return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
-    return Status::Ok();
+    // A keep-order file's mesh takes the input's order once it is whole.
+    return order.id == kSectionOrder ? decode_order(order.data, mesh) : Status::Ok();
   }
 
   Status feed(std::string_view bytes) {
@@ -583,6 +587,8 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
       else if (s.id == kSectionSegment)
         TSM_RETURN_IF_ERROR(segment(s));
+      else if (s.id == kSectionOrder)
+        order = std::move(s);
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));
     }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 
@@ -16,6 +17,7 @@
 #include "connectivity.hpp"
 #include "container.hpp"
 #include "geometry_predict.hpp"
+#include "order_coding.hpp"
 #include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
@@ -46,6 +48,7 @@ struct EncodedPart {
   Mesh faces;                       // as the decoder gives them
   std::vector<uint8_t> ref_out;     // per output vertex: a reference
   std::vector<uint32_t> q;          // own vertices' grid indices
+  std::vector<uint32_t> vertex_from;  // welded: output vertex id -> input vertex id (else `order`)
   Status status;
 };
 
@@ -615,7 +618,7 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const EncodeOptions& options, ContainerWriter& cw) {
+                       const EncodeOptions& options, ContainerWriter& cw, std::vector<uint32_t>& vertex_from) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -713,6 +716,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     cw.add_section(kSectionSegment, write_segment(sp), 0);
     p = EncodedPart();
   }
+  vertex_from.assign(V, kNone);
+  for (uint32_t x = 0; x < V; ++x) vertex_from[final_id[x]] = x;
   return Status::Ok();
 }
 
@@ -909,13 +914,16 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   bw.bytes(split);
   bw.u8(point_order ? 1 : 0);
   out.attributes = head + best.attributes;
+  out.vertex_from.assign(V, kNone);
+  for (size_t w = 0; w < walk_out.size(); ++w) out.vertex_from[walk_out[w]] = walk_input[w];
   welded = true;
   return Status::Ok();
 }
 
-}  // namespace
-
-Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
+// The file's sections without the end marker (`cw`), and per output vertex
+// its input id (`vertex_from`).
+Status encode_sections(const Mesh& mesh, const EncodeOptions& options, std::optional<ContainerWriter>& cw_out,
+                       std::vector<uint32_t>& vertex_from) {
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "mesh is invalid: " + why);
   if (options.quantization_bits < 1 || options.quantization_bits > 30)
@@ -968,7 +976,7 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());
-  ContainerWriter cw(h);
+  ContainerWriter& cw = cw_out.emplace(h);
   // Metadata first, so that a streaming client has it before any geometry.
   if (!mesh.metadata.empty()) {
     const std::string md = write_metadata(mesh.metadata);
@@ -981,10 +989,66 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     if (!welded) TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
+    vertex_from = welded ? std::move(p.vertex_from) : std::move(p.order);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, vertex_from));
   }
-  out = cw.finish();
+  return Status::Ok();
+}
+
+// EncodeMapping of a file (`bytes`, without an order section) decoded as
+// `decoded`: the faces on input ids matched to the input's faces.
+Status file_mapping(const Mesh& mesh, const Mesh& decoded, std::vector<uint32_t> vertex_from, EncodeMapping& m) {
+  if (vertex_from.size() != mesh.vertex_count() || decoded.vertex_count() != mesh.vertex_count())
+    return Status(ErrorCode::internal, "the decoded vertices do not map to the input's");
+  Mesh on_input;
+  on_input.face_offsets = decoded.face_offsets;
+  on_input.indices.reserve(decoded.indices.size());
+  for (uint32_t x : decoded.indices) on_input.indices.push_back(vertex_from[x]);
+  std::vector<uint32_t> face, shift;
+  if (!match_faces(on_input, mesh, face, shift))
+    return Status(ErrorCode::internal, "the decoded faces do not match the input's");
+  m.vertex_from = std::move(vertex_from);
+  m.face_from = std::move(face);
+  m.first_corner = std::move(shift);
+  return Status::Ok();
+}
+
+void identity_mapping(const Mesh& mesh, EncodeMapping& m) {
+  m.vertex_from.resize(mesh.vertex_count());
+  std::iota(m.vertex_from.begin(), m.vertex_from.end(), 0u);
+  m.face_from.resize(mesh.face_count());
+  std::iota(m.face_from.begin(), m.face_from.end(), 0u);
+  m.first_corner.assign(mesh.face_count(), 0);
+}
+
+}  // namespace
+
+Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out, EncodeMapping* mapping) {
+  std::optional<ContainerWriter> cw;
+  std::vector<uint32_t> vertex_from;
+  TSM_RETURN_IF_ERROR(encode_sections(mesh, options, cw, vertex_from));
+  if (!mapping && !options.keep_order) {
+    out = cw->finish();
+    return Status::Ok();
+  }
+  // The mapping follows the decoder's faces: decode the file as it stands.
+  ContainerWriter plain = *cw;
+  std::string bytes = plain.finish();
+  Mesh decoded;
+  DecodeOptions dopt;
+  dopt.threads = options.threads;
+  TSM_RETURN_IF_ERROR(decode(bytes, decoded, dopt));
+  EncodeMapping m;
+  TSM_RETURN_IF_ERROR(file_mapping(mesh, decoded, std::move(vertex_from), m));
+  if (!options.keep_order) {
+    out = std::move(bytes);
+    *mapping = std::move(m);
+    return Status::Ok();
+  }
+  cw->add_section(kSectionOrder, encode_order(decoded, m.vertex_from, m.face_from, m.first_corner), 0);
+  out = cw->finish();
+  if (mapping) identity_mapping(mesh, *mapping);
   return Status::Ok();
 }
 

@@ -34,6 +34,18 @@ struct EncodeOptions {
   int threads = 0;
   // Quantization of float attributes (integer-typed ones are coded exactly).
   AttributeQuantization attribute_bits{};
+  // The decoded mesh keeps the input's vertex order, face order and each
+  // face's first corner (an order section codes the permutation).
+  bool keep_order = false;
+};
+
+// Where the decoded mesh's vertices and faces come from in the input (the
+// decoder's order is its own unless EncodeOptions::keep_order): decoded
+// vertex v is input vertex vertex_from[v]; decoded face f is input face
+// face_from[f], its corner k the input face's corner (first_corner[f] + k)
+// mod n. Covers every vertex (on no face, welded or split) and face.
+struct EncodeMapping {
+  std::vector<uint32_t> vertex_from, face_from, first_corner;
 };
 
 struct DecodeOptions {
@@ -47,7 +59,8 @@ struct DecodeOptions {
   int threads = 0;
 };
 
-Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out);
+// `mapping`, when given, is filled (with keep_order: the identity).
+Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out, EncodeMapping* mapping = nullptr);
 Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options = {});
 
 // Decoding while the bytes arrive: feed() them in chunks of any size; each

@@ -1,0 +1,324 @@
+// The mapping from decoded to input vertices and faces (EncodeMapping, the
+// C API's tsm_encode_mapped) and keep-order files (EncodeOptions::
+// keep_order, tsm encode --keep-order): compared array by array.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <numeric>
+#include <random>
+
+#include "mesh_gen.hpp"
+#include "order_coding.hpp"
+#include "test_util.hpp"
+#include "tsm/io.hpp"
+#include "tsm/tsm.h"
+#include "tsm/tsm.hpp"
+
+using namespace tsm;
+using namespace tsm_test;
+
+namespace {
+
+bool is_permutation_of(const std::vector<uint32_t>& p, size_t n) {
+  if (p.size() != n) return false;
+  std::vector<uint8_t> seen(n, 0);
+  for (uint32_t x : p) {
+    if (x >= n || seen[x]) return false;
+    seen[x] = 1;
+  }
+  return true;
+}
+
+// Exact integer attributes holding each vertex's and each face's input id,
+// to be re-indexed through the mapping.
+Mesh with_ids(Mesh m) {
+  Attribute v;
+  v.name = "vertex_id";
+  v.type = AttributeType::i32;
+  for (uint32_t i = 0; i < m.vertex_count(); ++i) v.values.push_back(static_cast<float>(i));
+  Attribute f;
+  f.name = "face_id";
+  f.domain = AttributeDomain::face;
+  f.type = AttributeType::i32;
+  for (uint32_t i = 0; i < m.face_count(); ++i) f.values.push_back(static_cast<float>(i));
+  m.attributes.push_back(v);
+  m.attributes.push_back(f);
+  return m;
+}
+
+// Every face on vertices of its own (positions repeated): a welded file
+// with split vertices.
+Mesh split_corners(const Mesh& m) {
+  Mesh out;
+  for (size_t f = 0; f < m.face_count(); ++f) {
+    std::vector<uint32_t> c;
+    for (uint32_t k = 0; k < m.face_size(f); ++k) {
+      const uint32_t v = m.face(f)[k];
+      c.push_back(static_cast<uint32_t>(out.vertex_count()));
+      out.add_vertex(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
+    }
+    out.add_face(c.data(), c.size());
+  }
+  return out;
+}
+
+// A vertex on no face, a face with a repeated corner and a two-corner face.
+Mesh with_odd_parts(Mesh m) {
+  m.add_vertex(0.25f, 0.5f, -0.75f);
+  const uint32_t rep[3] = {0, 0, 1}, two[2] = {2, 3};
+  m.add_face(rep, 3);
+  m.add_face(two, 2);
+  return m;
+}
+
+// The decoded mesh against the input re-indexed through the mapping: grid
+// positions, corners, and the id attributes, exactly.
+void expect_mapped(const Mesh& in, const Mesh& out, const EncodeMapping& map, int bits) {
+  ASSERT_TRUE(is_permutation_of(map.vertex_from, in.vertex_count()));
+  ASSERT_TRUE(is_permutation_of(map.face_from, in.face_count()));
+  ASSERT_EQ(map.first_corner.size(), in.face_count());
+  ASSERT_EQ(out.vertex_count(), in.vertex_count());
+  ASSERT_EQ(out.face_count(), in.face_count());
+  const Grid g = Grid::for_mesh(in, bits);
+  for (size_t v = 0; v < out.vertex_count(); ++v)
+    for (int a = 0; a < 3; ++a)
+      ASSERT_EQ(g.quantize(out.positions[3 * v + a], a),
+                g.quantize(in.positions[3 * size_t{map.vertex_from[v]} + a], a))
+          << "vertex " << v;
+  for (size_t f = 0; f < out.face_count(); ++f) {
+    const uint32_t src = map.face_from[f], n = out.face_size(f);
+    ASSERT_EQ(in.face_size(src), n);
+    for (uint32_t k = 0; k < n; ++k)
+      ASSERT_EQ(map.vertex_from[out.face(f)[k]], in.face(src)[(map.first_corner[f] + k) % n]) << "face " << f;
+  }
+  for (const Attribute& a : out.attributes) {
+    if (a.name == "vertex_id") {
+      for (size_t v = 0; v < out.vertex_count(); ++v) ASSERT_EQ(a.values[v], static_cast<float>(map.vertex_from[v]));
+    }
+    if (a.name == "face_id") {
+      for (size_t f = 0; f < out.face_count(); ++f) ASSERT_EQ(a.values[f], static_cast<float>(map.face_from[f]));
+    }
+  }
+}
+
+void check_mapping(const Mesh& in, const EncodeOptions& o) {
+  std::string bytes;
+  EncodeMapping map;
+  ASSERT_TRUE(encode(in, o, bytes, &map).ok());
+  std::string plain;
+  ASSERT_TRUE(encode(in, o, plain).ok());
+  EXPECT_EQ(bytes, plain);  // asking for the mapping changes no byte
+  Mesh out;
+  ASSERT_TRUE(decode(bytes, out).ok());
+  expect_mapped(in, out, map, o.quantization_bits);
+}
+
+// Keep-order: the decoded mesh is the input, order for order, on the grid;
+// re-encoding it gives the same bytes.
+void check_keep_order(const Mesh& in, EncodeOptions o) {
+  o.keep_order = true;
+  std::string bytes;
+  EncodeMapping map;
+  ASSERT_TRUE(encode(in, o, bytes, &map).ok());
+  Mesh out;
+  ASSERT_TRUE(decode(bytes, out).ok());
+  ASSERT_EQ(out.face_offsets, in.face_offsets);
+  ASSERT_EQ(out.indices, in.indices);
+  std::vector<uint32_t> id(in.vertex_count());
+  std::iota(id.begin(), id.end(), 0u);
+  EXPECT_EQ(map.vertex_from, id);
+  expect_mapped(in, out, map, o.quantization_bits);
+  std::string again;
+  ASSERT_TRUE(encode(out, o, again).ok());
+  EXPECT_EQ(again, bytes) << "keep-order re-encoding is not canonical";
+  StreamDecoder sd;
+  ASSERT_TRUE(sd.feed(bytes).ok());
+  ASSERT_TRUE(sd.finish().ok());
+  EXPECT_EQ(sd.mesh().indices, in.indices);
+  EXPECT_EQ(sd.mesh().positions, out.positions);
+}
+
+// The mesh with its vertices and faces shuffled and each face rotated.
+Mesh shuffled(const Mesh& m, uint32_t seed) {
+  const std::vector<uint32_t> vp = tsm_test::random_permutation(m.vertex_count(), seed);
+  const std::vector<uint32_t> fp = tsm_test::random_permutation(m.face_count(), seed + 1);
+  Mesh out;
+  out.positions.resize(m.positions.size());
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    for (size_t a = 0; a < 3; ++a) out.positions[3 * size_t{vp[v]} + a] = m.positions[3 * v + a];
+  std::vector<uint32_t> inv(m.face_count());
+  for (uint32_t f = 0; f < m.face_count(); ++f) inv[fp[f]] = f;
+  std::mt19937 rng(seed);
+  for (uint32_t g = 0; g < m.face_count(); ++g) {
+    const uint32_t f = inv[g], n = m.face_size(f);
+    const uint32_t r = n ? static_cast<uint32_t>(rng() % n) : 0;
+    std::vector<uint32_t> c;
+    for (uint32_t k = 0; k < n; ++k) c.push_back(vp[m.face(f)[(r + k) % n]]);
+    out.add_face(c.data(), c.size());
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Mapping, CoversEveryKindOfPart) {
+  EncodeOptions o;
+  o.quantization_bits = 12;
+  check_mapping(with_ids(icosphere(2)), o);
+  check_mapping(with_ids(with_odd_parts(icosphere(2))), o);
+  check_mapping(with_ids(cube_quads()), o);
+  check_mapping(with_ids(ngon(7)), o);
+  check_mapping(with_ids(moebius(12)), o);
+  check_mapping(with_ids(split_corners(icosphere(2))), o);  // welded, split vertices
+  check_mapping(with_ids(shuffled(genus_surface(2), 7)), o);
+  check_mapping(random_soup(40, 120, 3), o);  // stitches, canonical rounds
+  EncodeOptions seg = o;
+  seg.segment_faces = 64;
+  check_mapping(with_ids(with_odd_parts(icosphere(3))), seg);  // segments, references
+  check_mapping(with_ids(shuffled(icosphere(3), 11)), seg);
+}
+
+TEST(Mapping, CApiGivesTheSameArrays) {
+  const Mesh m = shuffled(icosphere(2), 5);
+  tsm_mesh* cm = nullptr;
+  char err[256];
+  ASSERT_EQ(tsm_mesh_create(m.positions.data(), m.vertex_count(), nullptr, m.face_count(), m.indices.data(),
+                            m.indices.size(), &cm, err, sizeof err),
+            0)
+      << err;
+  uint8_t* out = nullptr;
+  size_t size = 0;
+  uint32_t *vf = nullptr, *ff = nullptr, *fc = nullptr;
+  ASSERT_EQ(tsm_encode_mapped(cm, nullptr, &out, &size, &vf, &ff, &fc, err, sizeof err), 0) << err;
+  EncodeMapping map;
+  std::string bytes;
+  ASSERT_TRUE(encode(m, EncodeOptions{}, bytes, &map).ok());
+  EXPECT_EQ(std::string(reinterpret_cast<char*>(out), size), bytes);
+  EXPECT_EQ(std::vector<uint32_t>(vf, vf + m.vertex_count()), map.vertex_from);
+  EXPECT_EQ(std::vector<uint32_t>(ff, ff + m.face_count()), map.face_from);
+  EXPECT_EQ(std::vector<uint32_t>(fc, fc + m.face_count()), map.first_corner);
+  tsm_free(out), tsm_free(vf), tsm_free(ff), tsm_free(fc);
+  tsm_encode_options opt{};
+  opt.level = -1;
+  opt.keep_order = 1;
+  ASSERT_EQ(tsm_encode(cm, &opt, &out, &size, err, sizeof err), 0) << err;
+  tsm_mesh* back = nullptr;
+  ASSERT_EQ(tsm_decode(out, size, nullptr, &back, err, sizeof err), 0) << err;
+  EXPECT_EQ(std::vector<uint32_t>(tsm_mesh_indices(back), tsm_mesh_indices(back) + m.indices.size()), m.indices);
+  tsm_free(out);
+  tsm_mesh_free(back);
+  tsm_mesh_free(cm);
+}
+
+TEST(KeepOrder, GivesBackTheInputsOrder) {
+  EncodeOptions o;
+  o.quantization_bits = 12;
+  check_keep_order(icosphere(2), o);
+  check_keep_order(with_ids(shuffled(icosphere(3), 1)), o);
+  check_keep_order(with_ids(with_odd_parts(shuffled(genus_surface(1), 2))), o);
+  check_keep_order(shuffled(cube_quads(), 3), o);
+  check_keep_order(with_ids(split_corners(shuffled(icosphere(2), 4))), o);
+  check_keep_order(random_soup(30, 90, 8), o);
+  Mesh empty;
+  check_keep_order(empty, o);
+  EncodeOptions seg = o;
+  seg.segment_faces = 100;
+  check_keep_order(with_ids(shuffled(icosphere(3), 6)), seg);
+}
+
+TEST(KeepOrder, CornerAttributesFollowTheirCorners) {
+  Mesh m = shuffled(cube_quads(), 9);
+  Attribute uv;
+  uv.name = "texcoord";
+  uv.kind = AttributeKind::texcoord;
+  uv.domain = AttributeDomain::corner;
+  uv.components = 2;
+  for (uint32_t i = 0; i < m.indices.size(); ++i) {
+    uv.values.push_back(static_cast<float>(i % 5) / 4.0f);
+    uv.values.push_back(static_cast<float>(i % 3) / 2.0f);
+    uv.indices.push_back(i);
+  }
+  m.attributes.push_back(uv);
+  EncodeOptions o;
+  o.keep_order = true;
+  std::string bytes;
+  ASSERT_TRUE(encode(m, o, bytes).ok());
+  Mesh out;
+  ASSERT_TRUE(decode(bytes, out).ok());
+  ASSERT_EQ(out.indices, m.indices);
+  const Attribute& a = out.attributes.at(0);
+  for (size_t i = 0; i < m.indices.size(); ++i)
+    for (int c = 0; c < 2; ++c)
+      EXPECT_NEAR(a.values[2 * size_t{a.indices[i]} + c], uv.values[2 * i + c], 1e-3) << "corner " << i;
+}
+
+TEST(KeepOrder, HostileOrderDataIsRefusedOrAPermutation) {
+  const Mesh base = icosphere(2);
+  std::mt19937 rng(41);
+  int refused = 0;
+  for (int t = 0; t < tsm_test::property_runs(400); ++t) {
+    Mesh m = base;
+    const std::string payload = tsm_test::random_bytes(rng, 1 + rng() % 200);
+    const Status s = decode_order(payload, m);
+    if (!s.ok()) {
+      EXPECT_EQ(s.code(), ErrorCode::corrupt_data);
+      ++refused;
+      continue;
+    }
+    ASSERT_EQ(m.vertex_count(), base.vertex_count());
+    ASSERT_EQ(m.face_offsets, base.face_offsets);
+    for (uint32_t x : m.indices) ASSERT_LT(x, m.vertex_count());
+  }
+  EXPECT_GT(refused, 0);
+  // A real payload cut short is refused.
+  EncodeOptions o;
+  o.keep_order = true;
+  std::string bytes;
+  const Mesh in = shuffled(base, 2);
+  ASSERT_TRUE(encode(in, o, bytes).ok());
+  Mesh decoded;
+  EncodeMapping map;
+  std::string plain;
+  ASSERT_TRUE(encode(in, EncodeOptions{}, plain, &map).ok());
+  ASSERT_TRUE(decode(plain, decoded).ok());
+  const std::string order = encode_order(decoded, map.vertex_from, map.face_from, map.first_corner);
+  Mesh whole = decoded;
+  ASSERT_TRUE(decode_order(order, whole).ok());
+  EXPECT_EQ(whole.indices, in.indices);
+  Mesh cut = decoded;
+  EXPECT_FALSE(decode_order(order.substr(0, order.size() / 2), cut).ok());
+}
+
+TEST(KeepOrder, CorpusMeshesInTheirFilesOrder) {
+  TSM_REQUIRE_CORPUS();
+  Mesh in;
+  ASSERT_TRUE(read_mesh(tsm_test::corpus_file("bun_zipper.ply"), in).ok());
+  check_keep_order(in, EncodeOptions{});
+}
+
+TEST(KeepOrder, CommandLineFlag) {
+  tsm_test::TempDir dir;
+  const Mesh m = shuffled(icosphere(2), 12);
+  ASSERT_TRUE(write_mesh(dir.file("in.ply"), m).ok());
+  const std::string cli = TSM_CLI_PATH;
+  ASSERT_EQ(std::system(
+                (cli + " encode --keep-order " + dir.file("in.ply") + " -o " + dir.file("k.tsm") + " > /dev/null 2>&1")
+                    .c_str()),
+            0);
+  ASSERT_EQ(
+      std::system((cli + " decode " + dir.file("k.tsm") + " -o " + dir.file("k.ply") + " > /dev/null 2>&1").c_str()),
+      0);
+  Mesh back;
+  ASSERT_TRUE(read_mesh(dir.file("k.ply"), back).ok());
+  EXPECT_EQ(back.indices, m.indices);
+  // Without the flag the order is the decoder's own.
+  ASSERT_EQ(
+      std::system((cli + " encode " + dir.file("in.ply") + " -o " + dir.file("d.tsm") + " > /dev/null 2>&1").c_str()),
+      0);
+  ASSERT_EQ(
+      std::system((cli + " decode " + dir.file("d.tsm") + " -o " + dir.file("d.ply") + " > /dev/null 2>&1").c_str()),
+      0);
+  Mesh plain;
+  ASSERT_TRUE(read_mesh(dir.file("d.ply"), plain).ok());
+  EXPECT_NE(plain.indices, m.indices);
+}
