@@ -474,6 +474,8 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   eo.segment_faces = a.segment_faces;
   eo.attribute_bits = a.attribute_bits;
   eo.keep_order = a.keep_order;
+  eo.lossless = a.lossless;
+  eo.allow_nonfinite = a.allow_nonfinite;
   // One file: its segments use the -j threads; several: the files do.
   eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
   std::string bytes;
@@ -490,11 +492,12 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
 
   if (!info.notes.empty()) r.note = shown_input(j.input) + ": " + info.notes;
   if (!empty_note.empty()) r.note += (r.note.empty() ? "" : "; ") + empty_note;
-  r.text = strf("%s: %s, %s -> %s: %s (ratio %s), %s bits/vertex (q=%d, level %d), read %s ms, encode %s ms",
+  r.text = strf("%s: %s, %s -> %s: %s (ratio %s), %s bits/vertex (%s, level %d), read %s ms, encode %s ms",
                 shown_input(j.input).c_str(), count_of(mesh.vertex_count(), "vertex", "vertices").c_str(),
                 count_of(mesh.face_count(), "face", "faces").c_str(), shown_output(j.output).c_str(),
                 count_of(bytes.size(), "byte", "bytes").c_str(), ratio_text(bytes_in, bytes.size()).c_str(),
-                fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(), a.qbits, a.level,
+                fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(),
+                a.lossless ? "lossless" : ("q=" + std::to_string(a.qbits)).c_str(), a.level,
                 fixed(read_ms, 1).c_str(), fixed(encode_ms, 1).c_str());
   return finish(Status::Ok());
 }

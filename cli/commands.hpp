@@ -25,6 +25,7 @@ struct EncodeArgs : BatchArgs {
   AttributeQuantization attribute_bits;
   bool force = false, allow_nonfinite = false;
   bool keep_order = false;          // EncodeOptions::keep_order
+  bool lossless = false;            // EncodeOptions::lossless
   // Simplify first, within this distance of the input ("E" model units or
   // "E%" of the bounding-box diagonal; "" = no simplification).
   std::string max_error;

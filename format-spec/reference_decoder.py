@@ -139,7 +139,7 @@ def read_container(data):
     if version != FORMAT_VERSION:
         raise Unsupported('format version %d (this decoder reads version %d only)'
                           % (version, FORMAT_VERSION))              # step 3
-    if flags != 0:
+    if flags & ~1:
         reject('flags')                                             # step 4
     hlen, pos = read_varint(data, 8, n)                             # step 5
     if hlen > 1 << 20 or hlen > n - pos:
@@ -165,6 +165,19 @@ def read_container(data):
     h['extent'] = struct.unpack_from('<d', data, p)[0]
     p += 8
     h['segment_count'], p = read_varint(data, p, hend)
+    h['exact'] = None
+    if flags & 1:                                                   # §3, §5.1: the exact grid
+        if hend - p < 8:
+            reject('header fields')
+        step = struct.unpack_from('<d', data, p)[0]
+        p += 8
+        base = []
+        for _ in range(3):
+            z, p = read_varint(data, p, hend)
+            base.append((z >> 1) ^ -(z & 1))
+        if not (math.isfinite(step) and step > 0) or any(abs(b) > 1 << 62 for b in base):
+            reject('exact grid')                                    # step 4
+        h['exact'] = (step, base)
     if not 1 <= h['segment_count'] <= 0xFFFFFFFF:
         reject('segment count')                                     # step 9
     if not all(math.isfinite(o) for o in h['origin']):
@@ -2693,6 +2706,10 @@ def decode(data, trace=None):
     for v in range(vc):
         pt = []
         for a in range(3):
+            if h['exact'] is not None:                               # §5.1
+                x = float(h['exact'][1][a] + q[v][a]) * h['exact'][0]
+                pt.append(f32(min(max(x, -FLT_MAX), FLT_MAX)))
+                continue
             x = float(h['origin'][a]) + float(q[v][a]) * step
             x = min(max(x, -FLT_MAX), FLT_MAX)
             c = f32(x)
@@ -2700,9 +2717,40 @@ def decode(data, trace=None):
                 c = f32_below(c)
             pt.append(c)
         positions.append(pt)
+    if h['exact'] is not None and sections.get(12) is not None:      # step 31, §5.1
+        apply_exceptions(sections[12], positions)
     if sections.get(11) is not None:                                 # step 31, §4.8
         faces, q, positions = apply_order(sections[11], faces, q, positions, attrs)
     return h, faces, q, positions, info, attrs
+
+
+# ---------------------------------------------------------------- §5.1 exceptions
+
+def apply_exceptions(payload, positions):
+    """§5.1: the coordinates the exact grid misses, as differences of bits in value order."""
+    n = len(payload)
+    count, p = read_varint(payload, 0, n)
+    if count > 3 * len(positions) or count > (n - p) // 2:
+        reject('exceptions: more exceptions than coordinates or bytes')
+    at = 0
+    for _ in range(count):
+        gap, p = read_varint(payload, p, n)
+        z, p = read_varint(payload, p, n)
+        if gap >= 3 * len(positions) - at:
+            reject('exceptions: a coordinate past the last vertex')
+        at += gap
+        d = (z >> 1) ^ -(z & 1)
+        v, a = divmod(at, 3)
+        u = struct.unpack('<I', struct.pack('<f', positions[v][a]))[0]
+        o = u if u < 0x80000000 else 0x7FFFFFFF - u
+        o += d
+        if not -(1 << 31) <= o <= 0x7FFFFFFF:
+            reject('exceptions: a correction past the floats')
+        u = o if o >= 0 else 0x7FFFFFFF - o
+        positions[v][a] = struct.unpack('<f', struct.pack('<I', u))[0]
+        at += 1
+    if p != n:
+        reject('exceptions: bytes after the last exception')
 
 
 # ---------------------------------------------------------------- §4.8 the order section

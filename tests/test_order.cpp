@@ -1,12 +1,16 @@
 // The mapping from decoded to input vertices and faces (EncodeMapping, the
-// C API's tsm_encode_mapped) and keep-order files (EncodeOptions::
-// keep_order, tsm encode --keep-order): compared array by array.
+// C API's tsm_encode_mapped), keep-order files (EncodeOptions::keep_order,
+// tsm encode --keep-order) and lossless files (EncodeOptions::lossless,
+// --lossless, --allow-nonfinite): compared array by array, bit for bit.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <numeric>
 #include <random>
 
+#include "exact_grid.hpp"
 #include "mesh_gen.hpp"
 #include "order_coding.hpp"
 #include "test_util.hpp"
@@ -321,4 +325,131 @@ TEST(KeepOrder, CommandLineFlag) {
   Mesh plain;
   ASSERT_TRUE(read_mesh(dir.file("d.ply"), plain).ok());
   EXPECT_NE(plain.indices, m.indices);
+}
+
+namespace {
+
+// Lossless round trip: every coordinate's bits, faces and order as the
+// mapping says; re-encoding the decoded mesh gives the same bytes.
+void check_lossless(const Mesh& in, EncodeOptions o) {
+  o.lossless = true;
+  std::string bytes;
+  EncodeMapping map;
+  const Status s = encode(in, o, bytes, &map);
+  ASSERT_TRUE(s.ok()) << s.message();
+  Mesh out;
+  ASSERT_TRUE(decode(bytes, out).ok());
+  ASSERT_EQ(out.vertex_count(), in.vertex_count());
+  for (size_t v = 0; v < out.vertex_count(); ++v)
+    ASSERT_EQ(std::memcmp(&out.positions[3 * v], &in.positions[3 * size_t{map.vertex_from[v]}], 12), 0)
+        << "vertex " << v << ": " << out.positions[3 * v] << " " << in.positions[3 * size_t{map.vertex_from[v]}];
+  for (size_t f = 0; f < out.face_count(); ++f)
+    for (uint32_t k = 0; k < out.face_size(f); ++k)
+      ASSERT_EQ(map.vertex_from[out.face(f)[k]],
+                in.face(map.face_from[f])[(map.first_corner[f] + k) % out.face_size(f)]);
+  std::string again;
+  ASSERT_TRUE(encode(out, o, again).ok());
+  EXPECT_EQ(again, bytes) << "lossless re-encoding is not canonical";
+  StreamDecoder sd;
+  ASSERT_TRUE(sd.feed(bytes).ok());
+  ASSERT_TRUE(sd.finish().ok());
+  EXPECT_EQ(std::memcmp(sd.mesh().positions.data(), out.positions.data(), 4 * out.positions.size()), 0);
+}
+
+// A mesh's positions replaced by `values` (cycled).
+Mesh with_positions(Mesh m, const std::vector<float>& values) {
+  for (size_t i = 0; i < m.positions.size(); ++i) m.positions[i] = values[i % values.size()];
+  return m;
+}
+
+}  // namespace
+
+TEST(Lossless, DecimalCoordinatesOnTheirGrid) {
+  // Six significant digits, as ascii PLY files have them.
+  Mesh m = icosphere(3);
+  for (float& x : m.positions) x = std::stof(std::to_string(x * 0.137f).substr(0, 9));
+  check_lossless(m, EncodeOptions{});
+  EncodeOptions seg;
+  seg.segment_faces = 200;
+  check_lossless(m, seg);
+  seg.keep_order = true;
+  check_lossless(shuffled(m, 3), seg);
+}
+
+TEST(Lossless, AnyFloatBitForBit) {
+  std::mt19937 rng(7);
+  std::vector<float> odd = {0.0f,     -0.0f,  1e-45f,      -1e-45f, 1.17e-38f, 3.0e38f,
+                            -3.0e38f, 1e-30f, 123456.789f, -7.0f,   0.1f,      1.0f + 1.0f / 8388608.0f};
+  for (int i = 0; i < 300; ++i) odd.push_back(tsm_test::from_bits(static_cast<uint32_t>(rng()) & 0xFF7FFFFFu));
+  check_lossless(with_positions(icosphere(2), odd), EncodeOptions{});
+  check_lossless(with_positions(with_odd_parts(genus_surface(1)), odd), EncodeOptions{});
+  std::vector<float> tiny;
+  for (int i = 0; i < 50; ++i) tiny.push_back(tsm_test::from_bits(static_cast<uint32_t>(rng()) % 0x00800000u));
+  check_lossless(with_positions(icosphere(1), tiny), EncodeOptions{});  // denormals only
+  check_lossless(split_corners(icosphere(2)), EncodeOptions{});
+}
+
+TEST(Lossless, NonFiniteOnlyWhenAllowed) {
+  const float inf = std::numeric_limits<float>::infinity();
+  Mesh m = icosphere(1);
+  m.positions[4] = std::numeric_limits<float>::quiet_NaN();
+  m.positions[7] = -inf;
+  m.positions[9] = tsm_test::from_bits(0x7FC12345u);  // a NaN with a payload
+  std::string bytes;
+  EncodeOptions o;
+  o.lossless = true;
+  Status s = encode(m, o, bytes);
+  EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
+  EXPECT_TRUE(tsm_test::contains(s.message(), "--allow-nonfinite"));
+  s = encode(m, EncodeOptions{}, bytes);
+  EXPECT_TRUE(tsm_test::contains(s.message(), "--lossless --allow-nonfinite"));
+  o.allow_nonfinite = true;
+  check_lossless(m, o);
+}
+
+TEST(Lossless, HostileExceptionsAreRefused) {
+  std::vector<float> p(30, 1.0f);
+  std::mt19937 rng(3);
+  int refused = 0;
+  for (int t = 0; t < 500; ++t) {
+    std::vector<float> q = p;
+    const Status s = apply_exceptions(tsm_test::random_bytes(rng, rng() % 40), q);
+    if (!s.ok()) {
+      EXPECT_EQ(s.code(), ErrorCode::corrupt_data);
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 400);
+  std::vector<float> q = p;
+  EXPECT_FALSE(apply_exceptions(std::string("\x01\x1e\x02", 3), q).ok());                  // coordinate 30 of 30
+  EXPECT_FALSE(apply_exceptions(std::string("\x01\x00\xff\xff\xff\xff\x1f", 7), q).ok());  // past the floats
+  EXPECT_TRUE(apply_exceptions(std::string("\x01\x02\x02", 3), q).ok());
+  EXPECT_EQ(tsm_test::bits(q[2]), tsm_test::bits(1.0f) + 1);
+}
+
+TEST(Lossless, CorpusBunnyBitForBit) {
+  TSM_REQUIRE_CORPUS();
+  Mesh in;
+  ASSERT_TRUE(read_mesh(tsm_test::corpus_file("bun_zipper.ply"), in).ok());
+  check_lossless(in, EncodeOptions{});
+}
+
+TEST(Lossless, CommandLineFlags) {
+  tsm_test::TempDir dir;
+  Mesh m = icosphere(2);
+  for (float& x : m.positions) x = x * 0.3183099f + 1e-3f;
+  ASSERT_TRUE(write_mesh(dir.file("in.ply"), m).ok());
+  const std::string cli = TSM_CLI_PATH;
+  ASSERT_EQ(std::system((cli + " encode --lossless --keep-order " + dir.file("in.ply") + " -o " + dir.file("l.tsm") +
+                         " > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  ASSERT_EQ(
+      std::system((cli + " decode " + dir.file("l.tsm") + " -o " + dir.file("l.ply") + " > /dev/null 2>&1").c_str()),
+      0);
+  Mesh back;
+  ASSERT_TRUE(read_mesh(dir.file("l.ply"), back).ok());
+  EXPECT_EQ(back.indices, m.indices);
+  ASSERT_EQ(back.positions.size(), m.positions.size());
+  EXPECT_EQ(std::memcmp(back.positions.data(), m.positions.data(), 4 * m.positions.size()), 0);
 }

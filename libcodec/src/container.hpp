@@ -24,7 +24,7 @@ constexpr uint64_t kMaxExpansion = 1024;
 enum SectionId : uint16_t {
   kSectionEnd = 0,
   // Ids 3-6 and 8 are reserved: a file that has one is refused
-  // (SectionRules); 1, 2 and 12 and up are unassigned: ignored.
+  // (SectionRules); 1, 2 and 13 and up are unassigned: ignored.
   kSectionReservedFirst = 3,  // 3-6: reserved
   kSectionReservedLast = 6,
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
@@ -32,6 +32,7 @@ enum SectionId : uint16_t {
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
   kSectionOrder = 11,         // keep-order: the input's vertex and face order (order_coding.hpp)
+  kSectionExceptions = 12,    // lossless: the coordinates the exact grid misses (exact_grid.hpp)
 };
 const char* section_name(uint16_t id);
 
@@ -45,7 +46,13 @@ struct Header {
   float origin[3] = {0, 0, 0};
   double extent = 0;              // largest bounding-box extent (max - min in double)
   uint32_t segment_count = 1;
+  // Lossless (flag kHeaderExactGrid, FORMAT.md §5.1): the grid is
+  // (exact_base + q) * exact_step, not the bounding-box grid.
+  uint16_t flags = 0;
+  double exact_step = 0;
+  int64_t exact_base[3] = {0, 0, 0};
 };
+constexpr uint16_t kHeaderExactGrid = 1;
 
 struct Section {
   uint16_t id = 0;

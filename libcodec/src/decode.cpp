@@ -13,6 +13,7 @@
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
+#include "exact_grid.hpp"
 #include "geometry_predict.hpp"
 #include "order_coding.hpp"
 #include "parallel.hpp"
@@ -273,6 +274,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
 
 // A grid index as a coordinate (FORMAT.md §5).
 float grid_value(const Header& h, double step, int axis, uint32_t q) {
+  if (h.flags & kHeaderExactGrid) return exact_value(h.exact_step, h.exact_base[axis], q);  // §5.1
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
   const double o = static_cast<double>(h.origin[axis]);
   double x = o + static_cast<double>(q) * step;
@@ -399,6 +401,8 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
   for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
   if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
+  const Section* ex = find_section(sections, kSectionExceptions);
+  if (ex && (h.flags & kHeaderExactGrid)) TSM_RETURN_IF_ERROR(apply_exceptions(ex->data, out.positions));
   if (const Section* order = find_section(sections, kSectionOrder)) TSM_RETURN_IF_ERROR(decode_order(order->data, out));
   return Status::Ok();
 }
@@ -442,7 +446,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.level = h.level;
   info.segment_count = h.segment_count;
   for (int a = 0; a < 3; ++a) info.bbox_min[a] = h.origin[a];
-  info.step = grid_step(h);
+  info.step = (h.flags & kHeaderExactGrid) ? h.exact_step : grid_step(h);
   info.file_bytes = bytes.size();
   for (const Section& s : sections) {
     SectionInfo si;
@@ -511,6 +515,7 @@ struct StreamDecoder::Impl {
   SectionRules rules;
   std::vector<Section> whole;  // a one-segment file's sections, until the end marker
   Section order;               // the order section (id 0: none), applied at the end
+  Section exceptions;          // the exceptions section (id 0: none), applied at the end
   Mesh mesh;
   uint32_t done = 0;
   uint64_t faces = 0, corners = 0;
@@ -556,7 +561,8 @@ struct StreamDecoder::Impl {
       if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
         return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
     }
-    // A keep-order file's mesh takes the input's order once it is whole.
+    // A lossless file's exact coordinates and a keep-order file's order, once the mesh is whole.
+    if (exceptions.id == kSectionExceptions && (h.flags & kHeaderExactGrid)) TSM_RETURN_IF_ERROR(apply_exceptions(exceptions.data, mesh.positions));
     return order.id == kSectionOrder ? decode_order(order.data, mesh) : Status::Ok();
   }
 
@@ -589,6 +595,8 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(segment(s));
       else if (s.id == kSectionOrder)
         order = std::move(s);
+      else if (s.id == kSectionExceptions)
+        exceptions = std::move(s);
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));
     }

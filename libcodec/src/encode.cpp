@@ -16,6 +16,7 @@
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
+#include "exact_grid.hpp"
 #include "geometry_predict.hpp"
 #include "order_coding.hpp"
 #include "parallel.hpp"
@@ -920,10 +921,38 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   return Status::Ok();
 }
 
-// The file's sections without the end marker (`cw`), and per output vertex
-// its input id (`vertex_from`).
-Status encode_sections(const Mesh& mesh, const EncodeOptions& options, std::optional<ContainerWriter>& cw_out,
-                       std::vector<uint32_t>& vertex_from) {
+// FORMAT.md §5.1: a lossless file's grid, chosen for the mesh, with its
+// bits in place of the options' quantization bits.
+bool attributes_finite(const Mesh& mesh) {
+  for (const Attribute& a : mesh.attributes)
+    for (float x : a.values)
+      if (!std::isfinite(x)) return false;
+  return true;
+}
+
+BoundingBox finite_box(const Mesh& mesh) {
+  BoundingBox box;
+  bool any[3] = {false, false, false};
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const float x = mesh.positions[i];
+    const size_t a = i % 3;
+    if (!std::isfinite(x)) continue;
+    box.min[a] = any[a] ? std::min(box.min[a], x) : x;
+    box.max[a] = any[a] ? std::max(box.max[a], x) : x;
+    any[a] = true;
+  }
+  return box;
+}
+
+// The file's sections without the end marker (`cw`), per output vertex its
+// input id (`vertex_from`), and for a lossless file its grid (`exact`).
+Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::optional<ContainerWriter>& cw_out,
+                       std::vector<uint32_t>& vertex_from, ExactGrid& exact) {
+  EncodeOptions options = options_in;
+  if (options.lossless) {
+    exact = choose_exact_grid(mesh);
+    options.quantization_bits = exact.bits;
+  }
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "mesh is invalid: " + why);
   if (options.quantization_bits < 1 || options.quantization_bits > 30)
@@ -931,10 +960,16 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options, std::opti
                   "quantization bits must be 1..30, got " + std::to_string(options.quantization_bits));
   if (options.level < 0 || options.level > 9)
     return Status(ErrorCode::invalid_argument, "level must be 0..9, got " + std::to_string(options.level));
-  if (!mesh.all_finite())
+  if (!mesh.all_finite() && !(options.lossless && options.allow_nonfinite && attributes_finite(mesh)))
     return Status(ErrorCode::invalid_argument,
-                  "mesh has NaN or infinite coordinates, which no quantization grid can hold; fix or drop those "
-                  "vertices first");
+                  options.lossless && !attributes_finite(mesh)
+                      ? "mesh has NaN or infinite attribute values, which no quantization grid can hold; fix or drop "
+                        "them first"
+                  : options.lossless
+                      ? "mesh has NaN or infinite coordinates; pass --allow-nonfinite (EncodeOptions::allow_nonfinite) "
+                        "to keep them exactly, or fix or drop those vertices"
+                      : "mesh has NaN or infinite coordinates, which no quantization grid can hold; encode with "
+                        "--lossless --allow-nonfinite to keep them, or fix or drop those vertices first");
 
   Header h;
   h.version = kFormatVersion;
@@ -943,7 +978,7 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options, std::opti
   h.corner_count = mesh.corner_count();
   h.quantization_bits = static_cast<uint8_t>(options.quantization_bits);
   h.level = static_cast<uint8_t>(options.level);
-  BoundingBox box = bounding_box(mesh);
+  BoundingBox box = options.lossless ? finite_box(mesh) : bounding_box(mesh);
   for (int a = 0; a < 3; ++a) h.origin[a] = box.min[a];
   h.extent = box.largest_extent();
   if (!std::isfinite(h.extent))
@@ -958,6 +993,12 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options, std::opti
   for (size_t i = 0; i < qin.size(); ++i) {
     int64_t x = grid.quantize(mesh.positions[i], static_cast<int>(i % 3));
     qin[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
+  }
+  if (options.lossless) {
+    h.flags = kHeaderExactGrid;
+    h.exact_step = exact.step;
+    for (int a = 0; a < 3; ++a) h.exact_base[a] = exact.base[a];
+    for (size_t i = 0; i < qin.size(); ++i) qin[i] = exact_index(exact, mesh.positions[i], static_cast<int>(i % 3));
   }
   for (const Attribute& a : mesh.attributes)
     if (a.type != AttributeType::f32)
@@ -1027,7 +1068,16 @@ void identity_mapping(const Mesh& mesh, EncodeMapping& m) {
 Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out, EncodeMapping* mapping) {
   std::optional<ContainerWriter> cw;
   std::vector<uint32_t> vertex_from;
-  TSM_RETURN_IF_ERROR(encode_sections(mesh, options, cw, vertex_from));
+  ExactGrid exact;
+  TSM_RETURN_IF_ERROR(encode_sections(mesh, options, cw, vertex_from, exact));
+  if (options.lossless) {
+    // The coordinates in decoded order, for the exceptions (FORMAT.md §5.1).
+    std::vector<float> decoded_order(mesh.positions.size());
+    for (size_t v = 0; v < vertex_from.size(); ++v)
+      for (int a = 0; a < 3; ++a) decoded_order[3 * v + a] = mesh.positions[3 * size_t{vertex_from[v]} + a];
+    const std::string ex = encode_exceptions(exact, decoded_order);
+    if (ex.size() > 1) cw->add_section(kSectionExceptions, ex, 19);
+  }
   if (!mapping && !options.keep_order) {
     out = cw->finish();
     return Status::Ok();

@@ -37,6 +37,13 @@ struct EncodeOptions {
   // The decoded mesh keeps the input's vertex order, face order and each
   // face's first corner (an order section codes the permutation).
   bool keep_order = false;
+  // Every float32 coordinate comes back bit for bit: positions are coded on
+  // a grid found for the mesh (a decimal or binary spacing that holds most
+  // coordinates exactly), the others stored as they are;
+  // quantization_bits is not used.
+  bool lossless = false;
+  // With lossless: NaN and infinite coordinates are kept (else refused).
+  bool allow_nonfinite = false;
 };
 
 // Where the decoded mesh's vertices and faces come from in the input (the
