@@ -211,6 +211,13 @@ TEST(Mapping, CApiGivesTheSameArrays) {
   EXPECT_EQ(std::vector<uint32_t>(tsm_mesh_indices(back), tsm_mesh_indices(back) + m.indices.size()), m.indices);
   tsm_free(out);
   tsm_mesh_free(back);
+  // Lossless through the C API: the positions bit for bit, in the input's order.
+  opt.lossless = 1;
+  ASSERT_EQ(tsm_encode(cm, &opt, &out, &size, err, sizeof err), 0) << err;
+  ASSERT_EQ(tsm_decode(out, size, nullptr, &back, err, sizeof err), 0) << err;
+  EXPECT_EQ(std::memcmp(tsm_mesh_positions(back), m.positions.data(), 4 * m.positions.size()), 0);
+  tsm_free(out);
+  tsm_mesh_free(back);
   tsm_mesh_free(cm);
 }
 

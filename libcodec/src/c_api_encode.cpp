@@ -26,6 +26,8 @@ tsm::EncodeOptions options_from(const tsm_encode_options* options) {
     if (options->color_bits) o.attribute_bits.color = options->color_bits;
     if (options->generic_bits) o.attribute_bits.generic = options->generic_bits;
     o.keep_order = options->keep_order != 0;
+    o.lossless = options->lossless != 0;
+    o.allow_nonfinite = options->allow_nonfinite != 0;
   }
   return o;
 }

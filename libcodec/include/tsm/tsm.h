@@ -49,7 +49,9 @@ typedef struct tsm_encode_options {
   int texcoord_bits;
   int color_bits;
   int generic_bits;
-  int keep_order; /* nonzero: the decoded mesh keeps the input's vertex, face and corner order */
+  int keep_order;      /* nonzero: the decoded mesh keeps the input's vertex, face and corner order */
+  int lossless;        /* nonzero: every float32 coordinate comes back bit for bit (quantization_bits unused) */
+  int allow_nonfinite; /* with lossless, nonzero: NaN and infinite coordinates are kept (else refused) */
 } tsm_encode_options;
 
 /* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
