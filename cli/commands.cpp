@@ -300,16 +300,16 @@ Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat f
                                 "a .gltf read from stdin cannot name buffer files: give the .gltf file's path instead "
                                 "of - (its buffers are then read from its folder), or embed the buffers (a .glb, or "
                                 "data: URIs)");
-  // The readers offer --allow-nonfinite for NaN / infinite values, but the
-  // encoder refuses such meshes all the same: say what does work.
+  // The readers offer --allow-nonfinite for NaN / infinite values, but only
+  // a lossless file keeps them: say what works.
   const size_t flag = m.find("--allow-nonfinite");
   if (flag != std::string::npos) {
     const size_t from = m.rfind("; ", flag);
     const size_t to = m.find("; ", flag);
     if (from != std::string::npos)
       return Status(s.code(), m.substr(0, from) +
-                                  "; tsm cannot compress NaN or infinite values (no quantization grid holds them): "
-                                  "fix or drop them in the file" +
+                                  "; only a lossless file keeps NaN or infinite coordinates: encode with "
+                                  "--lossless --allow-nonfinite, or fix or drop them in the file" +
                                   (to == std::string::npos ? std::string() : m.substr(to)));
   }
   return s;
