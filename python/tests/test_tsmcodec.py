@@ -194,3 +194,20 @@ def test_corpus_bunny_bytes_equal_the_tools(tmp_path):
     lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
     step = float((hi - lo).max()) / ((1 << tsmcodec.info(data)["quantization_bits"]) - 1)
     assert (back.positions >= lo - step).all() and (back.positions <= hi + step).all()
+
+
+def test_keep_order_and_lossless_round_trip():
+    rng = np.random.default_rng(41)
+    positions = rng.standard_normal((60, 3)).astype(np.float32)
+    positions[3, 1] = np.float32(-0.0)
+    positions[7, 2] = np.float32(1e-40)  # a denormal
+    faces = rng.permutation(np.array([[i, (i + 1) % 60, (i + 7) % 60] for i in range(60)], dtype=np.uint32))
+    data = tsmcodec.encode(positions, faces, keep_order=True, lossless=True)
+    mesh = tsmcodec.decode(data)
+    assert np.asarray(mesh.positions).tobytes() == positions.tobytes()
+    assert np.array_equal(np.asarray(mesh.faces), faces)
+    positions[5, 0] = np.nan
+    with pytest.raises(Exception, match="allow-nonfinite"):
+        tsmcodec.encode(positions, faces, lossless=True)
+    back = tsmcodec.decode(tsmcodec.encode(positions, faces, keep_order=True, lossless=True, allow_nonfinite=True))
+    assert np.asarray(back.positions).tobytes() == positions.tobytes()
