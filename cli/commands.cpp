@@ -285,16 +285,16 @@ Status parse_mesh(std::string_view bytes, const std::string& input, MeshFormat f
                                 "a .gltf read from stdin cannot name buffer files: give the .gltf file's path instead "
                                 "of - (its buffers are then read from its folder), or embed the buffers (a .glb, or "
                                 "data: URIs)");
-  // The readers offer --allow-nonfinite for NaN / infinite values, but the
-  // encoder refuses such meshes all the same: say what does work.
+  // The readers offer --allow-nonfinite for NaN / infinite values, but only
+  // a lossless file keeps them: say what works.
   const size_t flag = m.find("--allow-nonfinite");
   if (flag != std::string::npos) {
     const size_t from = m.rfind("; ", flag);
     const size_t to = m.find("; ", flag);
     if (from != std::string::npos)
       return Status(s.code(), m.substr(0, from) +
-                                  "; tsm cannot compress NaN or infinite values (no quantization grid holds them): "
-                                  "fix or drop them in the file" +
+                                  "; only a lossless file keeps NaN or infinite coordinates: encode with "
+                                  "--lossless --allow-nonfinite, or fix or drop them in the file" +
                                   (to == std::string::npos ? std::string() : m.substr(to)));
   }
   return s;
@@ -460,6 +460,9 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
   eo.segment_faces = a.segment_faces;
   eo.attribute_bits = a.attribute_bits;
   eo.progressive = a.progressive;
+  eo.keep_order = a.keep_order;
+  eo.lossless = a.lossless;
+  eo.allow_nonfinite = a.allow_nonfinite;
   // One file: its segments use the -j threads; several: the files do.
   eo.threads = a.inputs.size() == 1 ? static_cast<int>(a.jobs) : 1;
   std::string bytes;
@@ -476,11 +479,12 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
 
   if (!info.notes.empty()) r.note = shown_input(j.input) + ": " + info.notes;
   if (!empty_note.empty()) r.note += (r.note.empty() ? "" : "; ") + empty_note;
-  r.text = strf("%s: %s, %s -> %s: %s (ratio %s), %s bits/vertex (q=%d, level %d), read %s ms, encode %s ms",
+  r.text = strf("%s: %s, %s -> %s: %s (ratio %s), %s bits/vertex (%s, level %d), read %s ms, encode %s ms",
                 shown_input(j.input).c_str(), count_of(mesh.vertex_count(), "vertex", "vertices").c_str(),
                 count_of(mesh.face_count(), "face", "faces").c_str(), shown_output(j.output).c_str(),
                 count_of(bytes.size(), "byte", "bytes").c_str(), ratio_text(bytes_in, bytes.size()).c_str(),
-                fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(), a.qbits, a.level,
+                fixed(bits_per_vertex(bytes.size(), mesh.vertex_count()), 2).c_str(),
+                a.lossless ? "lossless" : ("q=" + std::to_string(a.qbits)).c_str(), a.level,
                 fixed(read_ms, 1).c_str(), fixed(encode_ms, 1).c_str());
   return finish(Status::Ok());
 }

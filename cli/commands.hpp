@@ -24,6 +24,8 @@ struct EncodeArgs : BatchArgs {
   uint32_t segment_faces = 0;       // 0 = the library's default
   AttributeQuantization attribute_bits;
   bool force = false, allow_nonfinite = false;
+  bool keep_order = false;          // EncodeOptions::keep_order
+  bool lossless = false;            // EncodeOptions::lossless
   // Simplify first, within this distance of the input ("E" model units or
   // "E%" of the bounding-box diagonal; "" = no simplification).
   std::string max_error;

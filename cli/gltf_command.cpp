@@ -110,6 +110,9 @@ int gltf_encode(const EncodeArgs& a) {
   o.encode.level = a.level;
   o.encode.segment_faces = a.segment_faces;
   o.encode.attribute_bits = a.attribute_bits;
+  o.encode.keep_order = a.keep_order;
+  o.encode.lossless = a.lossless;
+  o.encode.allow_nonfinite = a.allow_nonfinite;
   o.encode.threads = static_cast<int>(a.jobs);
   return run(a.inputs[0], a.output, o, a.quiet, "compressed glTF");
 }

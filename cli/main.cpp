@@ -208,13 +208,17 @@ int main(int argc, char** argv) {
   enc->add_flag("--drop-attributes", ea.drop_attributes,
                 "Code positions and faces only, leaving out normals, colours, texture coordinates and the like "
                 "(progressive files carry none)");
+  enc->add_flag("--keep-order", ea.keep_order,
+                "The decoded mesh keeps the input's vertex order, face order and first corners (costs bytes)");
+  enc->add_flag("--lossless", ea.lossless,
+                "Every float32 coordinate comes back bit for bit (-q is not used)");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--fallback", ea.fallback,
                 "glTF output: keep an uncompressed copy of each compressed primitive, for viewers without "
                 "TSM_mesh_compression");
   enc->add_flag("--allow-nonfinite", ea.allow_nonfinite,
-                "Let the readers accept NaN/inf values (the encoder refuses them all the same, so this only moves the "
-                "error from the reader to the encoder; kept for scripts)");
+                "Let the readers accept NaN/inf values; with --lossless they are kept exactly (without it the encoder "
+                "refuses them)");
   add_batch_options(enc, ea, true);
   enc->footer(
       "Examples:\n"

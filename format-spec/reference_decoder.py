@@ -139,7 +139,7 @@ def read_container(data):
     if version != FORMAT_VERSION:
         raise Unsupported('format version %d (this decoder reads version %d only)'
                           % (version, FORMAT_VERSION))              # step 3
-    if flags != 0:
+    if flags & ~1:
         reject('flags')                                             # step 4
     hlen, pos = read_varint(data, 8, n)                             # step 5
     if hlen > 1 << 20 or hlen > n - pos:
@@ -165,6 +165,19 @@ def read_container(data):
     h['extent'] = struct.unpack_from('<d', data, p)[0]
     p += 8
     h['segment_count'], p = read_varint(data, p, hend)
+    h['exact'] = None
+    if flags & 1:                                                   # §3, §5.1: the exact grid
+        if hend - p < 8:
+            reject('header fields')
+        step = struct.unpack_from('<d', data, p)[0]
+        p += 8
+        base = []
+        for _ in range(3):
+            z, p = read_varint(data, p, hend)
+            base.append((z >> 1) ^ -(z & 1))
+        if not (math.isfinite(step) and step > 0) or any(abs(b) > 1 << 62 for b in base):
+            reject('exact grid')                                    # step 4
+        h['exact'] = (step, base)
     if not 1 <= h['segment_count'] <= 0xFFFFFFFF:
         reject('segment count')                                     # step 9
     if not all(math.isfinite(o) for o in h['origin']):
@@ -2693,6 +2706,10 @@ def decode(data, trace=None):
     for v in range(vc):
         pt = []
         for a in range(3):
+            if h['exact'] is not None:                               # §5.1
+                x = float(h['exact'][1][a] + q[v][a]) * h['exact'][0]
+                pt.append(f32(min(max(x, -FLT_MAX), FLT_MAX)))
+                continue
             x = float(h['origin'][a]) + float(q[v][a]) * step
             x = min(max(x, -FLT_MAX), FLT_MAX)
             c = f32(x)
@@ -2700,7 +2717,158 @@ def decode(data, trace=None):
                 c = f32_below(c)
             pt.append(c)
         positions.append(pt)
+    if h['exact'] is not None and sections.get(14) is not None:      # step 31, §5.1
+        apply_exceptions(sections[14], positions)
+    if sections.get(11) is not None:                                 # step 31, §4.9
+        faces, q, positions = apply_order(sections[11], faces, q, positions, attrs)
     return h, faces, q, positions, info, attrs
+
+
+# ---------------------------------------------------------------- §5.1 exceptions
+
+def apply_exceptions(payload, positions):
+    """§5.1: the coordinates the exact grid misses, as differences of bits in value order."""
+    n = len(payload)
+    count, p = read_varint(payload, 0, n)
+    if count > 3 * len(positions) or count > (n - p) // 2:
+        reject('exceptions: more exceptions than coordinates or bytes')
+    at = 0
+    for _ in range(count):
+        gap, p = read_varint(payload, p, n)
+        z, p = read_varint(payload, p, n)
+        if gap >= 3 * len(positions) - at:
+            reject('exceptions: a coordinate past the last vertex')
+        at += gap
+        d = (z >> 1) ^ -(z & 1)
+        v, a = divmod(at, 3)
+        u = struct.unpack('<I', struct.pack('<f', positions[v][a]))[0]
+        o = u if u < 0x80000000 else 0x7FFFFFFF - u
+        o += d
+        if not -(1 << 31) <= o <= 0x7FFFFFFF:
+            reject('exceptions: a correction past the floats')
+        u = o if o >= 0 else 0x7FFFFFFF - o
+        positions[v][a] = struct.unpack('<f', struct.pack('<I', u))[0]
+        at += 1
+    if p != n:
+        reject('exceptions: bytes after the last exception')
+
+
+# ---------------------------------------------------------------- §4.8 the order section
+
+def decode_order(payload, faces, positions):
+    """§4.8: per input vertex its decoded vertex, per input face its decoded
+    face and first corner."""
+    vc, fc = len(positions), len(faces)
+    inc = [[] for _ in range(vc)]
+    for f, c in enumerate(faces):
+        for x in c:
+            if not inc[x] or inc[x][-1] != f:
+                inc[x].append(f)
+    nbr = [set() for _ in range(vc)]
+    for c in faces:
+        for k in range(len(c)):
+            a, b = c[k], c[(k + 1) % len(c)]
+            if a != b:
+                nbr[a].add(b)
+                nbr[b].add(a)
+    nbr = [sorted(x) for x in nbr]
+    d = RangeDecoder(payload)
+    vertex_pick = [UIntModel() for _ in range(5)]
+    corner_pick = [UIntModel() for _ in range(5)]
+    face_pick = [UIntModel() for _ in range(5)]
+    vertex_jump, corner_jump = SIntModel(), SIntModel()
+    used = [False] * vc
+    vertices, input_of = [], [0] * vc
+    for i in range(vc):
+        cand = []
+        if i:
+            p = vertices[-1]
+            cand = [u for u in nbr[p] if not used[u]][:16]
+            if i > 1 and len(cand) > 1:
+                p2 = vertices[-2]
+                key = []
+                for c in cand:
+                    dot = 0.0
+                    for a in range(3):
+                        dot += (positions[c][a] - positions[p][a]) * (positions[p][a] - positions[p2][a])
+                    key.append((-dot if math.isfinite(dot) else math.inf, c))
+                cand = [c for _, c in sorted(key)]
+        pick = vertex_pick[min(len(cand), 4)].decode(d) if cand else 0
+        if pick > len(cand):
+            reject('order section: vertex %d picks a candidate it does not have' % i)
+        if pick:
+            v = cand[pick - 1]
+        else:
+            v = (vertices[-1] + 1 if i else 0) + vertex_jump.decode(d)
+            if not 0 <= v < vc or used[v]:
+                reject('order section: vertex %d is not an unused vertex of the mesh' % i)
+        used[v] = True
+        vertices.append(v)
+        input_of[v] = i
+        if d.truncated():
+            reject('order section: cut off')
+    taken = [False] * fc
+    order, rot, new_faces = [], [], []
+    for j in range(fc):
+        cand = []
+        if j:
+            for x in new_faces[-1]:
+                if x not in cand:
+                    cand.append(x)
+        pick = corner_pick[min(len(cand), 4)].decode(d) if cand else 0
+        if pick > len(cand):
+            reject('order section: face %d picks a corner it does not have' % j)
+        if pick:
+            u = cand[pick - 1]
+        else:
+            u = (new_faces[-1][0] if j else 0) + corner_jump.decode(d)
+            if not 0 <= u < vc:
+                reject('order section: face %d: first corner out of range' % j)
+        x = vertices[u]
+        prev = set(faces[order[-1]]) if j else set()
+        first, later = [], []
+        for f in inc[x]:
+            if taken[f]:
+                continue
+            shared = len(set(faces[f]) & prev)
+            for k, y in enumerate(faces[f]):
+                if y == x:
+                    (first if shared >= 2 else later).append((f, k))
+        fcand = first + later
+        if not fcand:
+            reject('order section: face %d: no unused face at its first corner' % j)
+        k = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
+        if k >= len(fcand):
+            reject('order section: face %d picks a face it does not have' % j)
+        f, r = fcand[k]
+        taken[f] = True
+        order.append(f)
+        rot.append(r)
+        c = faces[f]
+        new_faces.append([input_of[c[(r + t) % len(c)]] for t in range(len(c))])
+        if d.truncated():
+            reject('order section: cut off')
+    return order, rot, vertices, new_faces
+
+
+def apply_order(payload, faces, q, positions, attrs):
+    """§4.8: the decoded mesh in the input's order."""
+    order, rot, vertices, new_faces = decode_order(payload, faces, positions)
+    start = [0]
+    for c in faces:
+        start.append(start[-1] + len(c))
+    for a in attrs:
+        dom = a['header'].domain
+        if a['indices'] is not None:
+            a['indices'] = [a['indices'][start[f] + (r + k) % len(faces[f])]
+                            for f, r in zip(order, rot) for k in range(len(faces[f]))]
+        elif dom == 0:
+            a['ints'] = [a['ints'][v] for v in vertices]
+            a['values'] = [a['values'][v] for v in vertices]
+        elif dom == 1:
+            a['ints'] = [a['ints'][f] for f in order]
+            a['values'] = [a['values'][f] for f in order]
+    return new_faces, [q[v] for v in vertices], [positions[v] for v in vertices]
 
 
 # ---------------------------------------------------------------- comparison with `tsm decode` output

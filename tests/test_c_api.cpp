@@ -90,7 +90,7 @@ TEST(CApi, CreateEncodeDecodeRoundTrip) {
   EXPECT_EQ(copy.indices, src.indices);
 
   Buffer buf;
-  tsm_encode_options eo{12, 5, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options eo{12, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
   ASSERT_NE(buf.p, nullptr);
   ASSERT_GT(buf.n, 0u);
@@ -126,7 +126,7 @@ TEST(CApi, DefaultOptions) {
   std::string cpp;
   ASSERT_TRUE(tsm::encode(src, tsm::EncodeOptions{}, cpp).ok());
   // quantization_bits = 0 and level = -1 mean the defaults; so does NULL.
-  tsm_encode_options defaults{0, -1, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options defaults{0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   Buffer a, b;
   ASSERT_EQ(tsm_encode(m.p, &defaults, &a.p, &a.n, nullptr, 0), TSM_OK);
   ASSERT_EQ(tsm_encode(m.p, nullptr, &b.p, &b.n, nullptr, 0), TSM_OK);
@@ -227,7 +227,7 @@ TEST(CApi, InvalidMeshesRefused) {
   // Bad options.
   MeshPtr good;
   ASSERT_EQ(tsm_mesh_create(pos, 3, nullptr, 1, idx, 3, &good.p, err, sizeof err), TSM_OK);
-  tsm_encode_options bad_q{31, -1, 0, 0, 0, 0, 0, 0}, bad_level{14, 10, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options bad_q{31, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0}, bad_level{14, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   EXPECT_EQ(tsm_encode(good.p, &bad_q, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err).find("quantization"), std::string::npos) << err;
   EXPECT_EQ(tsm_encode(good.p, &bad_level, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
@@ -557,7 +557,7 @@ TEST(CApi, AttributeBitsOption) {
   ASSERT_EQ(create_from(s.mesh, &m.p, err, sizeof err, false), TSM_OK) << err;
   add_attributes(m.p, s);
   if (HasFatalFailure()) return;
-  tsm_encode_options fine{0, -1, 0, 0, 8, 20, 0, 0};
+  tsm_encode_options fine{0, -1, 0, 0, 8, 20, 0, 0, 0, 0, 0};
   Buffer a, b;
   ASSERT_EQ(tsm_encode(m.p, nullptr, &a.p, &a.n, err, sizeof err), TSM_OK) << err;
   ASSERT_EQ(tsm_encode(m.p, &fine, &b.p, &b.n, err, sizeof err), TSM_OK) << err;
@@ -568,7 +568,7 @@ TEST(CApi, AttributeBitsOption) {
   ASSERT_TRUE(tsm::encode(s.mesh, eo, cpp).ok());
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(b.p), b.n), cpp);
   EXPECT_NE(a.n, b.n);
-  tsm_encode_options bad{0, -1, 0, 0, 0, 25, 0, 0};
+  tsm_encode_options bad{0, -1, 0, 0, 0, 25, 0, 0, 0, 0, 0};
   Buffer c;
   EXPECT_EQ(tsm_encode(m.p, &bad, &c.p, &c.n, err, sizeof err), TSM_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err).find("1..24"), std::string::npos) << err;
@@ -585,7 +585,7 @@ TEST(CApi, AttributesStreamed) {
   add_attributes(m.p, s);
   if (HasFatalFailure()) return;
   Buffer buf;
-  tsm_encode_options eo{0, -1, 200, 1, 0, 0, 0, 0};  // 7 segments
+  tsm_encode_options eo{0, -1, 200, 1, 0, 0, 0, 0, 0, 0, 0};  // 7 segments
   ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
   MeshPtr whole;
   ASSERT_EQ(tsm_decode(buf.p, buf.n, nullptr, &whole.p, err, sizeof err), TSM_OK) << err;

@@ -1093,7 +1093,7 @@ TEST_F(CliBatch, EveryHintLeadsSomewhere) {
   EXPECT_FALSE(fs::exists(file("rt.obj")));
   EXPECT_EQ(tsm("decode " + q("in.tsm") + " -o " + q("rt2.ply") + " --ascii --quiet").code, 0);
 
-  // NaN coordinates: no hint toward --allow-nonfinite, which cannot help.
+  // NaN coordinates: the hint (--lossless --allow-nonfinite) is followed and works.
   spit(file("nan.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                         "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   spit(file("nan.obj"), "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
@@ -1101,9 +1101,11 @@ TEST_F(CliBatch, EveryHintLeadsSomewhere) {
     for (const char* flag : {"", " --allow-nonfinite"}) {
       r = tsm("encode " + q(name) + " -o " + q("nan.tsm") + flag);
       EXPECT_EQ(r.code, 3) << name << flag << ": " << r.err;
-      EXPECT_EQ(r.err.find("--allow-nonfinite"), std::string::npos) << name << flag << ": " << r.err;
+      EXPECT_NE(r.err.find("--lossless --allow-nonfinite"), std::string::npos) << name << flag << ": " << r.err;
       EXPECT_NE(r.err.find("fix or drop"), std::string::npos) << name << flag << ": " << r.err;
     }
+    r = tsm("encode " + q(name) + " -o " + q(std::string(name) + ".tsm") + " --lossless --allow-nonfinite --quiet");
+    EXPECT_EQ(r.code, 0) << name << ": " << r.err;
   }
 
   // A .gltf on stdin whose buffer is a file: what to do on the command line.

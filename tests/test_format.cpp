@@ -162,11 +162,14 @@ TEST(Format, SectionRules) {
     EXPECT_EQ(decode_code(rebuild(good, {{tsm::kSectionMesh, mesh}, {id, "x"}})), tsm::ErrorCode::corrupt_data);
     EXPECT_EQ(decode_code(rebuild(good, {{id, "x"}, {tsm::kSectionMesh, mesh}})), tsm::ErrorCode::corrupt_data);
   }
-  for (int ignored : {1, 2, 11, 200, 0xFFFF}) {
+  for (int ignored : {1, 2, 15, 200, 0xFFFF}) {
     SCOPED_TRACE(ignored);
     const Mesh m = decode_ok(rebuild(good, {{static_cast<uint16_t>(ignored), "anything"}, {tsm::kSectionMesh, mesh}}));
     EXPECT_TRUE(m.indices == expected.indices && m.positions == expected.positions);
   }
+  // Section 11 is the order section (FORMAT.md §4.9): garbage there is refused.
+  EXPECT_EQ(decode_code(rebuild(good, {{tsm::kSectionMesh, mesh}, {tsm::kSectionOrder, "anything"}})),
+            tsm::ErrorCode::corrupt_data);
   EXPECT_EQ(decode_code(rebuild(good, {})), tsm::ErrorCode::corrupt_data);
   EXPECT_EQ(decode_code(rebuild(good, {{tsm::kSectionMesh, mesh}, {tsm::kSectionMesh, mesh}})),
             tsm::ErrorCode::corrupt_data);

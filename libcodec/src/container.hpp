@@ -24,15 +24,17 @@ constexpr uint64_t kMaxExpansion = 1024;
 enum SectionId : uint16_t {
   kSectionEnd = 0,
   // Ids 3-6 and 8 are reserved: a file that has one is refused
-  // (SectionRules); 1, 2 and 11 and up are unassigned: ignored.
+  // (SectionRules); 1, 2 and 13 and up are unassigned: ignored.
   kSectionReservedFirst = 3,  // 3-6: reserved
   kSectionReservedLast = 6,
   kSectionSegment = 7,        // one segment of a mesh coded in several (all of its streams)
   kSectionReserved8 = 8,      // reserved
   kSectionMetadata = 9,       // Mesh::metadata, passed through (key/value byte strings)
   kSectionMesh = 10,          // a one-segment mesh: its four streams and its attributes
+  kSectionOrder = 11,         // keep-order: the input's vertex and face order (order_coding.hpp)
   kSectionRefinement = 12,    // a progressive file's batch of vertex splits (FORMAT.md §4.8); repeats
   kSectionLoose = 13,         // a progressive file's vertices no face uses, after its batches (FORMAT.md §4.8)
+  kSectionExceptions = 14,    // lossless: the coordinates the exact grid misses (exact_grid.hpp)
 };
 const char* section_name(uint16_t id);
 
@@ -46,7 +48,13 @@ struct Header {
   float origin[3] = {0, 0, 0};
   double extent = 0;              // largest bounding-box extent (max - min in double)
   uint32_t segment_count = 1;
+  // Lossless (flag kHeaderExactGrid, FORMAT.md §5.1): the grid is
+  // (exact_base + q) * exact_step, not the bounding-box grid.
+  uint16_t flags = 0;
+  double exact_step = 0;
+  int64_t exact_base[3] = {0, 0, 0};
 };
+constexpr uint16_t kHeaderExactGrid = 1;
 
 struct Section {
   uint16_t id = 0;

@@ -27,8 +27,10 @@ const char* section_name(uint16_t id) {
     case kSectionReserved8: return "reserved";
     case kSectionMetadata: return "metadata";
     case kSectionMesh: return "mesh";
+    case kSectionOrder: return "order";
     case kSectionRefinement: return "refinement";
     case kSectionLoose: return "loose";
+    case kSectionExceptions: return "exceptions";
   }
   return id >= kSectionReservedFirst && id <= kSectionReservedLast ? "reserved" : "unknown";
 }
@@ -68,7 +70,8 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
     missing = "file ends inside the header";
     return Status::Ok();
   }
-  if (flags != 0) return corrupt("unknown header flags " + std::to_string(flags));
+  if (flags & ~kHeaderExactGrid) return corrupt("unknown header flags " + std::to_string(flags));
+  header.flags = flags;
   uint64_t header_len = 0;
   std::string_view fields;
   if (!r.varint(header_len)) {
@@ -94,7 +97,19 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
             h.u8(header.quantization_bits) && h.u8(header.level);
   for (float& o : header.origin) ok = ok && h.f32(o);
   ok = ok && h.f64(header.extent) && h.varint(segments);
+  if (ok && (flags & kHeaderExactGrid)) {
+    ok = h.f64(header.exact_step);
+    for (int64_t& b : header.exact_base) {
+      uint64_t z = 0;
+      ok = ok && h.varint(z);
+      b = static_cast<int64_t>(z >> 1) ^ -static_cast<int64_t>(z & 1);
+    }
+  }
   if (!ok) return corrupt("header fields are truncated");
+  if ((flags & kHeaderExactGrid) && !(header.exact_step > 0 && std::isfinite(header.exact_step)))
+    return corrupt("the exact grid's step is not a finite positive number");
+  for (int64_t b : header.exact_base)
+    if (b > (int64_t{1} << 62) || b < -(int64_t{1} << 62)) return corrupt("the exact grid's base is out of range");
   if (segments == 0 || segments > 0xffffffffu) return corrupt("bad segment count");
   header.segment_count = static_cast<uint32_t>(segments);
   for (float o : header.origin)
@@ -181,6 +196,12 @@ Status SectionRules::admit(const Section& s, const Header& h) {
   if (segment_count > 1 && s.id == kSectionMesh)
     return corrupt_at(at, s.id, "a whole-mesh section in a file of " + std::to_string(segment_count) + " segments");
   if (s.id == kSectionLoose && refinements == 0) return corrupt_at(at, s.id, "loose vertices before any refinement");
+  // A progressive file keeps neither the input's order nor exact coordinates (FORMAT.md §4.8).
+  const bool whole_mesh_only = s.id == kSectionOrder || s.id == kSectionExceptions;
+  if (whole_mesh_only && refinements > 0) return corrupt_at(at, s.id, "in a progressive file");
+  if (s.id == kSectionRefinement && (std::find(seen.begin(), seen.end(), kSectionOrder) != seen.end() ||
+                                     std::find(seen.begin(), seen.end(), kSectionExceptions) != seen.end()))
+    return corrupt_at(at, s.id, "a refinement in a keep-order or lossless file");
   if (s.id == kSectionRefinement) {
     if (std::find(seen.begin(), seen.end(), kSectionLoose) != seen.end())
       return corrupt_at(at, s.id, "a refinement after the loose vertices");

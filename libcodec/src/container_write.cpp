@@ -23,6 +23,10 @@ void write_header_fields(ByteWriter& w, const Header& h) {
   for (float o : h.origin) w.f32(o);
   w.f64(h.extent);
   w.varint(h.segment_count);
+  if (h.flags & kHeaderExactGrid) {
+    w.f64(h.exact_step);
+    for (int64_t b : h.exact_base) w.varint((static_cast<uint64_t>(b) << 1) ^ static_cast<uint64_t>(b >> 63));
+  }
 }
 
 }  // namespace
@@ -31,7 +35,7 @@ ContainerWriter::ContainerWriter(const Header& header) {
   ByteWriter w(out_);
   w.bytes(std::string_view(kMagic, 4));
   w.u16(header.version);
-  w.u16(0);  // flags
+  w.u16(header.flags);
   std::string fields;
   ByteWriter fw(fields);
   write_header_fields(fw, header);

@@ -13,10 +13,12 @@
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
+#include "exact_grid.hpp"
+#include "geometry_predict.hpp"
+#include "order_coding.hpp"
+#include "parallel.hpp"
 #include "progressive.hpp"
 #include "progressive_decode.hpp"
-#include "geometry_predict.hpp"
-#include "parallel.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
 #include "split_layout.hpp"
@@ -276,6 +278,7 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
 
 // A grid index as a coordinate (FORMAT.md §5).
 float grid_value(const Header& h, double step, int axis, uint32_t q) {
+  if (h.flags & kHeaderExactGrid) return exact_value(h.exact_step, h.exact_base[axis], q);  // §5.1
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
   const double o = static_cast<double>(h.origin[axis]);
   double x = o + static_cast<double>(q) * step;
@@ -404,6 +407,9 @@ Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options) {
   if (parts.size() > 1) out.reserve(h.vertex_count, h.face_count, h.corner_count);
   for (size_t k = 0; k < parts.size(); ++k) TSM_RETURN_IF_ERROR(append_part(h, parts[k], out, k == 0));
   if (const Section* md = find_section(sections, kSectionMetadata)) TSM_RETURN_IF_ERROR(read_metadata(md->data, out.metadata));
+  const Section* ex = find_section(sections, kSectionExceptions);
+  if (ex && (h.flags & kHeaderExactGrid)) TSM_RETURN_IF_ERROR(apply_exceptions(ex->data, out.positions));
+  if (const Section* order = find_section(sections, kSectionOrder)) TSM_RETURN_IF_ERROR(decode_order(order->data, out));
   return apply_refinements(h, sections, out, options);
 }
 
@@ -482,7 +488,7 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   info.level = h.level;
   info.segment_count = h.segment_count;
   for (int a = 0; a < 3; ++a) info.bbox_min[a] = h.origin[a];
-  info.step = grid_step(h);
+  info.step = (h.flags & kHeaderExactGrid) ? h.exact_step : grid_step(h);
   info.file_bytes = bytes.size();
   for (const Section& s : sections) {
     SectionInfo si;
@@ -550,6 +556,8 @@ struct StreamDecoder::Impl {
   Header h;
   SectionRules rules;
   std::vector<Section> whole;  // a one-segment file's sections, until the end marker
+  Section order;               // the order section (id 0: none), applied at the end
+  Section exceptions;          // the exceptions section (id 0: none), applied at the end
   Mesh mesh;
   uint32_t done = 0;
   uint64_t faces = 0, corners = 0;
@@ -591,14 +599,16 @@ struct StreamDecoder::Impl {
       TSM_RETURN_IF_ERROR(collect_parts(h, whole, streams, parts));
       TSM_RETURN_IF_ERROR(part_done(parts[0], streams[0]));
       whole.clear();
-      return Status::Ok();
+    } else {
+      if (done != h.segment_count)
+        return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
+                       std::to_string(done));
+      if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
+        return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
     }
-    if (done != h.segment_count)
-      return corrupt("the header announces " + std::to_string(h.segment_count) + " segments, the file holds " +
-                     std::to_string(done));
-    if (mesh.vertex_count() != h.vertex_count || faces != h.face_count || corners != h.corner_count)
-      return corrupt("the segments' vertex, face or corner counts do not add up to the header's");
-    return Status::Ok();
+    // A lossless file's exact coordinates and a keep-order file's order, once the mesh is whole.
+    if (exceptions.id == kSectionExceptions && (h.flags & kHeaderExactGrid)) TSM_RETURN_IF_ERROR(apply_exceptions(exceptions.data, mesh.positions));
+    return order.id == kSectionOrder ? decode_order(order.data, mesh) : Status::Ok();
   }
 
   Status end() {
@@ -650,6 +660,10 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(refinement(s));
       else if (s.id == kSectionLoose && batches > 0)
         TSM_RETURN_IF_ERROR(decode_loose(s.data, level, BatchLimits{options.max_vertices, options.max_faces}));
+      else if (s.id == kSectionOrder)
+        order = std::move(s);
+      else if (s.id == kSectionExceptions)
+        exceptions = std::move(s);
       else if (h.segment_count == 1)
         whole.push_back(std::move(s));
     }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 
@@ -15,7 +16,9 @@
 #include "codec_shared.hpp"
 #include "connectivity.hpp"
 #include "container.hpp"
+#include "exact_grid.hpp"
 #include "geometry_predict.hpp"
+#include "order_coding.hpp"
 #include "parallel.hpp"
 #include "progressive_encode.hpp"
 #include "range_coder.hpp"
@@ -47,6 +50,7 @@ struct EncodedPart {
   Mesh faces;                       // as the decoder gives them
   std::vector<uint8_t> ref_out;     // per output vertex: a reference
   std::vector<uint32_t> q;          // own vertices' grid indices
+  std::vector<uint32_t> vertex_from;  // welded: output vertex id -> input vertex id (else `order`)
   Status status;
 };
 
@@ -616,7 +620,7 @@ std::vector<uint32_t> canonical_part_order(const Mesh& mesh, const std::vector<u
 // references, which need the final ids of the segments before.
 Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
                        const std::vector<std::vector<uint32_t>>& segments, const std::vector<AttributeHeader>& headers,
-                       const EncodeOptions& options, ContainerWriter& cw) {
+                       const EncodeOptions& options, ContainerWriter& cw, std::vector<uint32_t>& vertex_from) {
   const size_t S = segments.size();
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint32_t> owner(V, kNone);
@@ -714,6 +718,8 @@ Status encode_segments(const Mesh& mesh, const std::vector<uint32_t>& qin,
     cw.add_section(kSectionSegment, write_segment(sp), 0);
     p = EncodedPart();
   }
+  vertex_from.assign(V, kNone);
+  for (uint32_t x = 0; x < V; ++x) vertex_from[final_id[x]] = x;
   return Status::Ok();
 }
 
@@ -910,26 +916,61 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   bw.bytes(split);
   bw.u8(point_order ? 1 : 0);
   out.attributes = head + best.attributes;
+  out.vertex_from.assign(V, kNone);
+  for (size_t w = 0; w < walk_out.size(); ++w) out.vertex_from[walk_out[w]] = walk_input[w];
   welded = true;
   return Status::Ok();
 }
 
-}  // namespace
+// FORMAT.md §5.1: a lossless file's grid, chosen for the mesh, with its
+// bits in place of the options' quantization bits.
+bool attributes_finite(const Mesh& mesh) {
+  for (const Attribute& a : mesh.attributes)
+    for (float x : a.values)
+      if (!std::isfinite(x)) return false;
+  return true;
+}
 
-Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
+BoundingBox finite_box(const Mesh& mesh) {
+  BoundingBox box;
+  bool any[3] = {false, false, false};
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const float x = mesh.positions[i];
+    const size_t a = i % 3;
+    if (!std::isfinite(x)) continue;
+    box.min[a] = any[a] ? std::min(box.min[a], x) : x;
+    box.max[a] = any[a] ? std::max(box.max[a], x) : x;
+    any[a] = true;
+  }
+  return box;
+}
+
+// The file's sections without the end marker (`cw`), per output vertex its
+// input id (`vertex_from`), and for a lossless file its grid (`exact`).
+Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::optional<ContainerWriter>& cw_out,
+                       std::vector<uint32_t>& vertex_from, ExactGrid& exact) {
+  EncodeOptions options = options_in;
+  if (options.lossless) {
+    exact = choose_exact_grid(mesh);
+    options.quantization_bits = exact.bits;
+  }
   std::string why;
   if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "mesh is invalid: " + why);
-  if (options.progressive && options.quantization_bits >= 1 && options.quantization_bits <= 30 && mesh.all_finite())
-    return encode_progressive(mesh, options, out);
   if (options.quantization_bits < 1 || options.quantization_bits > 30)
     return Status(ErrorCode::invalid_argument,
                   "quantization bits must be 1..30, got " + std::to_string(options.quantization_bits));
   if (options.level < 0 || options.level > 9)
     return Status(ErrorCode::invalid_argument, "level must be 0..9, got " + std::to_string(options.level));
-  if (!mesh.all_finite())
+  if (!mesh.all_finite() && !(options.lossless && options.allow_nonfinite && attributes_finite(mesh)))
     return Status(ErrorCode::invalid_argument,
-                  "mesh has NaN or infinite coordinates, which no quantization grid can hold; fix or drop those "
-                  "vertices first");
+                  options.lossless && !attributes_finite(mesh)
+                      ? "mesh has NaN or infinite attribute values, which no quantization grid can hold; fix or drop "
+                        "them first"
+                  : options.lossless
+                      ? "mesh has NaN or infinite coordinates; pass --allow-nonfinite (EncodeOptions::allow_nonfinite) "
+                        "to keep them exactly, or fix or drop those vertices"
+                      : "mesh has NaN or infinite coordinates, which no quantization grid can hold; encode with "
+                        "--lossless --allow-nonfinite to keep them, or fix or drop those vertices first");
 
   Header h;
   h.version = kFormatVersion;
@@ -938,7 +979,7 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   h.corner_count = mesh.corner_count();
   h.quantization_bits = static_cast<uint8_t>(options.quantization_bits);
   h.level = static_cast<uint8_t>(options.level);
-  BoundingBox box = bounding_box(mesh);
+  BoundingBox box = options.lossless ? finite_box(mesh) : bounding_box(mesh);
   for (int a = 0; a < 3; ++a) h.origin[a] = box.min[a];
   h.extent = box.largest_extent();
   if (!std::isfinite(h.extent))
@@ -953,6 +994,12 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   for (size_t i = 0; i < qin.size(); ++i) {
     int64_t x = grid.quantize(mesh.positions[i], static_cast<int>(i % 3));
     qin[i] = static_cast<uint32_t>(x < 0 ? 0 : x > qmax ? qmax : x);
+  }
+  if (options.lossless) {
+    h.flags = kHeaderExactGrid;
+    h.exact_step = exact.step;
+    for (int a = 0; a < 3; ++a) h.exact_base[a] = exact.base[a];
+    for (size_t i = 0; i < qin.size(); ++i) qin[i] = exact_index(exact, mesh.positions[i], static_cast<int>(i % 3));
   }
   for (const Attribute& a : mesh.attributes)
     if (a.type != AttributeType::f32)
@@ -971,7 +1018,7 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
   const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());
-  ContainerWriter cw(h);
+  ContainerWriter& cw = cw_out.emplace(h);
   // Metadata first, so that a streaming client has it before any geometry.
   if (!mesh.metadata.empty()) {
     const std::string md = write_metadata(mesh.metadata);
@@ -984,10 +1031,85 @@ Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out) 
     if (!welded) TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
     MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
     cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
+    vertex_from = welded ? std::move(p.vertex_from) : std::move(p.order);
   } else {
-    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw));
+    TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, vertex_from));
   }
-  out = cw.finish();
+  return Status::Ok();
+}
+
+// EncodeMapping of a file (`bytes`, without an order section) decoded as
+// `decoded`: the faces on input ids matched to the input's faces.
+Status file_mapping(const Mesh& mesh, const Mesh& decoded, std::vector<uint32_t> vertex_from, EncodeMapping& m) {
+  if (vertex_from.size() != mesh.vertex_count() || decoded.vertex_count() != mesh.vertex_count())
+    return Status(ErrorCode::internal, "the decoded vertices do not map to the input's");
+  Mesh on_input;
+  on_input.face_offsets = decoded.face_offsets;
+  on_input.indices.reserve(decoded.indices.size());
+  for (uint32_t x : decoded.indices) on_input.indices.push_back(vertex_from[x]);
+  std::vector<uint32_t> face, shift;
+  if (!match_faces(on_input, mesh, face, shift))
+    return Status(ErrorCode::internal, "the decoded faces do not match the input's");
+  m.vertex_from = std::move(vertex_from);
+  m.face_from = std::move(face);
+  m.first_corner = std::move(shift);
+  return Status::Ok();
+}
+
+void identity_mapping(const Mesh& mesh, EncodeMapping& m) {
+  m.vertex_from.resize(mesh.vertex_count());
+  std::iota(m.vertex_from.begin(), m.vertex_from.end(), 0u);
+  m.face_from.resize(mesh.face_count());
+  std::iota(m.face_from.begin(), m.face_from.end(), 0u);
+  m.first_corner.assign(mesh.face_count(), 0);
+}
+
+}  // namespace
+
+Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out, EncodeMapping* mapping) {
+  if (options.progressive) {
+    if (options.keep_order || options.lossless || mapping)
+      return Status(ErrorCode::invalid_argument,
+                    "a progressive file keeps neither the input order nor exact coordinates, and has no vertex "
+                    "mapping yet: drop the progressive option or keep_order / lossless / the mapping");
+    std::string why;
+    if (!mesh.valid(&why)) return Status(ErrorCode::invalid_argument, "mesh is invalid: " + why);
+    if (options.quantization_bits >= 1 && options.quantization_bits <= 30 && mesh.all_finite())
+      return encode_progressive(mesh, options, out);
+  }
+  std::optional<ContainerWriter> cw;
+  std::vector<uint32_t> vertex_from;
+  ExactGrid exact;
+  TSM_RETURN_IF_ERROR(encode_sections(mesh, options, cw, vertex_from, exact));
+  if (options.lossless) {
+    // The coordinates in decoded order, for the exceptions (FORMAT.md §5.1).
+    std::vector<float> decoded_order(mesh.positions.size());
+    for (size_t v = 0; v < vertex_from.size(); ++v)
+      for (int a = 0; a < 3; ++a) decoded_order[3 * v + a] = mesh.positions[3 * size_t{vertex_from[v]} + a];
+    const std::string ex = encode_exceptions(exact, decoded_order);
+    if (ex.size() > 1) cw->add_section(kSectionExceptions, ex, 19);
+  }
+  if (!mapping && !options.keep_order) {
+    out = cw->finish();
+    return Status::Ok();
+  }
+  // The mapping follows the decoder's faces: decode the file as it stands.
+  ContainerWriter plain = *cw;
+  std::string bytes = plain.finish();
+  Mesh decoded;
+  DecodeOptions dopt;
+  dopt.threads = options.threads;
+  TSM_RETURN_IF_ERROR(decode(bytes, decoded, dopt));
+  EncodeMapping m;
+  TSM_RETURN_IF_ERROR(file_mapping(mesh, decoded, std::move(vertex_from), m));
+  if (!options.keep_order) {
+    out = std::move(bytes);
+    *mapping = std::move(m);
+    return Status::Ok();
+  }
+  cw->add_section(kSectionOrder, encode_order(decoded, m.vertex_from, m.face_from, m.first_corner), 0);
+  out = cw->finish();
+  if (mapping) identity_mapping(mesh, *mapping);
   return Status::Ok();
 }
 

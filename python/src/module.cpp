@@ -150,8 +150,12 @@ std::string_view view_of(const py::buffer_info& b) {
   return std::string_view(static_cast<const char*>(b.ptr), size_t(b.size * b.itemsize));
 }
 
-tsm::EncodeOptions encode_options(int quantization_bits, int level, uint32_t segment_faces, int threads) {
+tsm::EncodeOptions encode_options(int quantization_bits, int level, uint32_t segment_faces, int threads,
+                                  bool keep_order, bool lossless, bool allow_nonfinite) {
   tsm::EncodeOptions o;
+  o.keep_order = keep_order;
+  o.lossless = lossless;
+  o.allow_nonfinite = allow_nonfinite;
   o.quantization_bits = quantization_bits;
   o.level = level;
   o.segment_faces = segment_faces;
@@ -211,27 +215,33 @@ PYBIND11_MODULE(_tsmcodec, m) {
                                return d;
                              })
       .def("__repr__", [](const tsm::Mesh& mm) {
-        return "<tsmcodec.Mesh " + std::to_string(mm.vertex_count()) + " vertices, " +
-               std::to_string(mm.face_count()) + " faces, " + std::to_string(mm.attributes.size()) + " attributes>";
+        return "<tsmcodec.Mesh " + std::to_string(mm.vertex_count()) + " vertices, " + std::to_string(mm.face_count()) +
+               " faces, " + std::to_string(mm.attributes.size()) + " attributes>";
       });
 
   m.def(
       "encode",
-      [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads) {
+      [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads, bool keep_order,
+         bool lossless, bool allow_nonfinite) {
         std::string out;
         {
           py::gil_scoped_release release;
-          check(tsm::encode(mesh, encode_options(quantization_bits, level, segment_faces, threads), out));
+          check(tsm::encode(
+              mesh,
+              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
+              out));
         }
         return py::bytes(out);
       },
       py::arg("mesh"), py::kw_only(), py::arg("quantization_bits") = tsm::kDefaultQuantizationBits,
       py::arg("level") = tsm::kDefaultLevel, py::arg("segment_faces") = 0, py::arg("threads") = 0,
-      "Encodes a Mesh; returns the .tsm bytes");
+      py::arg("keep_order") = false, py::arg("lossless") = false, py::arg("allow_nonfinite") = false,
+      "Encodes a Mesh; returns the .tsm bytes (keep_order: decoded in the input's order; lossless: positions bit "
+      "for bit, with allow_nonfinite NaN and infinities too)");
   m.def(
       "encode",
       [](const py::handle& positions, const py::handle& faces, const py::handle& attributes, int quantization_bits,
-         int level, uint32_t segment_faces, int threads) {
+         int level, uint32_t segment_faces, int threads, bool keep_order, bool lossless, bool allow_nonfinite) {
         tsm::Mesh mesh = make_mesh(positions, faces, py::none());
         if (!attributes.is_none()) {
           for (auto item : py::reinterpret_borrow<py::dict>(attributes)) {
@@ -243,13 +253,17 @@ PYBIND11_MODULE(_tsmcodec, m) {
         std::string out;
         {
           py::gil_scoped_release release;
-          check(tsm::encode(mesh, encode_options(quantization_bits, level, segment_faces, threads), out));
+          check(tsm::encode(
+              mesh,
+              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
+              out));
         }
         return py::bytes(out);
       },
       py::arg("positions"), py::arg("faces"), py::arg("attributes") = py::none(), py::kw_only(),
       py::arg("quantization_bits") = tsm::kDefaultQuantizationBits, py::arg("level") = tsm::kDefaultLevel,
-      py::arg("segment_faces") = 0, py::arg("threads") = 0,
+      py::arg("segment_faces") = 0, py::arg("threads") = 0, py::arg("keep_order") = false, py::arg("lossless") = false,
+      py::arg("allow_nonfinite") = false,
       "Encodes positions (N,3) and faces (M,k), with optional per-vertex attributes {name: (N,c) array} "
       "('normal', 'color', 'texcoord' by name, others generic)");
 

@@ -248,3 +248,20 @@ def test_simplify_within_the_bound_and_distance():
         tsmcodec.simplify(mesh)
     with pytest.raises(ValueError):
         tsmcodec.simplify(mesh, max_error=0.1, max_error_percent=1.0)
+
+
+def test_keep_order_and_lossless_round_trip():
+    rng = np.random.default_rng(41)
+    positions = rng.standard_normal((60, 3)).astype(np.float32)
+    positions[3, 1] = np.float32(-0.0)
+    positions[7, 2] = np.float32(1e-40)  # a denormal
+    faces = rng.permutation(np.array([[i, (i + 1) % 60, (i + 7) % 60] for i in range(60)], dtype=np.uint32))
+    data = tsmcodec.encode(positions, faces, keep_order=True, lossless=True)
+    mesh = tsmcodec.decode(data)
+    assert np.asarray(mesh.positions).tobytes() == positions.tobytes()
+    assert np.array_equal(np.asarray(mesh.faces), faces)
+    positions[5, 0] = np.nan
+    with pytest.raises(Exception, match="allow-nonfinite"):
+        tsmcodec.encode(positions, faces, lossless=True)
+    back = tsmcodec.decode(tsmcodec.encode(positions, faces, keep_order=True, lossless=True, allow_nonfinite=True))
+    assert np.asarray(back.positions).tobytes() == positions.tobytes()

@@ -49,6 +49,9 @@ typedef struct tsm_encode_options {
   int texcoord_bits;
   int color_bits;
   int generic_bits;
+  int keep_order;      /* nonzero: the decoded mesh keeps the input's vertex, face and corner order */
+  int lossless;        /* nonzero: every float32 coordinate comes back bit for bit (quantization_bits unused) */
+  int allow_nonfinite; /* with lossless, nonzero: NaN and infinite coordinates are kept (else refused) */
 } tsm_encode_options;
 
 /* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
@@ -65,6 +68,14 @@ int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t*
  * caller frees with tsm_free. */
 int tsm_encode(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size, char* err,
                size_t err_size);
+
+/* tsm_encode, also giving where the decoded mesh's vertices and faces come
+ * from in the input (tsm::EncodeMapping): *vertex_from (vertex_count
+ * entries), *face_from and *first_corner (face_count entries each) are
+ * malloc'ed arrays the caller frees with tsm_free. */
+int tsm_encode_mapped(const tsm_mesh* mesh, const tsm_encode_options* options, uint8_t** out, size_t* out_size,
+                      uint32_t** vertex_from, uint32_t** face_from, uint32_t** first_corner, char* err,
+                      size_t err_size);
 
 /* Streaming decode: feed bytes as they arrive; each segment is decoded as
  * soon as its bytes are all in.

@@ -37,8 +37,27 @@ struct EncodeOptions {
   // A progressive file (FORMAT.md §4.8): a coarse base mesh, then batches of
   // vertex splits, so that any prefix decodes to a level of detail of the
   // whole shape and the full file to the input. Positions and faces only
-  // (a mesh with attributes is refused).
+  // (a mesh with attributes is refused); not with keep_order or lossless.
   bool progressive = false;
+  // The decoded mesh keeps the input's vertex order, face order and each
+  // face's first corner (an order section codes the permutation).
+  bool keep_order = false;
+  // Every float32 coordinate comes back bit for bit: positions are coded on
+  // a grid found for the mesh (a decimal or binary spacing that holds most
+  // coordinates exactly), the others stored as they are;
+  // quantization_bits is not used.
+  bool lossless = false;
+  // With lossless: NaN and infinite coordinates are kept (else refused).
+  bool allow_nonfinite = false;
+};
+
+// Where the decoded mesh's vertices and faces come from in the input (the
+// decoder's order is its own unless EncodeOptions::keep_order): decoded
+// vertex v is input vertex vertex_from[v]; decoded face f is input face
+// face_from[f], its corner k the input face's corner (first_corner[f] + k)
+// mod n. Covers every vertex (on no face, welded or split) and face.
+struct EncodeMapping {
+  std::vector<uint32_t> vertex_from, face_from, first_corner;
 };
 
 struct DecodeOptions {
@@ -52,7 +71,8 @@ struct DecodeOptions {
   int threads = 0;
 };
 
-Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out);
+// `mapping`, when given, is filled (with keep_order: the identity).
+Status encode(const Mesh& mesh, const EncodeOptions& options, std::string& out, EncodeMapping* mapping = nullptr);
 Status decode(std::string_view bytes, Mesh& out, const DecodeOptions& options = {});
 
 // Decoding while the bytes arrive: feed() them in chunks of any size; each
