@@ -1943,6 +1943,8 @@ class AttrModels:
         self.import_id = SIntModel(4)
         self.recent_hit = [UIntModel(2), UIntModel(2)]   # [the previous vertex's value was a hit]
         self.recent_index = UIntModel(2)
+        self.sibling_hit = [[UIntModel(2), UIntModel(2)] for _ in range(2)]   # [previous was a hit][> 1 value]
+        self.sibling_index = UIntModel(2)
         self.last_zero = [1, 1, 1, 1]
         self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
@@ -2234,6 +2236,11 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             if h.domain != 0 and not h.per_vertex:
                 reject('attributes: %r names recent values but is not coded per vertex' % h.name)
             pr &= ~0x20
+        h.siblings = pr & 0x40 != 0                          # §8.12: siblings' values (vertex values only)
+        if h.siblings:
+            if h.domain != 0 and not h.per_vertex:
+                reject("attributes: %r names its siblings' values but is not coded per vertex" % h.name)
+            pr &= ~0x40
         if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
@@ -2263,7 +2270,40 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             indices = [rank[c] for f in faces for c in f]
         if h.domain == 0 or h.per_vertex:                    # vertex: own vertices in output order
             recent, hit_before = [], 0
+            earlier, last_at, sibling_before = [NONE] * own, {}, 0
+            for r in range(own):                             # the previous own vertex at the same grid position
+                key = tuple(q[r])
+                earlier[r] = last_at.get(key, NONE)
+                last_at[key] = r
             for r in range(own):
+                if h.siblings and earlier[r] != NONE:        # one of the siblings' values
+                    distinct, s, seen = [], earlier[r], 0
+                    while s != NONE and seen < 32:
+                        if walk.values[s] not in distinct:
+                            distinct.append(walk.values[s])
+                        s, seen = earlier[s], seen + 1
+                    hit = m.sibling_hit[sibling_before][1 if len(distinct) > 1 else 0].decode(d)
+                    if hit > 1:
+                        reject('attributes: vertex values of %r out of range' % h.name)
+                    sibling_before = hit
+                    if hit == 1:
+                        j = m.sibling_index.decode(d) if len(distinct) > 1 else 0
+                        if j >= len(distinct):
+                            reject('attributes: vertex values of %r out of range' % h.name)
+                        x = list(distinct[j])
+                        walk.prev = x
+                        walk.values.append(x)
+                        if h.recent:
+                            if x in recent:
+                                recent.remove(x)
+                            recent.insert(0, list(x))
+                            del recent[64:]
+                        if pr == 2:
+                            for f, _ in around[own_vertex[r]]:
+                                fa = faces[f]
+                                if len(fa) >= 3 and all(rank[c] <= r for c in fa):
+                                    walk.update_sigma([walk.values[rank[c]] for c in fa])
+                        continue
                 if h.recent:                                 # a recent value, or decoded as usual
                     hit = m.recent_hit[hit_before].decode(d)
                     if hit > 1:

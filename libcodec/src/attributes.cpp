@@ -43,6 +43,13 @@ constexpr uint8_t kAttributeTableFlag = 0x08;
 // the prediction misses them).
 constexpr uint8_t kAttributeRecentFlag = 0x20;
 constexpr size_t kRecentValues = 64;
+// Predictor bit 6: a vertex value may name the value of an earlier vertex at
+// the same grid position (its point's wedges, FORMAT.md §8.12: a split
+// vertex of a welded mesh usually repeats the UV, colour or skin weights of
+// its point's other vertices where only the normal changes, and the normal
+// where only the UV does). Up to 32 such vertices, the latest first.
+constexpr uint8_t kAttributeSiblingFlag = 0x40;
+constexpr uint32_t kSiblingVertices = 32;
 
 // Predictor bit 4: a corner attribute coded as a vertex attribute, one value
 // per own vertex, each corner using its vertex's value (an OBJ/PLY export of
@@ -154,6 +161,8 @@ struct Models {
   SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
   UIntModel recent_hit[2];  // [the previous vertex's was one]: the value is one of the recent values
   UIntModel recent_index;   // which, most recent first
+  UIntModel sibling_hit[2][2];  // [the previous was a hit][more than one wedge value]: an earlier sibling's value
+  UIntModel sibling_index;      // which of the siblings' distinct values, latest first
 };
 
 // Residual coding of one value against a prediction; contexts: the
@@ -507,16 +516,30 @@ struct AttributeWalk {
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
   // With `recent` (predictor bit 5), a value may instead name one of the
   // last 64 distinct values (the encoder does when the prediction misses it).
-  bool vertices(int predictor, bool recent, std::vector<int32_t>& x) {
+  bool vertices(int predictor, bool recent, bool siblings, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
     int32_t prev[4] = {0, 0, 0, 0};
     int sigma = 1;
     std::vector<const int32_t*> uv;
     std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
-    uint32_t hit_before = 0;
+    uint32_t hit_before = 0, sibling_before = 0;
+    std::vector<uint32_t> earlier;  // per own rank: the previous own vertex at its grid position, or kNone
+    if (siblings) earlier_at_same_position(earlier);
     for (size_t v = 0; v < rank.size(); ++v) {
       const uint32_t r = rank[v];
       if (r == kNone) continue;
+      if (siblings && !earlier.empty() && earlier[r] != kNone) {
+        uint32_t hit = 0;
+        if (!sibling_value(earlier, r, sibling_before, x, hit)) return false;
+        sibling_before = hit;
+        if (hit) {
+          const int32_t* xv = &x[n * static_cast<size_t>(r)];
+          std::copy(xv, xv + n, prev);
+          if (recent) touch_recent(list, xv);
+          if (predictor == 2) update_sigma(v, r, sigma, uv, x);
+          continue;
+        }
+      }
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
       if (predictor == 1 && (*ghas)[r]) {
         pred[0] = (*gnormal)[2 * r];
@@ -550,23 +573,95 @@ struct AttributeWalk {
         return false;
       }
       std::copy(xv, xv + n, prev);
-      if (predictor == 2) {  // faces completed by this vertex give the chart's orientation
-        for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
-          const uint32_t f = around->face[j], k = faces.face_size(f);
-          const uint32_t* c = faces.face(f);
-          bool complete = k >= 3;
-          uv.clear();
-          for (uint32_t i = 0; i < k && complete; ++i) {
-            complete = rank[c[i]] <= r;
-            if (complete) uv.push_back(&x[2 * static_cast<size_t>(rank[c[i]])]);
-          }
-          if (!complete) continue;
-          const int o = uv_orientation(uv.data(), k);
-          if (o != 0) sigma = o;
-        }
-      }
+      if (predictor == 2) update_sigma(v, r, sigma, uv, x);
     }
     return true;
+  }
+  // Faces completed by vertex v (own rank r) give the chart's orientation.
+  void update_sigma(size_t v, uint32_t r, int& sigma, std::vector<const int32_t*>& uv,
+                    const std::vector<int32_t>& x) const {
+    for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f);
+      const uint32_t* c = faces.face(f);
+      bool complete = k >= 3;
+      uv.clear();
+      for (uint32_t i = 0; i < k && complete; ++i) {
+        complete = rank[c[i]] <= r;
+        if (complete) uv.push_back(&x[2 * static_cast<size_t>(rank[c[i]])]);
+      }
+      if (!complete) continue;
+      const int o = uv_orientation(uv.data(), k);
+      if (o != 0) sigma = o;
+    }
+  }
+  // Per own rank, the previous own rank with the same grid position (kNone:
+  // none); empty without positions.
+  void earlier_at_same_position(std::vector<uint32_t>& earlier) const {
+    earlier.clear();
+    if (!q || q->empty()) return;
+    const size_t own = q->size() / 3;
+    std::vector<uint32_t> by_q(own);
+    for (uint32_t r = 0; r < own; ++r) by_q[r] = r;
+    const uint32_t* p = q->data();
+    std::sort(by_q.begin(), by_q.end(), [p](uint32_t a, uint32_t b) {
+      for (int k = 0; k < 3; ++k)
+        if (p[3 * size_t{a} + k] != p[3 * size_t{b} + k]) return p[3 * size_t{a} + k] < p[3 * size_t{b} + k];
+      return a < b;
+    });
+    earlier.assign(own, kNone);
+    for (size_t i = 1; i < own; ++i)
+      if (std::equal(p + 3 * size_t{by_q[i]}, p + 3 * size_t{by_q[i]} + 3, p + 3 * size_t{by_q[i - 1]}))
+        earlier[by_q[i]] = by_q[i - 1];
+  }
+  // The siblings' step (predictor bit 6) for own rank r, which has an
+  // earlier vertex at its position: whether its value is one of the
+  // distinct values of the up to kSiblingVertices latest such vertices
+  // (latest first) and which. `hit` = 1 when it is (x[r] then holds it).
+  bool sibling_value(const std::vector<uint32_t>& earlier, uint32_t r, uint32_t before, std::vector<int32_t>& x,
+                     uint32_t& hit) {
+    const uint32_t n = int_components(h);
+    uint32_t distinct[kSiblingVertices];
+    uint32_t count = 0, seen = 0;
+    for (uint32_t s = earlier[r]; s != kNone && seen < kSiblingVertices; s = earlier[s], ++seen) {
+      const int32_t* xs = &x[n * static_cast<size_t>(s)];
+      bool dup = false;
+      for (uint32_t j = 0; j < count && !dup; ++j)
+        dup = std::equal(xs, xs + n, &x[n * static_cast<size_t>(distinct[j])]);
+      if (!dup) distinct[count++] = s;
+    }
+    uint32_t j = 0;
+    hit = 0;
+    if constexpr (Coder::kEncoder) {
+      const int32_t* xv = &x[n * static_cast<size_t>(r)];
+      for (j = 0; j < count; ++j)
+        if (std::equal(xv, xv + n, &x[n * static_cast<size_t>(distinct[j])])) break;
+      hit = j < count;
+      if (!hit) j = 0;
+    }
+    hit = io.uint(vc.m.sibling_hit[before][count > 1], hit);
+    if (hit > 1) return false;
+    if (!hit) return true;
+    if (count > 1) j = io.uint(vc.m.sibling_index, j);
+    if (j >= count) return false;
+    const int32_t* xs = &x[n * static_cast<size_t>(distinct[j])];
+    std::copy(xs, xs + n, &x[n * static_cast<size_t>(r)]);
+    return true;
+  }
+  // A value taken without the recent values' step moves to the front of
+  // their list as one coded with it would.
+  void touch_recent(std::vector<std::array<int32_t, 4>>& list, const int32_t* xv) const {
+    const uint32_t n = int_components(h);
+    std::array<int32_t, 4> v{};
+    std::copy(xv, xv + n, v.begin());
+    const size_t at = find_recent(list, xv, n);
+    if (at < list.size()) {
+      std::move_backward(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(at),
+                         list.begin() + static_cast<std::ptrdiff_t>(at) + 1);
+      list[0] = v;
+      return;
+    }
+    list.insert(list.begin(), v);
+    if (list.size() > kRecentValues) list.pop_back();
   }
   // One vertex value with the recent values: a hit (and which) or the value
   // coded against `pred`; then the value moves to the front of `list`.
@@ -942,6 +1037,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
+  bool siblings = false;  // the attribute being coded names its siblings' values (predictor bit 6)
   auto code = [&](Enc& enc, size_t i, int predictor, bool recent) {
     const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
@@ -953,7 +1049,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
         if (rank[v] != kNone) to_ints(h, &a.values[h.components * static_cast<size_t>(order[v])], &x[n * rank[v]]);
-      return walk.vertices(predictor, recent, x);
+      return walk.vertices(predictor, recent, siblings, x);
     }
     if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
@@ -1002,6 +1098,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     size_t best = SIZE_MAX;
     own_values = nullptr;
     bool recent = false;
+    siblings = h.domain == AttributeDomain::vertex;
     auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
       if (!code(trial, i, p, recent)) return false;
@@ -1025,6 +1122,10 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
       recent = with < best;
       best = std::min(best, with);
+      siblings = false;  // the siblings' values where they pay (predictor bit 6)
+      if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
+      siblings = with >= best;
+      best = std::min(best, with);
     }
     TableResiduals residuals;
     bool tables = false;
@@ -1043,7 +1144,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       }
     }
     w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
-                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0)));
+                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0) |
+                              (siblings ? kAttributeSiblingFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -1075,7 +1177,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
-  uint64_t per_vertex = 0, recent = 0;
+  uint64_t per_vertex = 0, recent = 0, siblings = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -1095,6 +1197,12 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
         return corrupt("'" + headers[i].name + "' names recent values but is not coded per vertex");
       recent |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeRecentFlag);
+    }
+    if (p & kAttributeSiblingFlag) {
+      if (headers[i].domain != AttributeDomain::vertex)
+        return corrupt("'" + headers[i].name + "' names its siblings' values but is not coded per vertex");
+      siblings |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributeSiblingFlag);
     }
     if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
@@ -1146,7 +1254,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     std::vector<int32_t> x;
     if (h.domain == AttributeDomain::vertex) {
       x.assign(n * static_cast<size_t>(own), 0);
-      if (!walk.vertices(predictor[i], recent >> i & 1, x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (!walk.vertices(predictor[i], recent >> i & 1, siblings >> i & 1, x))
+        return corrupt("vertex values of '" + h.name + "' out of range");
       if (per_vertex >> i & 1) {  // each corner uses its vertex's value
         a.indices.resize(faces.indices.size());
         for (size_t k = 0; k < faces.indices.size(); ++k) a.indices[k] = rank[faces.indices[k]];
