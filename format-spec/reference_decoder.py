@@ -2167,6 +2167,7 @@ def decode_value(d, m, walk, item, segmented=False):
     elif item[0] in ('corner', 'unused'):
         walk.alias.append(None)
     x = []
+    top = (1 << h.bits) - 1
     for c in range(h.ints()):
         if m.table is not None:                              # §8.12.1
             tables, bits, base = m.table
@@ -2174,10 +2175,24 @@ def decode_value(d, m, walk, item, segmented=False):
         else:
             r = m.res[cls][c][m.last_zero[c]].decode(d)
         v = pred[c] + r
-        if not h.in_range(v):
+        if h.quant == 2:                                     # octahedral: up to one square beyond an edge
+            if not -top <= v <= 2 * top:
+                reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
+        elif not h.in_range(v):
             reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
         x.append(v)
         m.last_zero[c] = 1 if r == 0 else 0
+    if h.quant == 2:                                         # folded back into the square
+        a, b = x
+        if a > top:
+            a, b = 2 * top - a, top - b
+        elif a < 0:
+            a, b = -a, top - b
+        if b > top:
+            a, b = top - a, 2 * top - b
+        elif b < 0:
+            a, b = top - a, -b
+        x = [a, b]
     walk.prev = x
     walk.values.append(x)
     return x

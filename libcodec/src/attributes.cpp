@@ -174,6 +174,7 @@ struct ValueCoder {
   Models m;
   int last_zero[4] = {1, 1, 1, 1};
   bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls = 0) {
+    if (h.quant == AttributeQuant::octahedral) return octahedral_value(h, pred, x, cls);
     const uint32_t n = int_components(h);
     for (uint32_t c = 0; c < n; ++c) {
       int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]),
@@ -184,6 +185,78 @@ struct ValueCoder {
       last_zero[c] = r == 0;
     }
     return true;
+  }
+  // An octahedral value (FORMAT.md §8.12, "Octahedral residuals"): the square
+  // continues across each edge as its mirror image (the edge u = m is glued
+  // to itself with v -> m - v), so pred + residual may lie up to one square
+  // beyond an edge and is folded back. A normal near the square's border (a
+  // CAD part's -z, the lower hemisphere's rim) then costs the small step
+  // across the fold, not the width of the square.
+  bool octahedral_value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls) {
+    const int64_t top = (int64_t{1} << h.bits) - 1;
+    int64_t want[2] = {0, 0};
+    if constexpr (Coder::kEncoder) octahedral_residual(top, pred, x, want);
+    int64_t v[2];
+    for (uint32_t c = 0; c < 2; ++c) {
+      const int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]), want[c]);
+      v[c] = static_cast<int64_t>(pred[c]) + r;
+      if (v[c] < -top || v[c] > 2 * top) return false;
+      last_zero[c] = r == 0;
+    }
+    octahedral_fold(top, v);
+    x[0] = static_cast<int32_t>(v[0]);
+    x[1] = static_cast<int32_t>(v[1]);
+    return true;
+  }
+  // Folds a point of [-m, 2m]^2 into the square [0, m]^2.
+  static void octahedral_fold(int64_t m, int64_t* v) {
+    if (v[0] > m) {
+      v[0] = 2 * m - v[0];
+      v[1] = m - v[1];
+    } else if (v[0] < 0) {
+      v[0] = -v[0];
+      v[1] = m - v[1];
+    }
+    if (v[1] > m) {
+      v[1] = 2 * m - v[1];
+      v[0] = m - v[0];
+    } else if (v[1] < 0) {
+      v[1] = -v[1];
+      v[0] = m - v[0];
+    }
+  }
+  // The encoder's residual: of the value's mirror images (up to two
+  // reflections across the square's edges) that fold back to it, the one
+  // nearest the prediction (the smallest larger component, then the
+  // smallest sum, then the first in the order tried).
+  static void octahedral_residual(int64_t m, const int32_t* pred, const int32_t* x, int64_t* out) {
+    // Across u = m, u = 0, v = m, v = 0.
+    auto reflect = [m](int e, int64_t* p) {
+      const int a = e < 2 ? 0 : 1;
+      p[a] = (e % 2 == 0 ? 2 * m : 0) - p[a];
+      p[1 - a] = m - p[1 - a];
+    };
+    out[0] = int64_t{x[0]} - pred[0];
+    out[1] = int64_t{x[1]} - pred[1];
+    auto cost = [](const int64_t* r) {
+      const int64_t a = r[0] < 0 ? -r[0] : r[0], b = r[1] < 0 ? -r[1] : r[1];
+      return std::make_pair(std::max(a, b), a + b);
+    };
+    for (int e1 = -1; e1 < 4; ++e1)
+      for (int e2 = -1; e2 < 4; ++e2) {
+        int64_t p[2] = {x[0], x[1]};
+        if (e1 >= 0) reflect(e1, p);
+        if (e2 >= 0) reflect(e2, p);
+        if (p[0] < -m || p[0] > 2 * m || p[1] < -m || p[1] > 2 * m) continue;
+        int64_t f[2] = {p[0], p[1]};
+        octahedral_fold(m, f);
+        if (f[0] != x[0] || f[1] != x[1]) continue;
+        const int64_t r[2] = {p[0] - pred[0], p[1] - pred[1]};
+        if (cost(r) < cost(out)) {
+          out[0] = r[0];
+          out[1] = r[1];
+        }
+      }
   }
 };
 
