@@ -2586,8 +2586,8 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
     ids), per walk vertex its output id and its point."""
     d = RangeDecoder(stream)
-    fresh = probs(4 * 3 * 6)                               # fresh[nb][before][closeness]
-    rank = [UIntModel() for _ in range(6)]
+    fresh = probs(4 * 3 * 6 * 2)                           # fresh[nb][before][closeness][4 or more candidates]
+    rank = [[UIntModel(), UIntModel()] for _ in range(6)]   # [best][4 or more candidates]
     copy = probs(4)                                         # copy[nb]
     copy_rank = UIntModel()
     orig = []                                               # per walk vertex: the one whose values it has
@@ -2631,7 +2631,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
                 cand = [cand[k] for k in order]
                 best = close[order[0]]
-                before = 1 if d.bit(fresh, (nb * 3 + before) * 6 + best) else 2
+                before = 1 if d.bit(fresh, ((nb * 3 + before) * 6 + best) * 2 + (1 if len(cand) >= 4 else 0)) else 2
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
@@ -2644,7 +2644,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     orig.append(o)
                     made[p].append(v[i])
                 else:
-                    r = rank[best].decode(d) if len(cand) > 1 else 0
+                    r = rank[best][1 if len(cand) >= 4 else 0].decode(d) if len(cand) > 1 else 0
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]
