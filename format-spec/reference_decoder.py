@@ -1900,10 +1900,22 @@ def attribute_value(h, ints):
     return out
 
 
-def geometry_normals(faces, rank, q, bits):
+def squared_distance(a, b):
+    """The squared length of b - a (grid indices), summed x, y, z in binary64."""
+    s = 0.0
+    for k in range(3):
+        d = float(b[k] - a[k])
+        s += d * d
+    return s
+
+
+def geometry_normals(faces, rank, q, bits, weights=0):
     """§8.12 "Geometry normals": per own rank the octahedral integers of the
     summed fan cross products, or None where the sum is zero. Sums in face order,
-    a face's fan summed first, then added to each of its corners."""
+    a face's fan summed first, then added to each of its corners times the
+    corner's weight (weights 0: 1, by area; 1: 1 / the vector's length, by face;
+    2: 1 / sqrt of the product of the corner's two squared edge lengths, by
+    angle)."""
     n = len(q)
     sx, sy, sz = [0.0] * n, [0.0] * n, [0.0] * n
     for f in faces:
@@ -1919,11 +1931,19 @@ def geometry_normals(faces, rank, q, bits):
             nx += a1 * b2 - a2 * b1
             ny += a2 * b0 - a0 * b2
             nz += a0 * b1 - a1 * b0
-        for c in f:
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        for i, c in enumerate(f):
+            w = 1.0
+            if weights == 1:
+                w = 1 / length if length > 0 else 0.0
+            elif weights == 2:
+                pi = q[rank[c]]
+                e = squared_distance(pi, q[rank[f[(i + 1) % k]]]) * squared_distance(pi, q[rank[f[(i - 1) % k]]])
+                w = 1 / math.sqrt(e) if e > 0 else 0.0
             r = rank[c]
-            sx[r] += nx
-            sy[r] += ny
-            sz[r] += nz
+            sx[r] += nx * w
+            sy[r] += ny * w
+            sz[r] += nz * w
     out = [None] * n
     for r in range(n):
         if sx[r] != 0 or sy[r] != 0 or sz[r] != 0:
@@ -2011,7 +2031,8 @@ class AttrWalk:
 
     def __init__(self, h, predictor, faces, rank, q, around):
         self.h, self.predictor, self.faces, self.rank, self.q = h, predictor, faces, rank, q
-        self.gnormal = geometry_normals(faces, rank, q, h.bits) if h.quant == 2 else None
+        weights = {3: 1, 4: 2}.get(predictor, 0)      # predictors 3 and 4: by face, by angle
+        self.gnormal = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else None
         self.around = around            # predictor 2: faces_around()
         self.sigma = 1                  # predictor 2: the texture orientation so far
         self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
@@ -2098,7 +2119,7 @@ def predict_value(walk, item):
     h = walk.h
     if item[0] == 'vertex':
         r, v = item[1], item[2]
-        if walk.predictor == 1 and walk.gnormal[r] is not None:
+        if walk.predictor in (1, 3, 4) and walk.gnormal[r] is not None:
             return list(walk.gnormal[r]) + walk.prev[2:], 0
         if walk.predictor == 2:
             rank, vals = walk.rank, walk.values
@@ -2201,7 +2222,7 @@ def decode_value(d, m, walk, item, segmented=False):
 def predictor_allowed(h, pr):
     if pr == 0:
         return True
-    if pr == 1:
+    if pr in (1, 3, 4):
         return h.domain == 0 and h.quant == 2
     if pr == 2:
         return h.domain != 1 and h.quant == 1 and h.components == 2

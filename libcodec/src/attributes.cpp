@@ -317,11 +317,28 @@ struct Dec {
   static constexpr bool kEncoder = false;
 };
 
-// Area-weighted normals of the own vertices from the faces whose corners
-// are all own (fans for polygons), as octahedral indices; has[r] = 0 where
-// the sum is zero.
+// How the faces around a vertex weigh in its geometry normal (predictors
+// 1, 3 and 4): by area; each face alike (its unit normal: what most
+// modelling tools write for smooth shading); by the corner's angle (the
+// face's vector over the lengths of the corner's two edges: its sine).
+enum class NormalWeights { area = 0, face = 1, angle = 2 };
+
+NormalWeights normal_weights(int predictor) {
+  return predictor == 3 ? NormalWeights::face : predictor == 4 ? NormalWeights::angle : NormalWeights::area;
+}
+
+// The squared length of b - a (grid positions).
+double squared_distance(const uint32_t* a, const uint32_t* b) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) s += (double(b[k]) - a[k]) * (double(b[k]) - a[k]);
+  return s;
+}
+
+// Normals of the own vertices from the faces whose corners are all own
+// (fans for polygons), weighted as `weights` says, as octahedral indices;
+// has[r] = 0 where the sum is zero.
 void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q,
-                      int bits, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
+                      int bits, NormalWeights weights, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
   const size_t n = q.size() / 3;
   std::vector<double> sum(3 * n, 0.0);
   for (size_t f = 0; f < faces.face_count(); ++f) {
@@ -341,11 +358,21 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
       ny += a[2] * b[0] - a[0] * b[2];
       nz += a[0] * b[1] - a[1] * b[0];
     }
+    const double len = std::sqrt((nx * nx + ny * ny) + nz * nz);
     for (uint32_t i = 0; i < k; ++i) {
+      double w = 1;
+      if (weights == NormalWeights::face) {
+        w = len > 0 ? 1 / len : 0;
+      } else if (weights == NormalWeights::angle) {
+        const uint32_t* pi = &q[3 * static_cast<size_t>(rank[c[i]])];
+        const double e = squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + 1) % k]])]) *
+                         squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + k - 1) % k]])]);
+        w = e > 0 ? 1 / std::sqrt(e) : 0;
+      }
       double* s = &sum[3 * static_cast<size_t>(rank[c[i]])];
-      s[0] += nx;
-      s[1] += ny;
-      s[2] += nz;
+      s[0] += nx * w;
+      s[1] += ny * w;
+      s[2] += nz * w;
     }
   }
   oct.assign(2 * n, 0);
@@ -614,7 +641,7 @@ struct AttributeWalk {
         }
       }
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
-      if (predictor == 1 && (*ghas)[r]) {
+      if ((predictor == 1 || predictor >= 3) && (*ghas)[r]) {
         pred[0] = (*gnormal)[2 * r];
         pred[1] = (*gnormal)[2 * r + 1];
       }
@@ -1028,11 +1055,12 @@ std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const Attribute
 namespace {
 
 // The predictors an attribute may use, as bits (1 << predictor): 0 previous
-// value; 1 geometry normal (vertex normals, octahedral); 2 texture placement
-// from the geometry (two-component grid values per vertex or corner).
+// value; 1, 3 and 4 geometry normal weighted by area, by face, by angle
+// (vertex normals, octahedral); 2 texture placement from the geometry
+// (two-component grid values per vertex or corner).
 unsigned predictors_for(const AttributeHeader& h) {
   unsigned p = 1;
-  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2;
+  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2 | 8 | 16;
   if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
   return p;
 }
@@ -1117,6 +1145,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     const uint32_t n = int_components(h);
     ValueCoder<Enc> vc{enc, {}};
     const bool oct = h.quant == AttributeQuant::octahedral;
+    if (oct) geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor), gnormal, ghas);
     AttributeWalk<Enc> walk{h, vc, enc, faces, rank, oct ? &gnormal : nullptr, oct ? &ghas : nullptr, in.q, &around};
     if (h.domain == AttributeDomain::vertex) {
       std::vector<int32_t> x(n * static_cast<size_t>(own));
@@ -1165,7 +1194,6 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   for (size_t i = 0; i < headers.size(); ++i) {
     const bool per_vertex = in.per_vertex >> i & 1;
     const AttributeHeader h = coded_header(headers[i], per_vertex);
-    if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
     const unsigned choices = predictors_for(h);
     int predictor = 0;
     size_t best = SIZE_MAX;
@@ -1178,7 +1206,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       size = trial.e.finish().size();
       return true;
     };
-    for (int p = 0; p < 3 && choices != 1; ++p) {
+    for (int p = 0; p < 5 && choices != 1; ++p) {
       size_t size = 0;
       if (!(choices >> p & 1)) continue;
       if (!adaptive_size(p, size)) return Status(ErrorCode::internal, "attributes: values out of range");
@@ -1277,7 +1305,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       siblings |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeSiblingFlag);
     }
-    if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
+    if (p > 4 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
   if (in.per_vertex) *in.per_vertex = per_vertex;
@@ -1314,7 +1342,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     const uint32_t n = int_components(h);
     std::vector<int32_t> gn;
     std::vector<uint8_t> gh;
-    if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gn, gh);
+    if (h.quant == AttributeQuant::octahedral)
+      geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor[i]), gn, gh);
     ValueCoder<Dec> vc{dec, {}};
     AttributeWalk<Dec> walk{h, vc, dec, faces, rank, h.quant == AttributeQuant::octahedral ? &gn : nullptr,
                             h.quant == AttributeQuant::octahedral ? &gh : nullptr, in.q, &around};
