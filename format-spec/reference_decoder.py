@@ -2222,8 +2222,10 @@ def decode_value(d, m, walk, item, segmented=False):
 def predictor_allowed(h, pr):
     if pr == 0:
         return True
-    if pr in (1, 3, 4):
+    if pr == 1:
         return h.domain == 0 and h.quant == 2
+    if pr in (3, 4):
+        return h.domain in (0, 2) and h.quant == 2
     if pr == 2:
         return h.domain != 1 and h.quant == 1 and h.components == 2
     return False

@@ -1056,11 +1056,13 @@ namespace {
 
 // The predictors an attribute may use, as bits (1 << predictor): 0 previous
 // value; 1, 3 and 4 geometry normal weighted by area, by face, by angle
-// (vertex normals, octahedral); 2 texture placement from the geometry
+// (octahedral vertex normals; 3 and 4 also corner normals, whose new values
+// predictor 0 predicts by area); 2 texture placement from the geometry
 // (two-component grid values per vertex or corner).
 unsigned predictors_for(const AttributeHeader& h) {
   unsigned p = 1;
   if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2 | 8 | 16;
+  if (h.domain == AttributeDomain::corner && h.quant == AttributeQuant::octahedral) p |= 8 | 16;
   if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
   return p;
 }
