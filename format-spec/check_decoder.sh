@@ -160,6 +160,36 @@ for f in Fox/Fox.gltf CesiumMilkTruck/CesiumMilkTruck.gltf; do
     "$tsm" decode "$work/${n}_src.tsm" -o "$work/$n.obj" -f --quiet
   corpus_case acheck "$n" "$work/$n.obj" 11 6
 done
+# the truck's OBJ with its v, vt and vn lists deduplicated, as exporters
+# write them: corner values shared across vertices (normals predicted by
+# face or angle, §8.12 predictors 3 and 4, in the corner domain)
+if [ -f "$work/CesiumMilkTruck_obj.obj" ]; then
+  python3 - "$work/CesiumMilkTruck_obj.obj" "$work/truck_dedup.obj" <<'PY'
+import sys
+lists, faces = {'v': [], 'vt': [], 'vn': []}, []
+for line in open(sys.argv[1]):
+    p = line.split()
+    if p and p[0] in lists:
+        lists[p[0]].append(' '.join(p[1:]))
+    elif p and p[0] == 'f':
+        faces.append(p[1:])
+index, kept = {}, {}
+for k, values in lists.items():
+    first = {}
+    index[k] = [first.setdefault(v, len(first)) for v in values]
+    kept[k] = list(first)
+with open(sys.argv[2], 'w') as out:
+    for k in ('v', 'vt', 'vn'):
+        out.writelines('%s %s\n' % (k, v) for v in kept[k])
+    for f in faces:
+        corners = []
+        for c in f:
+            t = c.split('/')
+            corners.append('/'.join(str(index[k][int(x) - 1] + 1) for k, x in zip(('v', 'vt', 'vn'), t)))
+        out.write('f %s\n' % ' '.join(corners))
+PY
+  acheck truck_dedup_obj "$work/truck_dedup.obj" 11 6
+fi
 # predictor 2 (texture placement): vertex and corner domain, whole and segmented
 acheck uv_vertex "$work/uv_vertex.ply" 12 6
 acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150

@@ -1913,10 +1913,22 @@ def attribute_value(h, ints):
     return out
 
 
-def geometry_normals(faces, rank, q, bits):
+def squared_distance(a, b):
+    """The squared length of b - a (grid indices), summed x, y, z in binary64."""
+    s = 0.0
+    for k in range(3):
+        d = float(b[k] - a[k])
+        s += d * d
+    return s
+
+
+def geometry_normals(faces, rank, q, bits, weights=0):
     """§8.12 "Geometry normals": per own rank the octahedral integers of the
     summed fan cross products, or None where the sum is zero. Sums in face order,
-    a face's fan summed first, then added to each of its corners."""
+    a face's fan summed first, then added to each of its corners times the
+    corner's weight (weights 0: 1, by area; 1: 1 / the vector's length, by face;
+    2: 1 / sqrt of the product of the corner's two squared edge lengths, by
+    angle)."""
     n = len(q)
     sx, sy, sz = [0.0] * n, [0.0] * n, [0.0] * n
     for f in faces:
@@ -1932,11 +1944,19 @@ def geometry_normals(faces, rank, q, bits):
             nx += a1 * b2 - a2 * b1
             ny += a2 * b0 - a0 * b2
             nz += a0 * b1 - a1 * b0
-        for c in f:
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        for i, c in enumerate(f):
+            w = 1.0
+            if weights == 1:
+                w = 1 / length if length > 0 else 0.0
+            elif weights == 2:
+                pi = q[rank[c]]
+                e = squared_distance(pi, q[rank[f[(i + 1) % k]]]) * squared_distance(pi, q[rank[f[(i - 1) % k]]])
+                w = 1 / math.sqrt(e) if e > 0 else 0.0
             r = rank[c]
-            sx[r] += nx
-            sy[r] += ny
-            sz[r] += nz
+            sx[r] += nx * w
+            sy[r] += ny * w
+            sz[r] += nz * w
     out = [None] * n
     for r in range(n):
         if sx[r] != 0 or sy[r] != 0 or sz[r] != 0:
@@ -1956,6 +1976,8 @@ class AttrModels:
         self.import_id = SIntModel(4)
         self.recent_hit = [UIntModel(2), UIntModel(2)]   # [the previous vertex's value was a hit]
         self.recent_index = UIntModel(2)
+        self.sibling_hit = [[UIntModel(2), UIntModel(2)] for _ in range(2)]   # [previous was a hit][> 1 value]
+        self.sibling_index = UIntModel(2)
         self.last_zero = [1, 1, 1, 1]
         self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
@@ -2022,7 +2044,8 @@ class AttrWalk:
 
     def __init__(self, h, predictor, faces, rank, q, around):
         self.h, self.predictor, self.faces, self.rank, self.q = h, predictor, faces, rank, q
-        self.gnormal = geometry_normals(faces, rank, q, h.bits) if h.quant == 2 else None
+        weights = {3: 1, 4: 2}.get(predictor, 0)      # predictors 3 and 4: by face, by angle
+        self.gnormal = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else None
         self.around = around            # predictor 2: faces_around()
         self.sigma = 1                  # predictor 2: the texture orientation so far
         self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
@@ -2109,7 +2132,7 @@ def predict_value(walk, item):
     h = walk.h
     if item[0] == 'vertex':
         r, v = item[1], item[2]
-        if walk.predictor == 1 and walk.gnormal[r] is not None:
+        if walk.predictor in (1, 3, 4) and walk.gnormal[r] is not None:
             return list(walk.gnormal[r]) + walk.prev[2:], 0
         if walk.predictor == 2:
             rank, vals = walk.rank, walk.values
@@ -2178,6 +2201,7 @@ def decode_value(d, m, walk, item, segmented=False):
     elif item[0] in ('corner', 'unused'):
         walk.alias.append(None)
     x = []
+    top = (1 << h.bits) - 1
     for c in range(h.ints()):
         if m.table is not None:                              # §8.12.1
             tables, bits, base = m.table
@@ -2185,10 +2209,24 @@ def decode_value(d, m, walk, item, segmented=False):
         else:
             r = m.res[cls][c][m.last_zero[c]].decode(d)
         v = pred[c] + r
-        if not h.in_range(v):
+        if h.quant == 2:                                     # octahedral: up to one square beyond an edge
+            if not -top <= v <= 2 * top:
+                reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
+        elif not h.in_range(v):
             reject('attributes: %s values of %r out of range' % (DOMAIN_NAMES[h.domain], h.name))
         x.append(v)
         m.last_zero[c] = 1 if r == 0 else 0
+    if h.quant == 2:                                         # folded back into the square
+        a, b = x
+        if a > top:
+            a, b = 2 * top - a, top - b
+        elif a < 0:
+            a, b = -a, top - b
+        if b > top:
+            a, b = top - a, 2 * top - b
+        elif b < 0:
+            a, b = top - a, -b
+        x = [a, b]
     walk.prev = x
     walk.values.append(x)
     return x
@@ -2199,6 +2237,8 @@ def predictor_allowed(h, pr):
         return True
     if pr == 1:
         return h.domain == 0 and h.quant == 2
+    if pr in (3, 4):
+        return h.domain in (0, 2) and h.quant == 2
     if pr == 2:
         return h.domain != 1 and h.quant == 1 and h.components == 2
     return False
@@ -2247,6 +2287,11 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             if h.domain != 0 and not h.per_vertex:
                 reject('attributes: %r names recent values but is not coded per vertex' % h.name)
             pr &= ~0x20
+        h.siblings = pr & 0x40 != 0                          # §8.12: siblings' values (vertex values only)
+        if h.siblings:
+            if h.domain != 0 and not h.per_vertex:
+                reject("attributes: %r names its siblings' values but is not coded per vertex" % h.name)
+            pr &= ~0x40
         if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
@@ -2276,7 +2321,40 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             indices = [rank[c] for f in faces for c in f]
         if h.domain == 0 or h.per_vertex:                    # vertex: own vertices in output order
             recent, hit_before = [], 0
+            earlier, last_at, sibling_before = [NONE] * own, {}, 0
+            for r in range(own):                             # the previous own vertex at the same grid position
+                key = tuple(q[r])
+                earlier[r] = last_at.get(key, NONE)
+                last_at[key] = r
             for r in range(own):
+                if h.siblings and earlier[r] != NONE:        # one of the siblings' values
+                    distinct, s, seen = [], earlier[r], 0
+                    while s != NONE and seen < 32:
+                        if walk.values[s] not in distinct:
+                            distinct.append(walk.values[s])
+                        s, seen = earlier[s], seen + 1
+                    hit = m.sibling_hit[sibling_before][1 if len(distinct) > 1 else 0].decode(d)
+                    if hit > 1:
+                        reject('attributes: vertex values of %r out of range' % h.name)
+                    sibling_before = hit
+                    if hit == 1:
+                        j = m.sibling_index.decode(d) if len(distinct) > 1 else 0
+                        if j >= len(distinct):
+                            reject('attributes: vertex values of %r out of range' % h.name)
+                        x = list(distinct[j])
+                        walk.prev = x
+                        walk.values.append(x)
+                        if h.recent:
+                            if x in recent:
+                                recent.remove(x)
+                            recent.insert(0, list(x))
+                            del recent[64:]
+                        if pr == 2:
+                            for f, _ in around[own_vertex[r]]:
+                                fa = faces[f]
+                                if len(fa) >= 3 and all(rank[c] <= r for c in fa):
+                                    walk.update_sigma([walk.values[rank[c]] for c in fa])
+                        continue
                 if h.recent:                                 # a recent value, or decoded as usual
                     hit = m.recent_hit[hit_before].decode(d)
                     if hit > 1:
@@ -2544,8 +2622,8 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
     ids), per walk vertex its output id and its point."""
     d = RangeDecoder(stream)
-    fresh = probs(4 * 3 * 6)                               # fresh[nb][before][closeness]
-    rank = [UIntModel() for _ in range(6)]
+    fresh = probs(4 * 3 * 6 * 2)                           # fresh[nb][before][closeness][4 or more candidates]
+    rank = [[UIntModel(), UIntModel()] for _ in range(6)]   # [best][4 or more candidates]
     copy = probs(4)                                         # copy[nb]
     copy_rank = UIntModel()
     orig = []                                               # per walk vertex: the one whose values it has
@@ -2589,7 +2667,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
                 cand = [cand[k] for k in order]
                 best = close[order[0]]
-                before = 1 if d.bit(fresh, (nb * 3 + before) * 6 + best) else 2
+                before = 1 if d.bit(fresh, ((nb * 3 + before) * 6 + best) * 2 + (1 if len(cand) >= 4 else 0)) else 2
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
@@ -2602,7 +2680,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     orig.append(o)
                     made[p].append(v[i])
                 else:
-                    r = rank[best].decode(d) if len(cand) > 1 else 0
+                    r = rank[best][1 if len(cand) >= 4 else 0].decode(d) if len(cand) > 1 else 0
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]

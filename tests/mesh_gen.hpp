@@ -48,4 +48,10 @@ tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);
 // (stitches): irregular runs, as on a scan (the fast levels' run tables).
 tsm::Mesh irregular_grid(int n, uint32_t seed);
 
+// icosphere(level) flat-shaded as a glTF exporter writes it: a vertex per
+// corner, a `normal` vertex attribute (the face's), and a `texcoord` vertex
+// attribute (spherical, from the position: equal on the split vertices of one
+// point, so each point has one texture wedge and a normal wedge per face).
+tsm::Mesh flat_shaded_textured_sphere(int level);
+
 }  // namespace tsm_test

@@ -43,6 +43,13 @@ constexpr uint8_t kAttributeTableFlag = 0x08;
 // the prediction misses them).
 constexpr uint8_t kAttributeRecentFlag = 0x20;
 constexpr size_t kRecentValues = 64;
+// Predictor bit 6: a vertex value may name the value of an earlier vertex at
+// the same grid position (its point's wedges, FORMAT.md §8.12: a split
+// vertex of a welded mesh usually repeats the UV, colour or skin weights of
+// its point's other vertices where only the normal changes, and the normal
+// where only the UV does). Up to 32 such vertices, the latest first.
+constexpr uint8_t kAttributeSiblingFlag = 0x40;
+constexpr uint32_t kSiblingVertices = 32;
 
 // Predictor bit 4: a corner attribute coded as a vertex attribute, one value
 // per own vertex, each corner using its vertex's value (an OBJ/PLY export of
@@ -154,6 +161,8 @@ struct Models {
   SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
   UIntModel recent_hit[2];  // [the previous vertex's was one]: the value is one of the recent values
   UIntModel recent_index;   // which, most recent first
+  UIntModel sibling_hit[2][2];  // [the previous was a hit][more than one wedge value]: an earlier sibling's value
+  UIntModel sibling_index;      // which of the siblings' distinct values, latest first
 };
 
 // Residual coding of one value against a prediction; contexts: the
@@ -165,6 +174,7 @@ struct ValueCoder {
   Models m;
   int last_zero[4] = {1, 1, 1, 1};
   bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls = 0) {
+    if (h.quant == AttributeQuant::octahedral) return octahedral_value(h, pred, x, cls);
     const uint32_t n = int_components(h);
     for (uint32_t c = 0; c < n; ++c) {
       int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]),
@@ -175,6 +185,78 @@ struct ValueCoder {
       last_zero[c] = r == 0;
     }
     return true;
+  }
+  // An octahedral value (FORMAT.md §8.12, "Octahedral residuals"): the square
+  // continues across each edge as its mirror image (the edge u = m is glued
+  // to itself with v -> m - v), so pred + residual may lie up to one square
+  // beyond an edge and is folded back. A normal near the square's border (a
+  // CAD part's -z, the lower hemisphere's rim) then costs the small step
+  // across the fold, not the width of the square.
+  bool octahedral_value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls) {
+    const int64_t top = (int64_t{1} << h.bits) - 1;
+    int64_t want[2] = {0, 0};
+    if constexpr (Coder::kEncoder) octahedral_residual(top, pred, x, want);
+    int64_t v[2];
+    for (uint32_t c = 0; c < 2; ++c) {
+      const int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]), want[c]);
+      v[c] = static_cast<int64_t>(pred[c]) + r;
+      if (v[c] < -top || v[c] > 2 * top) return false;
+      last_zero[c] = r == 0;
+    }
+    octahedral_fold(top, v);
+    x[0] = static_cast<int32_t>(v[0]);
+    x[1] = static_cast<int32_t>(v[1]);
+    return true;
+  }
+  // Folds a point of [-m, 2m]^2 into the square [0, m]^2.
+  static void octahedral_fold(int64_t m, int64_t* v) {
+    if (v[0] > m) {
+      v[0] = 2 * m - v[0];
+      v[1] = m - v[1];
+    } else if (v[0] < 0) {
+      v[0] = -v[0];
+      v[1] = m - v[1];
+    }
+    if (v[1] > m) {
+      v[1] = 2 * m - v[1];
+      v[0] = m - v[0];
+    } else if (v[1] < 0) {
+      v[1] = -v[1];
+      v[0] = m - v[0];
+    }
+  }
+  // The encoder's residual: of the value's mirror images (up to two
+  // reflections across the square's edges) that fold back to it, the one
+  // nearest the prediction (the smallest larger component, then the
+  // smallest sum, then the first in the order tried).
+  static void octahedral_residual(int64_t m, const int32_t* pred, const int32_t* x, int64_t* out) {
+    // Across u = m, u = 0, v = m, v = 0.
+    auto reflect = [m](int e, int64_t* p) {
+      const int a = e < 2 ? 0 : 1;
+      p[a] = (e % 2 == 0 ? 2 * m : 0) - p[a];
+      p[1 - a] = m - p[1 - a];
+    };
+    out[0] = int64_t{x[0]} - pred[0];
+    out[1] = int64_t{x[1]} - pred[1];
+    auto cost = [](const int64_t* r) {
+      const int64_t a = r[0] < 0 ? -r[0] : r[0], b = r[1] < 0 ? -r[1] : r[1];
+      return std::make_pair(std::max(a, b), a + b);
+    };
+    for (int e1 = -1; e1 < 4; ++e1)
+      for (int e2 = -1; e2 < 4; ++e2) {
+        int64_t p[2] = {x[0], x[1]};
+        if (e1 >= 0) reflect(e1, p);
+        if (e2 >= 0) reflect(e2, p);
+        if (p[0] < -m || p[0] > 2 * m || p[1] < -m || p[1] > 2 * m) continue;
+        int64_t f[2] = {p[0], p[1]};
+        octahedral_fold(m, f);
+        if (f[0] != x[0] || f[1] != x[1]) continue;
+        const int64_t r[2] = {p[0] - pred[0], p[1] - pred[1]};
+        if (cost(r) < cost(out)) {
+          out[0] = r[0];
+          out[1] = r[1];
+        }
+      }
   }
 };
 
@@ -235,11 +317,28 @@ struct Dec {
   static constexpr bool kEncoder = false;
 };
 
-// Area-weighted normals of the own vertices from the faces whose corners
-// are all own (fans for polygons), as octahedral indices; has[r] = 0 where
-// the sum is zero.
+// How the faces around a vertex weigh in its geometry normal (predictors
+// 1, 3 and 4): by area; each face alike (its unit normal: what most
+// modelling tools write for smooth shading); by the corner's angle (the
+// face's vector over the lengths of the corner's two edges: its sine).
+enum class NormalWeights { area = 0, face = 1, angle = 2 };
+
+NormalWeights normal_weights(int predictor) {
+  return predictor == 3 ? NormalWeights::face : predictor == 4 ? NormalWeights::angle : NormalWeights::area;
+}
+
+// The squared length of b - a (grid positions).
+double squared_distance(const uint32_t* a, const uint32_t* b) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) s += (double(b[k]) - a[k]) * (double(b[k]) - a[k]);
+  return s;
+}
+
+// Normals of the own vertices from the faces whose corners are all own
+// (fans for polygons), weighted as `weights` says, as octahedral indices;
+// has[r] = 0 where the sum is zero.
 void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q,
-                      int bits, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
+                      int bits, NormalWeights weights, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
   const size_t n = q.size() / 3;
   std::vector<double> sum(3 * n, 0.0);
   for (size_t f = 0; f < faces.face_count(); ++f) {
@@ -259,11 +358,21 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
       ny += a[2] * b[0] - a[0] * b[2];
       nz += a[0] * b[1] - a[1] * b[0];
     }
+    const double len = std::sqrt((nx * nx + ny * ny) + nz * nz);
     for (uint32_t i = 0; i < k; ++i) {
+      double w = 1;
+      if (weights == NormalWeights::face) {
+        w = len > 0 ? 1 / len : 0;
+      } else if (weights == NormalWeights::angle) {
+        const uint32_t* pi = &q[3 * static_cast<size_t>(rank[c[i]])];
+        const double e = squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + 1) % k]])]) *
+                         squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + k - 1) % k]])]);
+        w = e > 0 ? 1 / std::sqrt(e) : 0;
+      }
       double* s = &sum[3 * static_cast<size_t>(rank[c[i]])];
-      s[0] += nx;
-      s[1] += ny;
-      s[2] += nz;
+      s[0] += nx * w;
+      s[1] += ny * w;
+      s[2] += nz * w;
     }
   }
   oct.assign(2 * n, 0);
@@ -507,18 +616,32 @@ struct AttributeWalk {
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
   // With `recent` (predictor bit 5), a value may instead name one of the
   // last 64 distinct values (the encoder does when the prediction misses it).
-  bool vertices(int predictor, bool recent, std::vector<int32_t>& x) {
+  bool vertices(int predictor, bool recent, bool siblings, std::vector<int32_t>& x) {
     const uint32_t n = int_components(h);
     int32_t prev[4] = {0, 0, 0, 0};
     int sigma = 1;
     std::vector<const int32_t*> uv;
     std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
-    uint32_t hit_before = 0;
+    uint32_t hit_before = 0, sibling_before = 0;
+    std::vector<uint32_t> earlier;  // per own rank: the previous own vertex at its grid position, or kNone
+    if (siblings) earlier_at_same_position(earlier);
     for (size_t v = 0; v < rank.size(); ++v) {
       const uint32_t r = rank[v];
       if (r == kNone) continue;
+      if (siblings && !earlier.empty() && earlier[r] != kNone) {
+        uint32_t hit = 0;
+        if (!sibling_value(earlier, r, sibling_before, x, hit)) return false;
+        sibling_before = hit;
+        if (hit) {
+          const int32_t* xv = &x[n * static_cast<size_t>(r)];
+          std::copy(xv, xv + n, prev);
+          if (recent) touch_recent(list, xv);
+          if (predictor == 2) update_sigma(v, r, sigma, uv, x);
+          continue;
+        }
+      }
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
-      if (predictor == 1 && (*ghas)[r]) {
+      if ((predictor == 1 || predictor >= 3) && (*ghas)[r]) {
         pred[0] = (*gnormal)[2 * r];
         pred[1] = (*gnormal)[2 * r + 1];
       }
@@ -550,23 +673,95 @@ struct AttributeWalk {
         return false;
       }
       std::copy(xv, xv + n, prev);
-      if (predictor == 2) {  // faces completed by this vertex give the chart's orientation
-        for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
-          const uint32_t f = around->face[j], k = faces.face_size(f);
-          const uint32_t* c = faces.face(f);
-          bool complete = k >= 3;
-          uv.clear();
-          for (uint32_t i = 0; i < k && complete; ++i) {
-            complete = rank[c[i]] <= r;
-            if (complete) uv.push_back(&x[2 * static_cast<size_t>(rank[c[i]])]);
-          }
-          if (!complete) continue;
-          const int o = uv_orientation(uv.data(), k);
-          if (o != 0) sigma = o;
-        }
-      }
+      if (predictor == 2) update_sigma(v, r, sigma, uv, x);
     }
     return true;
+  }
+  // Faces completed by vertex v (own rank r) give the chart's orientation.
+  void update_sigma(size_t v, uint32_t r, int& sigma, std::vector<const int32_t*>& uv,
+                    const std::vector<int32_t>& x) const {
+    for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f);
+      const uint32_t* c = faces.face(f);
+      bool complete = k >= 3;
+      uv.clear();
+      for (uint32_t i = 0; i < k && complete; ++i) {
+        complete = rank[c[i]] <= r;
+        if (complete) uv.push_back(&x[2 * static_cast<size_t>(rank[c[i]])]);
+      }
+      if (!complete) continue;
+      const int o = uv_orientation(uv.data(), k);
+      if (o != 0) sigma = o;
+    }
+  }
+  // Per own rank, the previous own rank with the same grid position (kNone:
+  // none); empty without positions.
+  void earlier_at_same_position(std::vector<uint32_t>& earlier) const {
+    earlier.clear();
+    if (!q || q->empty()) return;
+    const size_t own = q->size() / 3;
+    std::vector<uint32_t> by_q(own);
+    for (uint32_t r = 0; r < own; ++r) by_q[r] = r;
+    const uint32_t* p = q->data();
+    std::sort(by_q.begin(), by_q.end(), [p](uint32_t a, uint32_t b) {
+      for (int k = 0; k < 3; ++k)
+        if (p[3 * size_t{a} + k] != p[3 * size_t{b} + k]) return p[3 * size_t{a} + k] < p[3 * size_t{b} + k];
+      return a < b;
+    });
+    earlier.assign(own, kNone);
+    for (size_t i = 1; i < own; ++i)
+      if (std::equal(p + 3 * size_t{by_q[i]}, p + 3 * size_t{by_q[i]} + 3, p + 3 * size_t{by_q[i - 1]}))
+        earlier[by_q[i]] = by_q[i - 1];
+  }
+  // The siblings' step (predictor bit 6) for own rank r, which has an
+  // earlier vertex at its position: whether its value is one of the
+  // distinct values of the up to kSiblingVertices latest such vertices
+  // (latest first) and which. `hit` = 1 when it is (x[r] then holds it).
+  bool sibling_value(const std::vector<uint32_t>& earlier, uint32_t r, uint32_t before, std::vector<int32_t>& x,
+                     uint32_t& hit) {
+    const uint32_t n = int_components(h);
+    uint32_t distinct[kSiblingVertices];
+    uint32_t count = 0, seen = 0;
+    for (uint32_t s = earlier[r]; s != kNone && seen < kSiblingVertices; s = earlier[s], ++seen) {
+      const int32_t* xs = &x[n * static_cast<size_t>(s)];
+      bool dup = false;
+      for (uint32_t j = 0; j < count && !dup; ++j)
+        dup = std::equal(xs, xs + n, &x[n * static_cast<size_t>(distinct[j])]);
+      if (!dup) distinct[count++] = s;
+    }
+    uint32_t j = 0;
+    hit = 0;
+    if constexpr (Coder::kEncoder) {
+      const int32_t* xv = &x[n * static_cast<size_t>(r)];
+      for (j = 0; j < count; ++j)
+        if (std::equal(xv, xv + n, &x[n * static_cast<size_t>(distinct[j])])) break;
+      hit = j < count;
+      if (!hit) j = 0;
+    }
+    hit = io.uint(vc.m.sibling_hit[before][count > 1], hit);
+    if (hit > 1) return false;
+    if (!hit) return true;
+    if (count > 1) j = io.uint(vc.m.sibling_index, j);
+    if (j >= count) return false;
+    const int32_t* xs = &x[n * static_cast<size_t>(distinct[j])];
+    std::copy(xs, xs + n, &x[n * static_cast<size_t>(r)]);
+    return true;
+  }
+  // A value taken without the recent values' step moves to the front of
+  // their list as one coded with it would.
+  void touch_recent(std::vector<std::array<int32_t, 4>>& list, const int32_t* xv) const {
+    const uint32_t n = int_components(h);
+    std::array<int32_t, 4> v{};
+    std::copy(xv, xv + n, v.begin());
+    const size_t at = find_recent(list, xv, n);
+    if (at < list.size()) {
+      std::move_backward(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(at),
+                         list.begin() + static_cast<std::ptrdiff_t>(at) + 1);
+      list[0] = v;
+      return;
+    }
+    list.insert(list.begin(), v);
+    if (list.size() > kRecentValues) list.pop_back();
   }
   // One vertex value with the recent values: a hit (and which) or the value
   // coded against `pred`; then the value moves to the front of `list`.
@@ -860,11 +1055,14 @@ std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const Attribute
 namespace {
 
 // The predictors an attribute may use, as bits (1 << predictor): 0 previous
-// value; 1 geometry normal (vertex normals, octahedral); 2 texture placement
-// from the geometry (two-component grid values per vertex or corner).
+// value; 1, 3 and 4 geometry normal weighted by area, by face, by angle
+// (octahedral vertex normals; 3 and 4 also corner normals, whose new values
+// predictor 0 predicts by area); 2 texture placement from the geometry
+// (two-component grid values per vertex or corner).
 unsigned predictors_for(const AttributeHeader& h) {
   unsigned p = 1;
-  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2;
+  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2 | 8 | 16;
+  if (h.domain == AttributeDomain::corner && h.quant == AttributeQuant::octahedral) p |= 8 | 16;
   if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
   return p;
 }
@@ -942,18 +1140,20 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
+  bool siblings = false;  // the attribute being coded names its siblings' values (predictor bit 6)
   auto code = [&](Enc& enc, size_t i, int predictor, bool recent) {
     const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
     ValueCoder<Enc> vc{enc, {}};
     const bool oct = h.quant == AttributeQuant::octahedral;
+    if (oct) geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor), gnormal, ghas);
     AttributeWalk<Enc> walk{h, vc, enc, faces, rank, oct ? &gnormal : nullptr, oct ? &ghas : nullptr, in.q, &around};
     if (h.domain == AttributeDomain::vertex) {
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
         if (rank[v] != kNone) to_ints(h, &a.values[h.components * static_cast<size_t>(order[v])], &x[n * rank[v]]);
-      return walk.vertices(predictor, recent, x);
+      return walk.vertices(predictor, recent, siblings, x);
     }
     if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
@@ -996,19 +1196,19 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   for (size_t i = 0; i < headers.size(); ++i) {
     const bool per_vertex = in.per_vertex >> i & 1;
     const AttributeHeader h = coded_header(headers[i], per_vertex);
-    if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gnormal, ghas);
     const unsigned choices = predictors_for(h);
     int predictor = 0;
     size_t best = SIZE_MAX;
     own_values = nullptr;
     bool recent = false;
+    siblings = h.domain == AttributeDomain::vertex;
     auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
       if (!code(trial, i, p, recent)) return false;
       size = trial.e.finish().size();
       return true;
     };
-    for (int p = 0; p < 3 && choices != 1; ++p) {
+    for (int p = 0; p < 5 && choices != 1; ++p) {
       size_t size = 0;
       if (!(choices >> p & 1)) continue;
       if (!adaptive_size(p, size)) return Status(ErrorCode::internal, "attributes: values out of range");
@@ -1024,6 +1224,10 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       recent = true;
       if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
       recent = with < best;
+      best = std::min(best, with);
+      siblings = false;  // the siblings' values where they pay (predictor bit 6)
+      if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
+      siblings = with >= best;
       best = std::min(best, with);
     }
     TableResiduals residuals;
@@ -1043,7 +1247,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       }
     }
     w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
-                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0)));
+                              (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0) |
+                              (siblings ? kAttributeSiblingFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -1075,7 +1280,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
-  uint64_t per_vertex = 0, recent = 0;
+  uint64_t per_vertex = 0, recent = 0, siblings = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -1096,7 +1301,13 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       recent |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeRecentFlag);
     }
-    if (p > 2 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
+    if (p & kAttributeSiblingFlag) {
+      if (headers[i].domain != AttributeDomain::vertex)
+        return corrupt("'" + headers[i].name + "' names its siblings' values but is not coded per vertex");
+      siblings |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributeSiblingFlag);
+    }
+    if (p > 4 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
   if (in.per_vertex) *in.per_vertex = per_vertex;
@@ -1133,7 +1344,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     const uint32_t n = int_components(h);
     std::vector<int32_t> gn;
     std::vector<uint8_t> gh;
-    if (h.quant == AttributeQuant::octahedral) geometry_normals(faces, rank, *in.q, h.bits, gn, gh);
+    if (h.quant == AttributeQuant::octahedral)
+      geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor[i]), gn, gh);
     ValueCoder<Dec> vc{dec, {}};
     AttributeWalk<Dec> walk{h, vc, dec, faces, rank, h.quant == AttributeQuant::octahedral ? &gn : nullptr,
                             h.quant == AttributeQuant::octahedral ? &gh : nullptr, in.q, &around};
@@ -1146,7 +1358,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     std::vector<int32_t> x;
     if (h.domain == AttributeDomain::vertex) {
       x.assign(n * static_cast<size_t>(own), 0);
-      if (!walk.vertices(predictor[i], recent >> i & 1, x)) return corrupt("vertex values of '" + h.name + "' out of range");
+      if (!walk.vertices(predictor[i], recent >> i & 1, siblings >> i & 1, x))
+        return corrupt("vertex values of '" + h.name + "' out of range");
       if (per_vertex >> i & 1) {  // each corner uses its vertex's value
         a.indices.resize(faces.indices.size());
         for (size_t k = 0; k < faces.indices.size(); ++k) a.indices[k] = rank[faces.indices[k]];

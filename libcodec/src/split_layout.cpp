@@ -75,9 +75,10 @@ int closeness(const Normal& f, const int64_t sum[3]) {
 // same vertex, 3 two different vertices.
 struct SplitModels {
   // [neighbours (0-3)][the face's previous corner: 0 none, 1 a new vertex,
-  // 2 an old one][the first candidate's closeness (0-5)]
-  Prob fresh[4][3][6];
-  UIntModel rank[6];  // [the first candidate's closeness]
+  // 2 an old one][the first candidate's closeness (0-5)][4 or more
+  // candidates: a point of many vertices, as a CAD part's slivers make]
+  Prob fresh[4][3][6][2];
+  UIntModel rank[6][2];  // [the first candidate's closeness][4 or more candidates]
   Prob copy[4];       // a new vertex with an earlier vertex's values, [neighbours]
   UIntModel copy_rank;
 };
@@ -251,7 +252,7 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
         v[i] = walk.make(p);
       } else {
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        e.bit(m.fresh[nb][before][walk.best()], fresh);
+        e.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0], fresh);
         if (fresh) {
           // A copy: the values of a vertex of the point (the first such
           // candidate).
@@ -264,7 +265,7 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
-          if (cand.size() > 1) m.rank[walk.best()].encode(e, r);
+          if (cand.size() > 1) m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].encode(e, r);
           v[i] = it->second;
         }
       }
@@ -309,7 +310,7 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
         before = 1;
       } else {
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        before = d.bit(m.fresh[nb][before][walk.best()]) ? 1 : 2;
+        before = d.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0]) ? 1 : 2;
         if (before == 1) {
           const auto& cand = walk.cand();
           uint32_t original = kNoVertex;
@@ -321,7 +322,7 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
           v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
-          const uint32_t r = cand.size() > 1 ? m.rank[walk.best()].decode(d) : 0;
+          const uint32_t r = cand.size() > 1 ? m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].decode(d) : 0;
           if (r >= cand.size()) return corrupt("a vertex rank out of range");
           v[i] = cand[r];
         }
