@@ -895,13 +895,14 @@ struct FanTableDecoder {
     size_t guard = 0;
     do {
       const uint32_t hn = he_next(h), hp = he_prev(h), xu = cv[hn], xw = cv[hp];
-      const uint32_t u = xu != kNone && act[xu] != kUnknown ? xu : kNone;
-      const uint32_t w = xw != kNone && act[xw] != kUnknown ? xw : kNone;
+      auto decoded = [&](uint32_t x) { return x != kNone && act[x] != kUnknown; };
+      const uint32_t u = decoded(xu) ? xu : kNone;
       if (u != kNone) {
         const uint32_t* U = at(u);
         for (int a = 0; a < 3; ++a) nb[a] += U[a];
         ++nnb;
         actsum += act[u];
+        const uint32_t w = decoded(xw) ? xw : kNone;
         if (w != kNone) {
           if (npair < kPairs) pu[npair] = u, pw[npair] = w;
           ++npair;
@@ -919,7 +920,7 @@ struct FanTableDecoder {
         }
       }
       // (v counts as done there: decoded before the next vertex is chosen)
-      if (greedy) greedy->count(cv, twin, h, hn, hp, xu, xw, u != kNone || xu == v, w != kNone || xw == v);
+      if (greedy) greedy->count(cv, twin, h, hn, hp, xu, xw, u != kNone || xu == v, decoded(xw) || xw == v);
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
