@@ -831,7 +831,11 @@ struct GreedyQueue {
   __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
                                             uint32_t hp) {
     const uint32_t xu = cv[hn], xw = cv[hp];
-    const bool u = done(xu), w = done(xw);
+    count(cv, twin, h, hn, hp, xu, xw, done(xu), done(xw));
+  }
+  // The same with u = cv[hn] and w = cv[hp] given, and whether each is done.
+  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
+                                            uint32_t hp, uint32_t xu, uint32_t xw, bool u, bool w) {
     // v as a neighbour of u, and the parallelogram of u across w-v.
     if (!u && xu != kNone) raise(xu, w && done(cv[he_prev(twin[hp])]), 1);
     // The parallelogram of w across v-u.
@@ -890,13 +894,15 @@ struct FanTableDecoder {
     uint32_t h = h0;
     size_t guard = 0;
     do {
-      const uint32_t hn = he_next(h), u = known(hn);
+      const uint32_t hn = he_next(h), hp = he_prev(h), xu = cv[hn], xw = cv[hp];
+      auto decoded = [&](uint32_t x) { return x != kNone && act[x] != kUnknown; };
+      const uint32_t u = decoded(xu) ? xu : kNone;
       if (u != kNone) {
         const uint32_t* U = at(u);
         for (int a = 0; a < 3; ++a) nb[a] += U[a];
         ++nnb;
         actsum += act[u];
-        const uint32_t w = known(he_prev(h));
+        const uint32_t w = decoded(xw) ? xw : kNone;
         if (w != kNone) {
           if (npair < kPairs) pu[npair] = u, pw[npair] = w;
           ++npair;
@@ -913,7 +919,8 @@ struct FanTableDecoder {
           }
         }
       }
-      if (greedy) greedy->count(cv, twin, h, hn, he_prev(h));
+      // (v counts as done there: decoded before the next vertex is chosen)
+      if (greedy) greedy->count(cv, twin, h, hn, hp, xu, xw, u != kNone || xu == v, decoded(xw) || xw == v);
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
