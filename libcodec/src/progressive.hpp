@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "container.hpp"
@@ -61,6 +62,12 @@ struct VertexSplit {
   uint32_t v = 0, y = 0, x = 0;
   uint32_t q[3] = {0, 0, 0};
 };
+
+// The ring of v from the edges opposite v in its triangles (each (a, b): the
+// corners after v): the closed fan of FORMAT.md §4.8, listed from its least
+// vertex; false when the edges do not form one (a repeated or degenerate
+// edge, a vertex twice, more than one cycle). Sorts `edge`.
+bool ring_from_edges(uint32_t v, std::vector<std::pair<uint32_t, uint32_t>>& edge, std::vector<uint32_t>& ring);
 
 // A refinement payload (FORMAT.md §4.8): the error of the level before and
 // after the batch (symmetric Hausdorff distance to the input, model units),

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "progressive.hpp"
 #include "progressive_plan.hpp"
 
 namespace tsm {
@@ -152,20 +153,7 @@ bool Collapser::ring(uint32_t v, std::vector<uint32_t>& out) const {
     const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
     edge[i] = {c[(k + 1) % 3], c[(k + 2) % 3]};
   }
-  std::sort(edge.begin(), edge.end());
-  for (size_t i = 1; i < d; ++i)
-    if (edge[i].first == edge[i - 1].first) return false;
-  uint32_t at = edge[0].first;
-  for (size_t i = 0; i < d; ++i) {
-    out.push_back(at);
-    auto it = std::lower_bound(edge.begin(), edge.end(), std::make_pair(at, uint32_t{0}));
-    if (it == edge.end() || it->first != at) return false;
-    at = it->second;
-  }
-  if (at != out[0]) return false;
-  std::vector<uint32_t> sorted = out;
-  std::sort(sorted.begin(), sorted.end());
-  return std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end();
+  return ring_from_edges(v, edge, out);
 }
 
 // Normal of triangle t with vertex `from` moved to `to`'s grid point.

@@ -125,8 +125,16 @@ bool LevelMesh::ring(uint32_t v, std::vector<uint32_t>& ring) const {
     const uint32_t* c = mesh_->face(f);
     const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
     edge[i] = {c[(k + 1) % 3], c[(k + 2) % 3]};
-    if (edge[i].first == v || edge[i].second == v || edge[i].first == edge[i].second) return false;
   }
+  return ring_from_edges(v, edge, ring);
+}
+
+bool ring_from_edges(uint32_t v, std::vector<std::pair<uint32_t, uint32_t>>& edge, std::vector<uint32_t>& ring) {
+  ring.clear();
+  const size_t d = edge.size();
+  if (d < 3) return false;
+  for (const auto& e : edge)
+    if (e.first == v || e.second == v || e.first == e.second) return false;
   std::sort(edge.begin(), edge.end());
   for (size_t i = 1; i < d; ++i)
     if (edge[i].first == edge[i - 1].first) return false;
