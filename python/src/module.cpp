@@ -239,6 +239,31 @@ PYBIND11_MODULE(_tsmcodec, m) {
       "Encodes a Mesh; returns the .tsm bytes (keep_order: decoded in the input's order; lossless: positions bit "
       "for bit, with allow_nonfinite NaN and infinities too)");
   m.def(
+      "encode_mapped",
+      [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads, bool keep_order,
+         bool lossless, bool allow_nonfinite) {
+        std::string out;
+        tsm::EncodeMapping map;
+        {
+          py::gil_scoped_release release;
+          check(tsm::encode(
+              mesh,
+              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
+              out, &map));
+        }
+        py::dict d;
+        d["vertex_from"] = to_array(map.vertex_from, 1);
+        d["face_from"] = to_array(map.face_from, 1);
+        d["first_corner"] = to_array(map.first_corner, 1);
+        return py::make_tuple(py::bytes(out), d);
+      },
+      py::arg("mesh"), py::kw_only(), py::arg("quantization_bits") = tsm::kDefaultQuantizationBits,
+      py::arg("level") = tsm::kDefaultLevel, py::arg("segment_faces") = 0, py::arg("threads") = 0,
+      py::arg("keep_order") = false, py::arg("lossless") = false, py::arg("allow_nonfinite") = false,
+      "As encode, and where the decoded mesh comes from in the input: (bytes, {'vertex_from', 'face_from', "
+      "'first_corner'}): decoded vertex v is input vertex vertex_from[v], decoded face f input face face_from[f] "
+      "starting at its corner first_corner[f]");
+  m.def(
       "encode",
       [](const py::handle& positions, const py::handle& faces, const py::handle& attributes, int quantization_bits,
          int level, uint32_t segment_faces, int threads, bool keep_order, bool lossless, bool allow_nonfinite) {

@@ -265,3 +265,24 @@ def test_keep_order_and_lossless_round_trip():
         tsmcodec.encode(positions, faces, lossless=True)
     back = tsmcodec.decode(tsmcodec.encode(positions, faces, keep_order=True, lossless=True, allow_nonfinite=True))
     assert np.asarray(back.positions).tobytes() == positions.tobytes()
+
+
+def test_encode_mapped_reindexes_the_input():
+    positions, faces = grid(8)
+    rng = np.random.default_rng(7)
+    order = rng.permutation(len(positions))
+    shuffled = np.empty_like(positions)
+    shuffled[order] = positions  # input vertex order[i] holds grid vertex i
+    mesh = tsmcodec.Mesh(shuffled, order[faces].astype(np.uint32))
+    data, mapping = tsmcodec.encode_mapped(mesh, quantization_bits=16)
+    assert data == tsmcodec.encode(mesh, quantization_bits=16)  # asking for the mapping changes no byte
+    back = tsmcodec.decode(data)
+    vf = np.asarray(mapping["vertex_from"])
+    assert sorted(vf) == list(range(len(positions)))
+    # Decoded vertex v is input vertex vf[v]: positions agree within the 16-bit grid.
+    assert np.abs(np.asarray(back.positions) - shuffled[vf]).max() < 12 / (1 << 16)
+    ff, fc = np.asarray(mapping["face_from"]), np.asarray(mapping["first_corner"])
+    in_faces = np.asarray(mesh.faces)
+    for f in range(back.face_count):
+        want = np.roll(in_faces[ff[f]], -int(fc[f]))
+        assert list(vf[np.asarray(back.faces)[f]]) == list(want)

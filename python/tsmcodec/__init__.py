@@ -13,8 +13,8 @@
 
 Errors raise tsmcodec.Error with the library's message.
 """
-from ._tsmcodec import (Attribute, Error, Mesh, StreamDecoder, __version__, decode, distance, encode, info, read,
-                        simplify, write)
+from ._tsmcodec import (Attribute, Error, Mesh, StreamDecoder, __version__, decode, distance, encode, encode_mapped,
+                        info, read, simplify, write)
 
-__all__ = ["Attribute", "Error", "Mesh", "StreamDecoder", "__version__", "decode", "distance", "encode", "info", "read",
-           "simplify", "write"]
+__all__ = ["Attribute", "Error", "Mesh", "StreamDecoder", "__version__", "decode", "distance", "encode",
+           "encode_mapped", "info", "read", "simplify", "write"]
