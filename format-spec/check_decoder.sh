@@ -122,6 +122,10 @@ corpus_case check dragon_segments "$dragon" 11 6 2000
 check keep_order_mixed "$work/mixed.obj" 12 6 0 --keep-order
 check keep_order_double_sided "$work/double_sided.obj" 12 6 300 --keep-order
 corpus_case check keep_order_dragon "$dragon" 11 6 0 --keep-order
+# progressive files (§4.8): the base mesh, then batches of vertex splits and the loose vertices
+check progressive_irregular "$work/irregular.obj" 12 6 0 --progressive
+check progressive_mixed "$work/mixed.obj" 12 6 0 --progressive
+corpus_case check progressive_dragon "$dragon" 11 6 0 --progressive
 # lossless files (§5.1): the exact grid and its exceptions
 check lossless_mixed "$work/mixed.obj" 12 6 0 --lossless
 check lossless_segments "$work/irregular.obj" 12 0 600 --lossless

@@ -189,6 +189,7 @@ def read_container(data):
         reject('quantization bits')                                 # step 12
     sections = {}
     segments = []
+    refinements = []
     order = []
     pos = hend + 4
     while True:
@@ -223,6 +224,17 @@ def read_container(data):
         if sid == 7:                                                # step 20, §4.3
             if h['segment_count'] == 1 or len(segments) >= h['segment_count']:
                 reject('segment section')
+        elif sid == 12:                                             # §4.3, §4.8: repeats
+            if 13 in sections or 11 in sections or 14 in sections:
+                reject('refinement after the loose vertices or in a keep-order or lossless file')
+            if not (10 in sections if h['segment_count'] == 1 else len(segments) == h['segment_count']):
+                reject('refinement before the base mesh')
+            if len(refinements) >= 64:
+                reject('too many refinement sections')
+        elif sid == 13 and not refinements:
+            reject('loose vertices before any refinement')
+        elif sid in (11, 14) and refinements:
+            reject('order or exceptions in a progressive file')
         elif sid in sections:
             reject('duplicate section id')
         elif 3 <= sid <= 6 or sid == 8:
@@ -249,6 +261,9 @@ def read_container(data):
         if sid == 7:
             segments.append(bytes(body))
             continue
+        if sid == 12:
+            refinements.append(bytes(body))
+            continue
         sections[sid] = bytes(body)
         order.append(sid)
         if len(order) > 4096:
@@ -256,6 +271,7 @@ def read_container(data):
     if pos != n:
         reject('bytes after the end marker')                        # step 23
     sections[7] = segments
+    sections[12] = refinements
     return h, sections
 
 
@@ -2779,27 +2795,230 @@ def decode(data, trace=None):
     attrs = join_attributes(part_attrs)                              # step 29, §8.12
     info['metadata'] = read_metadata(sections[9]) if sections.get(9) is not None else None   # step 30, §4.6
     info['metadata_skipped'] = 9 in sections and sections[9] is None  # zstd-coded, no zstandard module
-    step = h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
-    positions = []
-    for v in range(vc):
-        pt = []
-        for a in range(3):
-            if h['exact'] is not None:                               # §5.1
-                x = float(h['exact'][1][a] + q[v][a]) * h['exact'][0]
-                pt.append(f32(min(max(x, -FLT_MAX), FLT_MAX)))
-                continue
-            x = float(h['origin'][a]) + float(q[v][a]) * step
-            x = min(max(x, -FLT_MAX), FLT_MAX)
-            c = f32(x)
-            while c - float(h['origin'][a]) > h['extent']:     # §5: not past origin + extent
-                c = f32_below(c)
-            pt.append(c)
-        positions.append(pt)
+    positions = [[grid_coordinate(h, a, q[v][a]) for a in range(3)] for v in range(vc)]
     if h['exact'] is not None and sections.get(14) is not None:      # step 31, §5.1
         apply_exceptions(sections[14], positions)
     if sections.get(11) is not None:                                 # step 31, §4.9
         faces, q, positions = apply_order(sections[11], faces, q, positions, attrs)
+    if sections[12]:                                                 # step 32, §4.8
+        faces, q, positions = apply_refinements(h, sections[12], sections.get(13), faces, positions)
+        info['batches'] = len(sections[12])
     return h, faces, q, positions, info, attrs
+
+
+def grid_step(h):
+    return h['extent'] / ((1 << h['bits']) - 1) if h['extent'] > 0 else 0.0
+
+
+def grid_coordinate(h, a, qa):
+    """§5 (and §5.1): the float32 coordinate of grid index qa on axis a."""
+    if h['exact'] is not None:
+        x = float(h['exact'][1][a] + qa) * h['exact'][0]
+        return f32(min(max(x, -FLT_MAX), FLT_MAX))
+    x = float(h['origin'][a]) + float(qa) * grid_step(h)
+    x = min(max(x, -FLT_MAX), FLT_MAX)
+    c = f32(x)
+    while c - float(h['origin'][a]) > h['extent']:             # §5: not past origin + extent
+        c = f32_below(c)
+    return c
+
+
+# ---------------------------------------------------------------- §4.8 progressive files
+
+def max_decisions(nbytes):
+    return 2843 * (nbytes + 8)                                       # §9 step 26's D(S)
+
+
+class LevelMesh:
+    """The level of detail the batches refine: faces, per vertex its grid
+    index and the faces that use it."""
+
+    def __init__(self, h, faces, positions):
+        self.h = h
+        self.faces = faces
+        self.positions = positions
+        step = grid_step(h)
+        qmax = (1 << h['bits']) - 1
+        self.q = []
+        for pt in positions:
+            g = []
+            for a in range(3):
+                x = math.floor((pt[a] - float(h['origin'][a])) / step + 0.5) if step > 0 else 0.0
+                g.append(int(min(max(x, 0.0), qmax)))
+            self.q.append(g)
+        self.vf = [[] for _ in positions]
+        for f, face in enumerate(faces):
+            for c in face:
+                if not self.vf[c] or self.vf[c][-1] != f:
+                    self.vf[c].append(f)
+
+    def ring(self, v):
+        """v's closed fan (§4.8) listed from its least vertex, or None."""
+        fs = self.vf[v]
+        if len(fs) < 3:
+            return None
+        edges = []
+        for f in fs:
+            c = self.faces[f]
+            if len(c) != 3:
+                return None
+            k = 0 if c[0] == v else 1 if c[1] == v else 2
+            edges.append((c[(k + 1) % 3], c[(k + 2) % 3]))
+        if any(a == v or b == v or a == b for a, b in edges):
+            return None
+        edges.sort()
+        if any(edges[i][0] == edges[i - 1][0] for i in range(1, len(edges))):
+            return None
+        nxt = dict(edges)
+        ring = []
+        at = edges[0][0]
+        for _ in edges:
+            ring.append(at)
+            if at not in nxt:
+                return None
+            at = nxt[at]
+        if at != ring[0] or len(set(ring)) != len(ring):
+            return None
+        return ring
+
+    def adjacent_to_marked(self, v, marked):
+        return any(c < len(marked) and marked[c] for f in self.vf[v] for c in self.faces[f])
+
+    def add_point(self, g):
+        self.q.append(list(g))
+        self.positions.append([grid_coordinate(self.h, a, g[a]) for a in range(3)])
+        self.vf.append([])
+
+    def split(self, v, ring, ia, dist, g):
+        u = len(self.q)
+        d = len(ring)
+        self.add_point(g)
+        keep = []
+        for f in self.vf[v]:
+            c = self.faces[f]
+            k = 0 if c[0] == v else 1 if c[1] == v else 2
+            first = ring.index(c[(k + 1) % 3]) if c[(k + 1) % 3] in ring else d
+            if (first + d - ia) % d < dist:
+                c[k] = u
+                self.vf[u].append(f)
+            else:
+                keep.append(f)
+        self.vf[v] = keep
+        y, x = ring[ia], ring[(ia + dist) % d]
+        f1 = len(self.faces)
+        self.faces.append([v, u, x])
+        self.faces.append([v, y, u])
+        for w in (v, u, x):
+            self.vf[w].append(f1)
+        for w in (v, y, u):
+            self.vf[w].append(f1 + 1)
+
+
+class BatchModels:
+    def __init__(self):
+        self.flag = probs(8)
+        self.start = UIntModel(2)
+        self.dist = [UIntModel(2) for _ in range(16)]
+        self.residual = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
+
+
+def decode_batch(payload, level, m):
+    """§4.8: one refinement section's vertex splits, applied to level."""
+    if len(payload) < 8:
+        reject('refinement header')
+    before, after = struct.unpack_from('<2f', payload, 0)
+    if not all(math.isfinite(e) and e >= 0 for e in (before, after)):
+        reject('refinement error')
+    splits, p = read_varint(payload, 8, len(payload))
+    stream = payload[p:]
+    n = len(level.q)
+    if splits == 0 or splits > n or splits > max_decisions(len(stream)) // 4:
+        reject('split count')
+    d = RangeDecoder(stream)
+    marked = [0] * n
+    ones = 0
+    for i in range(n):                                               # 1. flags
+        if ones >= splits:
+            break
+        if level.adjacent_to_marked(i, marked):
+            continue
+        ring = level.ring(i)
+        if ring is None:
+            continue
+        b = d.bit(m.flag, min(len(ring), 10) - 3)
+        marked[i] = b
+        ones += b
+        if d.truncated():
+            reject('refinement flags truncated')
+    if ones != splits:
+        reject('fewer split flags than the split count')
+    qmax = (1 << level.h['bits']) - 1
+    for v in range(n):                                               # 2. splits
+        if not marked[v]:
+            continue
+        ring = level.ring(v)
+        dd = len(ring)
+        ia = m.start.decode(d)
+        dist = m.dist[min(dd, 15)].decode(d) + 1
+        if not (ia < dd and 1 <= dist < dd):
+            reject('split ring neighbours')
+        arc = [ring[(ia + k) % dd] for k in range(dist + 1)]
+        qv = level.q[v]
+        pred = []
+        for a in range(3):
+            total = qv[a] + sum(level.q[r][a] for r in arc)
+            pred.append((total + (dist + 2) // 2) // (dist + 2))
+        span = max(abs(level.q[r][a] - qv[a]) for r in arc for a in range(3))
+        sc = min(bit_length(span), 23)
+        nrm = [0.0, 0.0, 0.0]
+        for i in range(dd):
+            ra, rb = level.q[ring[i]], level.q[ring[(i + 1) % dd]]
+            e1 = [float(ra[k]) - float(qv[k]) for k in range(3)]
+            e2 = [float(rb[k]) - float(qv[k]) for k in range(3)]
+            nrm[0] += e1[1] * e2[2] - e1[2] * e2[1]
+            nrm[1] += e1[2] * e2[0] - e1[0] * e2[2]
+            nrm[2] += e1[0] * e2[1] - e1[1] * e2[0]
+        rank = [sum(1 for b in range(3) if abs(nrm[b]) > abs(nrm[a]) or (abs(nrm[b]) == abs(nrm[a]) and b < a))
+                for a in range(3)]
+        g = []
+        for a in range(3):
+            x = pred[a] + m.residual[sc][rank[a]].decode(d)
+            if not 0 <= x <= qmax:
+                reject('a new vertex off the grid')
+            g.append(x)
+        if d.truncated():
+            reject('refinement splits truncated')
+        level.split(v, ring, ia, dist, g)
+
+
+def decode_loose(payload, level):
+    """§4.8: the loose vertices, appended without faces."""
+    count, p = read_varint(payload, 0, len(payload))
+    stream = payload[p:]
+    if count == 0 or count > max_decisions(len(stream)) // 3:
+        reject('loose vertex count')
+    d = RangeDecoder(stream)
+    axis = [SIntModel(3) for _ in range(3)]
+    qmax = (1 << level.h['bits']) - 1
+    prev = [0, 0, 0]
+    for _ in range(count):
+        for a in range(3):
+            prev[a] += axis[a].decode(d)
+            if not 0 <= prev[a] <= qmax:
+                reject('a loose vertex off the grid')
+        if d.truncated():
+            reject('loose vertices truncated')
+        level.add_point(prev)
+
+
+def apply_refinements(h, batches, loose, faces, positions):
+    level = LevelMesh(h, faces, positions)
+    m = BatchModels()
+    for payload in batches:
+        decode_batch(payload, level, m)
+    if loose is not None:
+        decode_loose(loose, level)
+    return level.faces, level.q, level.positions
 
 
 # ---------------------------------------------------------------- §5.1 exceptions
