@@ -9,6 +9,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "golden_hash.hpp"
 #include "tsm/tsm.h"
@@ -65,9 +66,13 @@ int main(int argc, char** argv) {
     int files = 0;
     for (std::string line; std::getline(list, line);) {
       if (line.empty() || line[0] == '#') continue;
+      // file mesh option... hash
       std::istringstream f(line);
-      std::string file, mesh, q, level, seg, hash;
-      if (!(f >> file >> mesh >> q >> level >> seg >> hash)) continue;
+      std::vector<std::string> t;
+      for (std::string w; f >> w;) t.push_back(w);
+      if (t.size() < 4) continue;
+      const std::string& file = t[0];
+      const std::string& hash = t.back();
       std::ifstream in(dir + file, std::ios::binary);
       const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
       tsm::Mesh g;

@@ -204,6 +204,8 @@ struct Case {
   Mesh (*build)();
   // What the file must show (tsm::inspect): the features it stands for.
   void (*features)(const tsm::FileInfo&);
+  // "progressive", "keep_order" or "lossless" (EncodeOptions), or "".
+  std::string mode = "";
 };
 
 const std::vector<Case>& cases() {
@@ -240,6 +242,12 @@ const std::vector<Case>& cases() {
          EXPECT_EQ(fi.geometry_predictor, "raw+top");
          EXPECT_EQ(fi.lattice_planes[0], 2u);
        }},
+      {"progressive.tsm", "smooth_sphere", 12, 6, 0, smooth_sphere,
+       [](const tsm::FileInfo& fi) { EXPECT_GE(fi.batches.size(), 3u); }, "progressive"},
+      {"keep_order.tsm", "topology", 12, 6, 0, topology_mesh,
+       [](const tsm::FileInfo& fi) { EXPECT_GT(fi.stitches, 0u); }, "keep_order"},
+      {"lossless.tsm", "noisy_sphere", 14, 2, 0, noisy_sphere,
+       [](const tsm::FileInfo& fi) { EXPECT_EQ(fi.batches.size(), 0u); }, "lossless"},
   };
   return all;
 }
@@ -257,6 +265,9 @@ std::string encode(const Case& c) {
   o.quantization_bits = c.q;
   o.level = c.level;
   o.segment_faces = c.segment_faces;
+  o.progressive = c.mode == "progressive";
+  o.keep_order = c.mode == "keep_order";
+  o.lossless = c.mode == "lossless";
   std::string out;
   const tsm::Status s = tsm::encode(c.build(), o, out);
   EXPECT_TRUE(s.ok()) << c.file << ": " << s.to_string();
@@ -265,7 +276,7 @@ std::string encode(const Case& c) {
 
 std::string options_of(const Case& c) {
   return "q=" + std::to_string(c.q) + " level=" + std::to_string(c.level) +
-         " segment_faces=" + std::to_string(c.segment_faces);
+         " segment_faces=" + std::to_string(c.segment_faces) + (c.mode.empty() ? "" : " " + c.mode);
 }
 
 constexpr const char* kRegenerate =
@@ -281,9 +292,14 @@ std::map<std::string, Entry> read_manifest() {
   std::istringstream in(slurp(manifest_path()));
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
+    // file mesh option... hash
     std::istringstream f(line);
-    std::string file, mesh, q, level, seg, hash;
-    if (f >> file >> mesh >> q >> level >> seg >> hash) out[file] = {mesh, q + " " + level + " " + seg, hash};
+    std::vector<std::string> t;
+    for (std::string w; f >> w;) t.push_back(w);
+    if (t.size() < 4) continue;
+    std::string options;
+    for (size_t i = 2; i + 1 < t.size(); ++i) options += (options.empty() ? "" : " ") + t[i];
+    out[t[0]] = {t[1], options, t.back()};
   }
   return out;
 }
