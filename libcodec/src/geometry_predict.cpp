@@ -601,10 +601,12 @@ struct SurfaceCoder {
       std::copy(f.nb, f.nb + 3, nb);
       std::copy(f.spread, f.spread + 3, spread);
       npara = f.npara, nnb = f.nnb, npair = f.npair;
-      const uint32_t* id = &kept->ids[f.ids];
-      for (int i = 0; i < nnb; ++i) actsum += c.act[id[i]];
-      id += nnb;
-      for (int i = 0; i < std::min(npair, kPairs); ++i) pu[i] = id[2 * i], pw[i] = id[2 * i + 1];
+      if (nnb > 0 || npair > 0) {  // (a walk that found nothing kept no ids: f.ids may be the end)
+        const uint32_t* id = kept->ids.data() + f.ids;
+        for (int i = 0; i < nnb; ++i) actsum += c.act[id[i]];
+        id += nnb;
+        for (int i = 0; i < std::min(npair, kPairs); ++i) pu[i] = id[2 * i], pw[i] = id[2 * i + 1];
+      }
     } else {
       const size_t first_id = kept ? kept->ids.size() : 0;
       walk(visit);
