@@ -68,6 +68,13 @@ async function prepare() {
 
 const given = arg('--index', null);
 const index = [];
+// The page loads the wasm decoder from build/web: without it, it would wait for its timeout.
+for (const f of ['tsm_decoder.wasm', 'tsm_decoder.js', 'tsm.js']) {
+  if (!fs.existsSync(path.join(root, 'build/web', f))) {
+    console.error(`gltf-bench: error: build/web/${f} is missing: build the web decoder first (bash web/build.sh)`);
+    process.exit(1);
+  }
+}
 if (given) {
   // Copied under web/'s server root, where the page fetches them.
   for (const [i, asset] of JSON.parse(fs.readFileSync(given, 'utf8')).entries()) {
@@ -84,7 +91,7 @@ if (given) {
 }
 fs.writeFileSync(path.join(out, 'index.json'), JSON.stringify(index, null, 1));
 
-const r = await runBenchPage(`gltf-bench.html?reps=${arg('--reps', '15')}`, 600000);
+const r = await runBenchPage(`gltf-bench.html?reps=${arg('--reps', '15')}`, given ? 180000 : 600000);
 if (r.state !== 'done') { console.error('gltf bench failed:', r.error); process.exit(1); }
 if (given) {
   console.log(JSON.stringify(r));
