@@ -175,7 +175,6 @@ void bench_tsm(const std::string& input, const std::string& name, const std::str
 std::string cell_bytes(const AssetTool& t, size_t bytes) { return t.ok ? thousands(bytes) : std::string("-"); }
 
 std::string cell_ms(double ms) { return ms >= 0 ? fixed(ms, 1) : std::string("-"); }
-std::string cell_ms2(double ms) { return ms >= 0 ? fixed(ms, 2) : std::string("-"); }
 
 std::string cell_ratio(const AssetTool& a, const AssetTool& b) {
   if (!a.ok || !b.ok || b.geometry_bytes == 0) return "-";
@@ -381,8 +380,8 @@ void print_asset_table(const std::vector<AssetRow>& rows, bool browser) {
                 cell_ratio(r.tsm, r.gltfpack).c_str(), cell_ms(r.tsm.decode_ms).c_str(),
                 cell_ms(r.draco.decode_ms).c_str(), cell_ms(r.gltfpack.decode_ms).c_str());
     if (browser)
-      std::printf(" %s | %s | %s |", cell_ms2(r.tsm.browser_ms).c_str(), cell_ms2(r.draco.browser_ms).c_str(),
-                  cell_ms2(r.gltfpack.browser_ms).c_str());
+      std::printf(" %s | %s | %s |", cell_ms(r.tsm.browser_ms).c_str(), cell_ms(r.draco.browser_ms).c_str(),
+                  cell_ms(r.gltfpack.browser_ms).c_str());
     std::printf("\n");
   }
   for (const AssetRow& r : rows)
