@@ -300,16 +300,12 @@ Mesh copies(const Mesh& src, int count) {
   return m;
 }
 
-tsm::Mesh flat_shaded_textured_sphere(int level) {
-  const tsm::Mesh in = icosphere(level);
+tsm::Mesh flat_shaded(const tsm::Mesh& in) {
   tsm::Mesh m;
-  tsm::Attribute n, t;
+  tsm::Attribute n;
   n.name = "normal";
   n.kind = tsm::AttributeKind::normal;
   n.components = 3;
-  t.name = "texcoord";
-  t.kind = tsm::AttributeKind::texcoord;
-  t.components = 2;
   for (uint32_t f = 0; f < in.face_count(); ++f) {
     const uint32_t* c = in.face(f);
     const float* a = &in.positions[3 * size_t{c[0]}];
@@ -318,18 +314,31 @@ tsm::Mesh flat_shaded_textured_sphere(int level) {
     const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
     const float nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     const float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-    uint32_t corners[3];
-    for (uint32_t k = 0; k < 3; ++k) {
+    std::vector<uint32_t> corners;
+    for (uint32_t k = 0; k < in.face_size(f); ++k) {
       const float* p = &in.positions[3 * size_t{c[k]}];
-      corners[k] = static_cast<uint32_t>(m.vertex_count());
+      corners.push_back(static_cast<uint32_t>(m.vertex_count()));
       m.add_vertex(p[0], p[1], p[2]);
       for (float x : nn) n.values.push_back(len > 0 ? x / len : 0.0f);
-      t.values.push_back(0.5f + std::atan2(p[1], p[0]) / 6.2831853f);
-      t.values.push_back(0.5f + std::asin(std::max(-1.0f, std::min(1.0f, p[2]))) / 3.1415927f);
     }
-    m.add_face(corners, 3);
+    m.add_face(corners.data(), corners.size());
   }
-  m.attributes = {n, t};
+  m.attributes = {n};
+  return m;
+}
+
+tsm::Mesh flat_shaded_textured_sphere(int level) {
+  tsm::Mesh m = flat_shaded(icosphere(level));
+  tsm::Attribute t;
+  t.name = "texcoord";
+  t.kind = tsm::AttributeKind::texcoord;
+  t.components = 2;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    const float* p = &m.positions[3 * v];
+    t.values.push_back(0.5f + std::atan2(p[1], p[0]) / 6.2831853f);
+    t.values.push_back(0.5f + std::asin(std::max(-1.0f, std::min(1.0f, p[2]))) / 3.1415927f);
+  }
+  m.attributes.push_back(t);
   return m;
 }
 

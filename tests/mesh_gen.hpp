@@ -48,6 +48,9 @@ tsm::Mesh jittered(tsm::Mesh m, float amplitude, uint32_t seed);
 // (stitches): irregular runs, as on a scan (the fast levels' run tables).
 tsm::Mesh irregular_grid(int n, uint32_t seed);
 
+// Every face gets vertices of its own carrying its normal (flat shading,
+// glTF style).
+tsm::Mesh flat_shaded(const tsm::Mesh& in);
 // icosphere(level) flat-shaded as a glTF exporter writes it: a vertex per
 // corner, a `normal` vertex attribute (the face's), and a `texcoord` vertex
 // attribute (spherical, from the position: equal on the split vertices of one

@@ -30,32 +30,6 @@ Attribute vertex_attribute(const std::string& name, AttributeKind kind, uint32_t
   return a;
 }
 
-// Every face gets vertices of its own carrying its normal (flat shading,
-// glTF style).
-Mesh flat_shaded(const Mesh& in) {
-  Mesh m;
-  Attribute n = vertex_attribute("normal", AttributeKind::normal, 3);
-  for (uint32_t f = 0; f < in.face_count(); ++f) {
-    const uint32_t* c = in.face(f);
-    const float* a = &in.positions[3 * size_t{c[0]}];
-    const float* b = &in.positions[3 * size_t{c[1]}];
-    const float* d = &in.positions[3 * size_t{c[2]}];
-    const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    float nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const float len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-    std::vector<uint32_t> corners;
-    for (uint32_t k = 0; k < in.face_size(f); ++k) {
-      const float* p = &in.positions[3 * size_t{c[k]}];
-      corners.push_back(static_cast<uint32_t>(m.vertex_count()));
-      m.add_vertex(p[0], p[1], p[2]);
-      for (float x : nn) n.values.push_back(len > 0 ? x / len : 0.0f);
-    }
-    m.add_face(corners.data(), corners.size());
-  }
-  m.attributes = {n};
-  return m;
-}
-
 // A sphere with spherical UVs per vertex and a seam: the faces on one side
 // of the seam use copies of its vertices with u + 1.
 Mesh uv_seam_sphere(int level) {
