@@ -163,6 +163,15 @@ tsm::EncodeOptions encode_options(int quantization_bits, int level, uint32_t seg
   return o;
 }
 
+// Encodes with the GIL released; tsmcodec.Error on failure.
+std::string encode_released(const tsm::Mesh& mesh, const tsm::EncodeOptions& options,
+                            tsm::EncodeMapping* mapping = nullptr) {
+  std::string out;
+  py::gil_scoped_release release;
+  check(tsm::encode(mesh, options, out, mapping));
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_tsmcodec, m) {
@@ -223,15 +232,8 @@ PYBIND11_MODULE(_tsmcodec, m) {
       "encode",
       [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads, bool keep_order,
          bool lossless, bool allow_nonfinite) {
-        std::string out;
-        {
-          py::gil_scoped_release release;
-          check(tsm::encode(
-              mesh,
-              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
-              out));
-        }
-        return py::bytes(out);
+        return py::bytes(encode_released(
+            mesh, encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite)));
       },
       py::arg("mesh"), py::kw_only(), py::arg("quantization_bits") = tsm::kDefaultQuantizationBits,
       py::arg("level") = tsm::kDefaultLevel, py::arg("segment_faces") = 0, py::arg("threads") = 0,
@@ -242,15 +244,10 @@ PYBIND11_MODULE(_tsmcodec, m) {
       "encode_mapped",
       [](const tsm::Mesh& mesh, int quantization_bits, int level, uint32_t segment_faces, int threads, bool keep_order,
          bool lossless, bool allow_nonfinite) {
-        std::string out;
         tsm::EncodeMapping map;
-        {
-          py::gil_scoped_release release;
-          check(tsm::encode(
-              mesh,
-              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
-              out, &map));
-        }
+        const std::string out = encode_released(
+            mesh, encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
+            &map);
         py::dict d;
         d["vertex_from"] = to_array(map.vertex_from, 1);
         d["face_from"] = to_array(map.face_from, 1);
@@ -275,15 +272,8 @@ PYBIND11_MODULE(_tsmcodec, m) {
             add_attribute(mesh, name, item.second, kind, "vertex", "f32", py::none());
           }
         }
-        std::string out;
-        {
-          py::gil_scoped_release release;
-          check(tsm::encode(
-              mesh,
-              encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite),
-              out));
-        }
-        return py::bytes(out);
+        return py::bytes(encode_released(
+            mesh, encode_options(quantization_bits, level, segment_faces, threads, keep_order, lossless, allow_nonfinite)));
       },
       py::arg("positions"), py::arg("faces"), py::arg("attributes") = py::none(), py::kw_only(),
       py::arg("quantization_bits") = tsm::kDefaultQuantizationBits, py::arg("level") = tsm::kDefaultLevel,
