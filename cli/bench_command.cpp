@@ -18,6 +18,7 @@
 
 #include "bench_assets.hpp"
 #include "bench_draco.hpp"
+#include "bench_simplify.hpp"
 #include "bench_timing.hpp"
 #include "cli_util.hpp"
 #include "tsm/compare.hpp"
@@ -107,11 +108,12 @@ Mesh generated_sphere(int rings, int segments) {
 }  // namespace
 
 int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::vector<int>& qbits, int runs, int level,
-              bool quiet, bool browser) {
+              bool quiet, bool browser, const std::vector<double>& simplify_bounds) {
   std::vector<std::string> meshes = meshes_in.empty() ? default_meshes() : meshes_in;
   std::vector<Row> rows;
   std::vector<ReadRow> reads;
   std::vector<AssetRow> assets;
+  std::vector<SimplifyRow> simplified;
   // The compressed glTF files, kept until the browser has decoded them.
   std::string work_dir = (std::filesystem::temp_directory_path() / "tsm-bench-XXXXXX").string();
   if (!mkdtemp(work_dir.data())) work_dir = ".";
@@ -228,6 +230,10 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       }
       rows.push_back(std::move(row));
     }
+    for (double pct : simplify_bounds) {
+      simplified.push_back(bench_simplify(mesh, rr.mesh, pct, quiet));
+      if (!simplified.back().error.empty()) failures.push_back(rr.mesh + ": " + simplified.back().error);
+    }
   }
 
   if (browser && !assets.empty()) {
@@ -279,6 +285,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       doc["reads"].push_back(
           {{"mesh", r.mesh}, {"tsm_ms", rounded(r.tsm_ms, 1e3)}, {"draco_ms", rounded(r.draco_ms, 1e3)}});
     doc["assets"] = asset_rows_json(assets);
+    if (!simplify_bounds.empty()) doc["simplify"] = simplify_rows_json(simplified);
     doc["failures"] = failures.size();
     std::printf("%s\n", doc.dump(2, ' ', false, ojson::error_handler_t::replace).c_str());
     return failures.empty() ? kExitOk : kExitBadInput;
@@ -315,6 +322,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
     }
   }
   if (!assets.empty()) print_asset_table(assets, browser);
+  if (!simplified.empty()) print_simplify_table(simplified);
   if (!reads.empty()) {
     std::printf("\n| mesh | tsm read ms | Draco read ms | Draco/tsm |\n|---|---:|---:|---:|\n");
     for (const ReadRow& r : reads)

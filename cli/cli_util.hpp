@@ -53,7 +53,9 @@ std::string default_corpus_dir();
 // The default mesh for demos: data/dragon_vrip.ply in the source tree, or "".
 std::string default_mesh_path();
 
+// simplify_bounds: percentages of the diagonal for the simplification table
+// (none: no table).
 int run_bench(const std::vector<std::string>& meshes, bool json, const std::vector<int>& qbits,
-              int runs, int level, bool quiet, bool browser);
+              int runs, int level, bool quiet, bool browser, const std::vector<double>& simplify_bounds);
 
 }  // namespace tsm::cli

@@ -279,6 +279,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> bench_meshes;
   bool bench_json = false, bench_quiet = false, bench_browser = false;
   std::vector<int> bench_q{11, 14};
+  std::vector<double> bench_simplify;
   int bench_runs = 3, bench_level = kDefaultLevel;
   CLI::App* ben = app.add_subcommand(
       "bench", "Compare tsm with Draco (cl7, cl10) on meshes, and with draco_transcoder and gltfpack on glTF assets");
@@ -291,9 +292,15 @@ int main(int argc, char** argv) {
   ben->add_flag("--browser", bench_browser,
                 "glTF assets: also decode time in headless Chromium beside draco3d and meshopt (needs the source "
                 "tree's web/ set up: bash web/test.sh)");
+  ben->add_option("--simplify", bench_simplify,
+                  "Meshes other than glTF: also simplify under these bounds (% of the diagonal, e.g. 0.1,0.5,1) "
+                  "beside meshoptimizer's simplifier at the same measured distance")
+      ->delimiter(',')
+      ->check(CLI::Range(1e-6, 100.0));
   ben->footer(
       "Examples:\n"
       "  tsm bench ../shared/corpus/bun_zipper.ply -q 11 -q 14 --runs 5\n"
+      "  tsm bench ../shared/corpus/bun_zipper.ply -q 14 --simplify 0.1,0.5,1\n"
       "  tsm bench --json --quiet > bench.json");
 
   CompareArgs ca;
@@ -346,7 +353,8 @@ int main(int argc, char** argv) {
     if (*inf) return cmd_info(ia);
     if (*cmp) return cmd_compare(ca);
     if (*sim) return cmd_simplify(sa);
-    if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet, bench_browser);
+    if (*ben) return run_bench(bench_meshes, bench_json, bench_q, bench_runs, bench_level, bench_quiet, bench_browser,
+                                 bench_simplify);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "tsm: error: out of memory\n");
     return kExitInternal;

@@ -347,6 +347,39 @@ TEST_F(Cli, BenchOnASmallMesh) {
   EXPECT_NE(r.err.find("bad.ply"), std::string::npos) << r.err;
 }
 
+// The simplification table: tsm within each bound it was given, and
+// meshoptimizer (required in CI) within it too by the same measurement.
+TEST_F(Cli, BenchSimplifiesBesideMeshoptimizer) {
+  write_input("small.ply");
+  Result r = tsm("bench " + q("small.ply") + " --runs 1 -q 8 --simplify 2,5 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(doc.contains("simplify")) << r.out;
+  ASSERT_EQ(doc["simplify"].size(), 2u) << r.out;
+  size_t previous = SIZE_MAX;
+  for (const auto& row : doc["simplify"]) {
+    const double bound = row["bound_percent"].get<double>();
+    EXPECT_EQ(row["faces"].get<size_t>(), 320u);
+    const size_t faces = row["tsm_faces"].get<size_t>();
+    EXPECT_LT(faces, 320u) << row;
+    EXPECT_LE(faces, previous) << "a looser bound keeps no more triangles";
+    previous = faces;
+    EXPECT_LE(row["tsm_measured_percent"].get<double>(), bound) << row;
+    EXPECT_GE(row["tsm_measured_bound_percent"].get<double>(), row["tsm_measured_percent"].get<double>()) << row;
+    if (!row.contains("meshopt_faces")) {
+      EXPECT_FALSE(tsm_test::running_in_ci()) << "meshoptimizer (libmeshoptimizer-dev) is required in CI";
+      continue;
+    }
+    EXPECT_LE(row["meshopt_faces"].get<size_t>(), 320u) << row;
+    EXPECT_LE(row["meshopt_measured_percent"].get<double>(), bound) << row;
+  }
+  r = tsm("bench " + q("small.ply") + " --runs 1 -q 8 --simplify 1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("| small.ply | 320 | 1% |"), std::string::npos) << r.out;
+  r = tsm("bench " + q("small.ply") + " --simplify 0");
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+}
+
 // ---------------------------------------------------------------- many files, pipes, safety
 
 // Lines of a text.

@@ -83,7 +83,7 @@ struct Piece {
 };
 
 constexpr uint32_t kMaxPieceDepth = 4;  // a piece is cut at most this many times (4^4 parts)
-constexpr uint32_t kMaxCheckDepth = 4;  // a new triangle is cut at most this many times
+constexpr uint32_t kMaxCheckDepth = 5;  // a new triangle is cut at most this many times
 // kLocked: the vertex never moves or goes; kKeep: it may move but never goes.
 constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4, kKeep = 8;
 
@@ -115,7 +115,14 @@ class Simplifier {
     uint32_t u, v;  // u goes, v stays (at x)
     Vec3 x;
   };
-  std::vector<Place> placements(uint32_t a, uint32_t b, const Quadric& q) const;
+  struct Places {
+    Place at[4];
+    int count = 0;
+    const Place* begin() const { return at; }
+    const Place* end() const { return at + count; }
+    void push_back(const Place& p) { at[count++] = p; }
+  };
+  Places placements(uint32_t a, uint32_t b, const Quadric& q) const;
   bool try_collapse(uint32_t u, uint32_t v);
   bool topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris);
   bool attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris);
@@ -150,6 +157,10 @@ class Simplifier {
   std::vector<uint32_t> comp_live_;  // per component: live triangles
   std::vector<Quadric> quad_;
   std::vector<uint32_t> stamp_;
+  // Per vertex: the other ends of its edges whose collapse was refused, tried
+  // again once the vertex's neighbourhood changes (an edge still queued
+  // keeps its cost: only the kept vertex's position and quadric change).
+  std::vector<std::vector<uint32_t>> refused_;
   std::vector<double> param_;  // per vertex: scratch
   uint64_t live_ = 0;
   std::priority_queue<Candidate> heap_;
@@ -173,12 +184,18 @@ class Simplifier {
   std::vector<uint32_t> new_tris_;                  // changed triangles that stay (with u or v replaced by the moved v)
   std::vector<uint32_t> near_tris_;                 // unchanged live triangles around, also able to take pieces
   std::vector<std::pair<uint32_t, Piece>> placed_;  // triangle, piece (an attempt's assignments)
-  struct NearCache {
+  // Nearest original triangles of the points met in one try_collapse
+  // (corners and cut points are shared between neighbouring triangles and
+  // between placements): open addressing, emptied by a new generation.
+  struct NearEntry {
     Vec3 p;
     double d;
     int64_t t;
+    uint32_t gen = 0;
   };
-  std::vector<NearCache> near_cache_;
+  std::vector<NearEntry> near_cache_ = std::vector<NearEntry>(1u << 12);
+  uint32_t near_gen_ = 1, near_used_ = 0;
+  void clear_near_cache() { ++near_gen_, near_used_ = 0; }
   std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original
                                       // triangles of points met in one try_collapse
 
@@ -196,6 +213,7 @@ void Simplifier::build() {
   vtris_.assign(nv, {});
   flags_.assign(nv, 0);
   stamp_.assign(nv, 0);
+  refused_.assign(nv, {});
   for (size_t i = 0; i < in_.attributes.size(); ++i) {
     const Attribute& a = in_.attributes[i];
     if (a.domain == AttributeDomain::vertex) {
@@ -515,15 +533,28 @@ bool Simplifier::assign_piece(const Piece& pc) {
 // (corners and edge midpoints shared by the new triangles, the ring's
 // vertices for every placement tried) come from a small cache.
 bool Simplifier::nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint) {
-  for (const NearCache& c : near_cache_)
+  if (2 * (near_used_ + 1) > near_cache_.size()) {
+    // Full: start again twice as large (the entries are only a cache).
+    near_cache_.assign(2 * near_cache_.size(), {});
+    near_gen_ = 1, near_used_ = 0;
+  }
+  uint64_t bits[3];
+  std::memcpy(&bits[0], &p.x, 8), std::memcpy(&bits[1], &p.y, 8), std::memcpy(&bits[2], &p.z, 8);
+  uint64_t h = (bits[0] * 0x9E3779B97F4A7C15ull) ^ (bits[1] * 0xC2B2AE3D27D4EB4Full) ^ (bits[2] * 0x165667B19E3779F9ull);
+  const size_t mask = near_cache_.size() - 1;
+  size_t i = static_cast<size_t>(h ^ (h >> 29)) & mask;
+  for (; near_cache_[i].gen == near_gen_; i = (i + 1) & mask) {
+    const NearEntry& c = near_cache_[i];
     if (c.p.x == p.x && c.p.y == p.y && c.p.z == p.z) {
       d = c.d, t = c.t;
       return d * d <= e2_;
     }
+  }
   double d2;
   t = bvh_.nearest(p, d2, hint);
   d = std::sqrt(d2);
-  near_cache_.push_back({p, d, t});
+  near_cache_[i] = {p, d, t, near_gen_};
+  ++near_used_;
   return d2 <= e2_;
 }
 
@@ -555,14 +586,9 @@ bool Simplifier::within_original_rec(const Vec3 p[3], const double d[3], const i
   double dm[3];
   int64_t tm[3];
   for (int k = 0; k < 3; ++k) {
-    if (depth == 0) {
-      // The new triangles' edge midpoints: shared between neighbours.
-      if (!nearest_original(m[k], dm[k], tm[k], t[k])) return false;
-      continue;
-    }
-    tm[k] = bvh_.nearest(m[k], dm[k], t[k]);
-    if (dm[k] > e2_) return false;
-    dm[k] = std::sqrt(dm[k]);
+    // Cut points are shared with the neighbouring part (and at the first
+    // cut with the neighbouring new triangle).
+    if (!nearest_original(m[k], dm[k], tm[k], t[k])) return false;
   }
   const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
              c3[3] = {m[0], m[1], m[2]};
@@ -714,24 +740,32 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
     }
   }
   ++collapses_;
-  // New candidates around v.
+  // New candidates: v's edges, and the refused edges of v's ring (each once).
   ++stamp_[v];
-  std::vector<uint32_t> ring;
+  refused_[u].clear();
+  refused_[v].clear();
+  push_edges_of(v);
+  std::vector<std::pair<uint32_t, uint32_t>> again;
   for (uint32_t t : vtris_[v])
     for (uint32_t w : tri_[t])
-      if (w != v) ring.push_back(w);
-  std::sort(ring.begin(), ring.end());
-  ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-  for (uint32_t w : ring) ++stamp_[w];
-  push_edges_of(v);
-  for (uint32_t w : ring) push_edges_of(w);
+      if (w != v) {
+        for (uint32_t x : refused_[w])
+          if (x != v && !(flags_[x] & kRemoved)) again.push_back({std::min(w, x), std::max(w, x)});
+        refused_[w].clear();
+      }
+  std::sort(again.begin(), again.end());
+  again.erase(std::unique(again.begin(), again.end()), again.end());
+  for (const auto& [a, b] : again) {
+    Candidate c;
+    if (candidate_for(a, b, c)) heap_.push(c);
+  }
 }
 
 // Where the edge (a, b) may collapse to, cheapest first: the quadric
 // optimum, the midpoint, the endpoints; only into a vertex that stays (not
 // kLocked / kKeep going), only at a vertex that cannot move.
-std::vector<Simplifier::Place> Simplifier::placements(uint32_t a, uint32_t b, const Quadric& q) const {
-  std::vector<Place> places;
+Simplifier::Places Simplifier::placements(uint32_t a, uint32_t b, const Quadric& q) const {
+  Places places;
   auto can_go = [&](uint32_t w) { return !(flags_[w] & (kLocked | kKeep)); };
   auto can_move = [&](uint32_t w) { return !(flags_[w] & kLocked); };
   uint32_t u = a, v = b;  // u goes
@@ -748,14 +782,15 @@ std::vector<Simplifier::Place> Simplifier::placements(uint32_t a, uint32_t b, co
     if (can_go(v) && can_move(u)) places.push_back({q.eval(pos_[u]), v, u, pos_[u]});
   }
   places.push_back({q.eval(pos_[v]), u, v, pos_[v]});
-  std::stable_sort(places.begin(), places.end(), [](const Place& x1, const Place& x2) { return x1.cost < x2.cost; });
+  for (int i = 1; i < places.count; ++i)  // cheapest first, ties in the order above
+    for (int j = i; j > 0 && places.at[j].cost < places.at[j - 1].cost; --j) std::swap(places.at[j], places.at[j - 1]);
   return places;
 }
 
 bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
   std::vector<uint32_t> edge_tris;
   if (!topology_ok(a, b, edge_tris)) return false;
-  near_cache_.clear();
+  clear_near_cache();
   Quadric q = quad_[a];
   q.add(quad_[b]);
   for (const Place& p : placements(a, b, q))
@@ -837,7 +872,11 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
     heap_.pop();
     if ((flags_[c.u] | flags_[c.v]) & kRemoved) continue;
     if (stamp_[c.u] != c.stamp_u || stamp_[c.v] != c.stamp_v) continue;
-    if (!try_collapse(c.u, c.v)) ++rejected_;
+    if (!try_collapse(c.u, c.v)) {
+      ++rejected_;
+      refused_[c.u].push_back(c.v);
+      refused_[c.v].push_back(c.u);
+    }
     if (o_.progress && ++since >= 256) {
       since = 0;
       o_.progress(live_faces(), report.faces_in, o_.progress_user);

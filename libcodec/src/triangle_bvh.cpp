@@ -77,31 +77,45 @@ TriangleBvh::TriangleBvh(const TriangleSet& set) : set_(set) {
   if (n == 0) return;
   order_.resize(n);
   std::vector<Vec3> centroid(n);
+  std::vector<Box> box(n);
   for (size_t t = 0; t < n; ++t) {
     order_[t] = static_cast<uint32_t>(t);
     centroid[t] = (set.corner(t, 0) + set.corner(t, 1) + set.corner(t, 2)) * (1.0 / 3);
+    box[t] = triangle_box(set, t);
   }
   nodes_.reserve(2 * n / 2 + 1);
   nodes_.push_back({});
-  build(0, 0, static_cast<uint32_t>(n), centroid);
+  build(0, 0, static_cast<uint32_t>(n), centroid, box);
+  leaf_box_.resize(n);
+  for (size_t i = 0; i < n; ++i) leaf_box_[i] = box[order_[i]];
 }
 
-void TriangleBvh::build(uint32_t node, uint32_t begin, uint32_t end, std::vector<Vec3>& centroid) {
+// A float box holding the double triangle: each bound rounded outwards once.
+TriangleBvh::Box TriangleBvh::triangle_box(const TriangleSet& set, size_t t) {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  Box b;
+  for (int a = 0; a < 3; ++a) b.lo[a] = inf, b.hi[a] = -inf;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = set.corner(t, k);
+    const double q[3] = {p.x, p.y, p.z};
+    for (int a = 0; a < 3; ++a) {
+      const float f = static_cast<float>(q[a]);
+      b.lo[a] = std::min(b.lo[a], static_cast<double>(f) <= q[a] ? f : std::nextafter(f, -inf));
+      b.hi[a] = std::max(b.hi[a], static_cast<double>(f) >= q[a] ? f : std::nextafter(f, inf));
+    }
+  }
+  return b;
+}
+
+void TriangleBvh::build(uint32_t node, uint32_t begin, uint32_t end, std::vector<Vec3>& centroid,
+                        const std::vector<Box>& box) {
   float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
                  std::numeric_limits<float>::max()};
   float hi[3] = {-lo[0], -lo[0], -lo[0]};
   double clo[3] = {1e300, 1e300, 1e300}, chi[3] = {-1e300, -1e300, -1e300};
   for (uint32_t i = begin; i < end; ++i) {
     const uint32_t t = order_[i];
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 p = set_.corner(t, k);
-      const double q[3] = {p.x, p.y, p.z};
-      for (int a = 0; a < 3; ++a) {
-        // Rounded outwards so that the float box holds the double triangle.
-        lo[a] = std::min(lo[a], std::nextafter(static_cast<float>(q[a]), -std::numeric_limits<float>::infinity()));
-        hi[a] = std::max(hi[a], std::nextafter(static_cast<float>(q[a]), std::numeric_limits<float>::infinity()));
-      }
-    }
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], box[t].lo[a]), hi[a] = std::max(hi[a], box[t].hi[a]);
     const double c[3] = {centroid[t].x, centroid[t].y, centroid[t].z};
     for (int a = 0; a < 3; ++a) clo[a] = std::min(clo[a], c[a]), chi[a] = std::max(chi[a], c[a]);
   }
@@ -124,18 +138,8 @@ void TriangleBvh::build(uint32_t node, uint32_t begin, uint32_t end, std::vector
   nodes_[node].count = 0;
   nodes_.push_back({});
   nodes_.push_back({});
-  build(child, begin, mid, centroid);
-  build(child + 1, mid, end, centroid);
-}
-
-double TriangleBvh::box_dist2(const Node& n, Vec3 p) const {
-  const double q[3] = {p.x, p.y, p.z};
-  double d2 = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double d = q[a] < n.lo[a] ? n.lo[a] - q[a] : q[a] > n.hi[a] ? q[a] - n.hi[a] : 0.0;
-    d2 += d * d;
-  }
-  return d2;
+  build(child, begin, mid, centroid, box);
+  build(child + 1, mid, end, centroid, box);
 }
 
 int64_t TriangleBvh::nearest(Vec3 p, double& dist2, int64_t hint) const {
@@ -159,6 +163,7 @@ int64_t TriangleBvh::nearest(Vec3 p, double& dist2, int64_t hint) const {
     const Node& n = nodes_[it.node];
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+        if (box_dist2(leaf_box_[i], p) >= dist2) continue;  // cheaper than the exact distance
         const uint32_t t = order_[i];
         const double d2 = point_triangle_dist2(p, set_.corner(t, 0), set_.corner(t, 1), set_.corner(t, 2));
         if (d2 < dist2) dist2 = d2, best = t;

@@ -52,12 +52,27 @@ class TriangleBvh {
     float lo[3], hi[3];
     uint32_t first, count;  // leaf: triangles order_[first..first+count); inner: count = 0, children first, first+1
   };
-  void build(uint32_t node, uint32_t begin, uint32_t end, std::vector<Vec3>& centroid);
-  double box_dist2(const Node& n, Vec3 p) const;
+  struct Box {
+    float lo[3], hi[3];
+  };
+  static Box triangle_box(const TriangleSet& set, size_t t);
+  void build(uint32_t node, uint32_t begin, uint32_t end, std::vector<Vec3>& centroid, const std::vector<Box>& box);
+  static double box_dist2(const float* lo, const float* hi, Vec3 p) {
+    const double q[3] = {p.x, p.y, p.z};
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = q[a] < lo[a] ? lo[a] - q[a] : q[a] > hi[a] ? q[a] - hi[a] : 0.0;
+      d2 += d * d;
+    }
+    return d2;
+  }
+  static double box_dist2(const Node& n, Vec3 p) { return box_dist2(n.lo, n.hi, p); }
+  static double box_dist2(const Box& b, Vec3 p) { return box_dist2(b.lo, b.hi, p); }
 
   const TriangleSet& set_;
   std::vector<Node> nodes_;
   std::vector<uint32_t> order_;
+  std::vector<Box> leaf_box_;  // per position in order_: its triangle's box
 };
 
 template <typename F>
