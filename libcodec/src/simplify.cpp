@@ -196,8 +196,9 @@ class Simplifier {
   std::vector<NearEntry> near_cache_ = std::vector<NearEntry>(1u << 12);
   uint32_t near_gen_ = 1, near_used_ = 0;
   void clear_near_cache() { ++near_gen_, near_used_ = 0; }
-  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces  // nearest original
-                                      // triangles of points met in one try_collapse
+  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
+  std::vector<uint32_t> orig_mark_;   // per original triangle: orig_mark_gen_ when in local_orig_
+  uint32_t orig_mark_gen_ = 0;
 
   uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
 };
@@ -252,6 +253,7 @@ void Simplifier::build() {
   for (uint32_t v = 0; v < nv; ++v) had_faces_[v] = !vtris_[v].empty();
   live_ = tri_.size();
   pieces_.resize(tri_.size());
+  orig_mark_.assign(tri_.size(), 0);
   tri_pieces_.assign(tri_.size(), {});
   for (uint32_t t = 0; t < tri_.size(); ++t) {
     for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
@@ -633,11 +635,14 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
   // First the original triangles whose pieces the changed triangles hold:
   // a new triangle within E of one of them needs no search.
   local_orig_.clear();
-  for (uint32_t t : changed_)
-    for (uint32_t pi : tri_pieces_[t])
-      if (local_orig_.size() < 64 &&
-          std::find(local_orig_.begin(), local_orig_.end(), pieces_[pi].orig) == local_orig_.end())
-        local_orig_.push_back(pieces_[pi].orig);
+  ++orig_mark_gen_;
+  for (size_t i = 0; i < changed_.size() && local_orig_.size() < 64; ++i)
+    for (uint32_t pi : tri_pieces_[changed_[i]]) {
+      const uint32_t o = pieces_[pi].orig;
+      if (orig_mark_[o] == orig_mark_gen_ || local_orig_.size() >= 64) continue;
+      orig_mark_[o] = orig_mark_gen_;
+      local_orig_.push_back(o);
+    }
   for (uint32_t t : new_tris_) {
     const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
     bool near = false;
