@@ -154,16 +154,44 @@ std::vector<uint32_t> anchor_keys(const Mesh& mesh, const ConnectivityEncoding& 
   return by_input;
 }
 
+// Puts the output vertices on no triangle in the order the cut gives them
+// with anchors (stably by anchor `key`, then grid position): a vertex on no
+// triangle is a component of its own, coded alike wherever it comes, so
+// when no face names one (no side face: then the topology stream would
+// change) the second pass would code the same streams in this order.
+// Returns false when a face names one.
+bool sort_by_anchor(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint32_t>& key,
+                    ConnectivityEncoding& ce) {
+  const uint32_t n = ce.layout.vertex_count;
+  std::vector<uint8_t> on_triangle(n, 0), input_on(mesh.vertex_count(), 0);
+  for (uint32_t v : ce.layout.corners())
+    if (v != kNone) on_triangle[v] = 1;
+  for (uint32_t v = 0; v < n; ++v) input_on[ce.vertex_order[v]] = on_triangle[v];
+  for (uint32_t v : mesh.indices)
+    if (!input_on[v]) return false;
+  std::vector<uint32_t> at, ids;
+  for (uint32_t v = 0; v < n; ++v)
+    if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
+  std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+    if (key[a] != key[b]) return key[a] < key[b];
+    return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
+                                        &qin[3 * size_t{b}] + 3);
+  });
+  for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
+  return true;
+}
+
 // The anchor step of part_connectivity on its first pass `ce`: when vertices
-// on no triangle have an anchor, a second pass that orders them by it.
+// on no triangle have an anchor, a second pass that orders them by it (or
+// the same order found without coding again, sort_by_anchor).
 Status anchor_step(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                    int bits, CutHints hints, ConnectivityEncoding& ce, OwnView& view) {
   const std::vector<uint32_t> by_input = anchor_keys(mesh, ce, view, bits);
   if (!by_input.empty()) {
-    if (in_anchor_order(ce, by_input)) {
-      // The cut would keep its order (a decoded mesh, in canonical rounds):
-      // the second pass would code the same streams, so only hand the
-      // anchors to the geometry coder.
+    if (in_anchor_order(ce, by_input) || sort_by_anchor(mesh, qin, by_input, ce)) {
+      // The cut would keep its order (a decoded mesh, in canonical rounds)
+      // or sort_by_anchor found it: the second pass would code the same
+      // streams, so only hand the anchors to the geometry coder.
       for (uint32_t v = 0; v < ce.layout.vertex_count; ++v) ce.layout.anchor[v] = by_input[ce.vertex_order[v]];
     } else {
       ce = ConnectivityEncoding();
@@ -280,7 +308,9 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
                                       [&](uint32_t v) { return !on_triangle[v]; });
   const bool full_round0 = side_named || same_faces(decoded0, mesh);
   if (full_round0) {
-    TSM_RETURN_IF_ERROR(code(mesh));
+    // (code(mesh) again, with the anchor step: the step on this coding.)
+    TSM_RETURN_IF_ERROR(anchor_step(mesh, qin, is_ref, options.quantization_bits,
+                                    part_hints(mesh, qin, options, tree), ce, view));
     if (ce.stats.stitches == 0) return Status::Ok();
   } else {
     // What the step would change for round 1: unless their anchors are in
