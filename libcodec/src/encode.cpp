@@ -243,6 +243,28 @@ int canonical_rounds(size_t faces) {
 
 bool same_faces(const Mesh& a, const Mesh& b) { return a.indices == b.indices && a.face_offsets == b.face_offsets; }
 
+// The faces decode_connectivity gives for `ce`'s streams (indices and face
+// offsets), decoded, or read off the layout when every face is a triangle
+// of the cut surface (no polygons, no side faces): there the decoder's
+// faces are the layout's triangles in decode order, less those on a virtual
+// vertex (the geometry coder sees the same layout on both sides).
+Status decoded_faces(const ConnectivityEncoding& ce, const Mesh& mesh, Mesh& out) {
+  if (ce.stats.polygons != 0 || ce.stats.side_faces != 0) {
+    GeometryLayout scratch;
+    return decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(), out, scratch);
+  }
+  const std::vector<uint32_t>& corner = ce.layout.corners();
+  out.indices.clear();
+  out.indices.reserve(mesh.corner_count());
+  for (size_t k = 0; k + 2 < corner.size(); k += 3)
+    if (corner[k] != kNone && corner[k + 1] != kNone && corner[k + 2] != kNone)
+      out.indices.insert(out.indices.end(), corner.begin() + static_cast<std::ptrdiff_t>(k),
+                         corner.begin() + static_cast<std::ptrdiff_t>(k + 3));
+  out.face_offsets.resize(out.indices.size() / 3 + 1);
+  for (size_t f = 0; f < out.face_offsets.size(); ++f) out.face_offsets[f] = static_cast<uint32_t>(3 * f);
+  return Status::Ok();
+}
+
 // The order of the codings on a cycle: by their streams' size, then bytes,
 // with the stitch targets coded as distances (ConnectivityEncoding::
 // distance_topology; any fixed order would do, this one keeps the bytes
@@ -295,10 +317,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     return anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce,
                        view);
   Mesh decoded0;
-  {
-    GeometryLayout scratch;
-    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded0, scratch));
-  }
+  TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, decoded0));
   // (Vertices on no triangle that side faces name: the step changes those
   // faces, so round 0 is coded whole as well.)
   std::vector<uint8_t> on_triangle(n, 0);
@@ -339,12 +358,10 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   const int rounds = canonical_rounds(mesh.face_count());
   for (int round = 0; round < rounds; ++round) {
     Mesh decoded;
-    GeometryLayout scratch;
     if (round == 0 && !full_round0)
       decoded = std::move(decoded0);
     else
-      TSM_RETURN_IF_ERROR(
-          decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
+      TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, decoded));
     const Mesh& now = round == 0 ? mesh : coded;
     if (same_faces(decoded, now)) {
       // Output vertex v as `now`'s vertex v, when every vertex is on a face
@@ -435,9 +452,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
-    GeometryLayout scratch;
-    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(),
-                                            out.faces, scratch));
+    TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, out.faces));
     out.ref_out.resize(mark.size());
     for (size_t v = 0; v < mark.size(); ++v) out.ref_out[v] = mark[v] != kNone;
     out.q = std::move(q);
