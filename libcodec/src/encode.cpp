@@ -89,9 +89,17 @@ OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qi
   if (!is_ref.empty())
     for (size_t v = 0; v < n; ++v)
       if (is_ref[ce.vertex_order[v]]) w.mark[v] = 0;
+  w.q.resize(3 * n);
+  size_t k = 0;
   for (size_t v = 0; v < n; ++v)
-    if (w.mark[v] == kNone)
-      for (int a = 0; a < 3; ++a) w.q.push_back(qin[3 * static_cast<size_t>(ce.vertex_order[v]) + a]);
+    if (w.mark[v] == kNone) {
+      const uint32_t* p = &qin[3 * static_cast<size_t>(ce.vertex_order[v])];
+      w.q[k] = p[0];
+      w.q[k + 1] = p[1];
+      w.q[k + 2] = p[2];
+      k += 3;
+    }
+  w.q.resize(k);
   w.layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, w.mark);
   return w;
 }
