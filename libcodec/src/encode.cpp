@@ -336,8 +336,8 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   const bool full_round0 = side_named || same_faces(decoded0, mesh);
   if (full_round0) {
     // (code(mesh) again, with the anchor step: the step on this coding.)
-    TSM_RETURN_IF_ERROR(anchor_step(mesh, qin, is_ref, options.quantization_bits,
-                                    part_hints(mesh, qin, options, tree), ce, view));
+    TSM_RETURN_IF_ERROR(
+        anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce, view));
     if (ce.stats.stitches == 0) return Status::Ok();
   } else {
     // What the step would change for round 1: unless their anchors are in
