@@ -89,9 +89,17 @@ OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qi
   if (!is_ref.empty())
     for (size_t v = 0; v < n; ++v)
       if (is_ref[ce.vertex_order[v]]) w.mark[v] = 0;
+  w.q.resize(3 * n);
+  size_t k = 0;
   for (size_t v = 0; v < n; ++v)
-    if (w.mark[v] == kNone)
-      for (int a = 0; a < 3; ++a) w.q.push_back(qin[3 * static_cast<size_t>(ce.vertex_order[v]) + a]);
+    if (w.mark[v] == kNone) {
+      const uint32_t* p = &qin[3 * static_cast<size_t>(ce.vertex_order[v])];
+      w.q[k] = p[0];
+      w.q[k + 1] = p[1];
+      w.q[k + 2] = p[2];
+      k += 3;
+    }
+  w.q.resize(k);
   w.layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, w.mark);
   return w;
 }
@@ -154,16 +162,44 @@ std::vector<uint32_t> anchor_keys(const Mesh& mesh, const ConnectivityEncoding& 
   return by_input;
 }
 
+// Puts the output vertices on no triangle in the order the cut gives them
+// with anchors (stably by anchor `key`, then grid position): a vertex on no
+// triangle is a component of its own, coded alike wherever it comes, so
+// when no face names one (no side face: then the topology stream would
+// change) the second pass would code the same streams in this order.
+// Returns false when a face names one.
+bool sort_by_anchor(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint32_t>& key,
+                    ConnectivityEncoding& ce) {
+  const uint32_t n = ce.layout.vertex_count;
+  std::vector<uint8_t> on_triangle(n, 0), input_on(mesh.vertex_count(), 0);
+  for (uint32_t v : ce.layout.corners())
+    if (v != kNone) on_triangle[v] = 1;
+  for (uint32_t v = 0; v < n; ++v) input_on[ce.vertex_order[v]] = on_triangle[v];
+  for (uint32_t v : mesh.indices)
+    if (!input_on[v]) return false;
+  std::vector<uint32_t> at, ids;
+  for (uint32_t v = 0; v < n; ++v)
+    if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
+  std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+    if (key[a] != key[b]) return key[a] < key[b];
+    return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
+                                        &qin[3 * size_t{b}] + 3);
+  });
+  for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
+  return true;
+}
+
 // The anchor step of part_connectivity on its first pass `ce`: when vertices
-// on no triangle have an anchor, a second pass that orders them by it.
+// on no triangle have an anchor, a second pass that orders them by it (or
+// the same order found without coding again, sort_by_anchor).
 Status anchor_step(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                    int bits, CutHints hints, ConnectivityEncoding& ce, OwnView& view) {
   const std::vector<uint32_t> by_input = anchor_keys(mesh, ce, view, bits);
   if (!by_input.empty()) {
-    if (in_anchor_order(ce, by_input)) {
-      // The cut would keep its order (a decoded mesh, in canonical rounds):
-      // the second pass would code the same streams, so only hand the
-      // anchors to the geometry coder.
+    if (in_anchor_order(ce, by_input) || sort_by_anchor(mesh, qin, by_input, ce)) {
+      // The cut would keep its order (a decoded mesh, in canonical rounds)
+      // or sort_by_anchor found it: the second pass would code the same
+      // streams, so only hand the anchors to the geometry coder.
       for (uint32_t v = 0; v < ce.layout.vertex_count; ++v) ce.layout.anchor[v] = by_input[ce.vertex_order[v]];
     } else {
       ce = ConnectivityEncoding();
@@ -214,6 +250,28 @@ int canonical_rounds(size_t faces) {
 }
 
 bool same_faces(const Mesh& a, const Mesh& b) { return a.indices == b.indices && a.face_offsets == b.face_offsets; }
+
+// The faces decode_connectivity gives for `ce`'s streams (indices and face
+// offsets), decoded, or read off the layout when every face is a triangle
+// of the cut surface (no polygons, no side faces): there the decoder's
+// faces are the layout's triangles in decode order, less those on a virtual
+// vertex (the geometry coder sees the same layout on both sides).
+Status decoded_faces(const ConnectivityEncoding& ce, const Mesh& mesh, Mesh& out) {
+  if (ce.stats.polygons != 0 || ce.stats.side_faces != 0) {
+    GeometryLayout scratch;
+    return decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(), out, scratch);
+  }
+  const std::vector<uint32_t>& corner = ce.layout.corners();
+  out.indices.clear();
+  out.indices.reserve(mesh.corner_count());
+  for (size_t k = 0; k + 2 < corner.size(); k += 3)
+    if (corner[k] != kNone && corner[k + 1] != kNone && corner[k + 2] != kNone)
+      out.indices.insert(out.indices.end(), corner.begin() + static_cast<std::ptrdiff_t>(k),
+                         corner.begin() + static_cast<std::ptrdiff_t>(k + 3));
+  out.face_offsets.resize(out.indices.size() / 3 + 1);
+  for (size_t f = 0; f < out.face_offsets.size(); ++f) out.face_offsets[f] = static_cast<uint32_t>(3 * f);
+  return Status::Ok();
+}
 
 // The order of the codings on a cycle: by their streams' size, then bytes,
 // with the stitch targets coded as distances (ConnectivityEncoding::
@@ -267,10 +325,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     return anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce,
                        view);
   Mesh decoded0;
-  {
-    GeometryLayout scratch;
-    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded0, scratch));
-  }
+  TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, decoded0));
   // (Vertices on no triangle that side faces name: the step changes those
   // faces, so round 0 is coded whole as well.)
   std::vector<uint8_t> on_triangle(n, 0);
@@ -280,7 +335,9 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
                                       [&](uint32_t v) { return !on_triangle[v]; });
   const bool full_round0 = side_named || same_faces(decoded0, mesh);
   if (full_round0) {
-    TSM_RETURN_IF_ERROR(code(mesh));
+    // (code(mesh) again, with the anchor step: the step on this coding.)
+    TSM_RETURN_IF_ERROR(
+        anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce, view));
     if (ce.stats.stitches == 0) return Status::Ok();
   } else {
     // What the step would change for round 1: unless their anchors are in
@@ -309,12 +366,10 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   const int rounds = canonical_rounds(mesh.face_count());
   for (int round = 0; round < rounds; ++round) {
     Mesh decoded;
-    GeometryLayout scratch;
     if (round == 0 && !full_round0)
       decoded = std::move(decoded0);
     else
-      TSM_RETURN_IF_ERROR(
-          decode_connectivity(ce.streams, n, mesh.face_count(), mesh.corner_count(), decoded, scratch));
+      TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, decoded));
     const Mesh& now = round == 0 ? mesh : coded;
     if (same_faces(decoded, now)) {
       // Output vertex v as `now`'s vertex v, when every vertex is on a face
@@ -405,9 +460,7 @@ Status encode_part_from(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   if (!headers.empty()) {
     // The faces as the decoder will give them, to code face and corner
     // values in its order.
-    GeometryLayout scratch;
-    TSM_RETURN_IF_ERROR(decode_connectivity(ce.streams, mesh.vertex_count(), mesh.face_count(), mesh.corner_count(),
-                                            out.faces, scratch));
+    TSM_RETURN_IF_ERROR(decoded_faces(ce, mesh, out.faces));
     out.ref_out.resize(mark.size());
     for (size_t v = 0; v < mark.size(); ++v) out.ref_out[v] = mark[v] != kNone;
     out.q = std::move(q);

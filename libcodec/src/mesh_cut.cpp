@@ -78,6 +78,12 @@ void root_by_position(CutMesh& m, const std::vector<uint8_t>& on_triangle, const
   }
 }
 
+bool triangles_only(const Mesh& mesh) {
+  for (size_t f = 0; f < mesh.face_count(); ++f)
+    if (mesh.face_offsets[f + 1] - mesh.face_offsets[f] != 3) return false;
+  return true;
+}
+
 }  // namespace
 
 PreparedInput prepare_input(const Mesh& mesh) {
@@ -103,24 +109,49 @@ PreparedInput prepare_input(const Mesh& mesh) {
     out.tri_diagonal.reserve(3 * (tris + tris / 64 + 16));
     poly_of_tri.reserve(tris);
   }
+  if (triangles_only(mesh)) {
+    // The loop below for triangles alone, writing in place (no polygons:
+    // pass 2 has nothing to check).
+    out.tri.resize(corners_in);
+    out.tri_diagonal.resize(corners_in);
+    size_t k = 0;
+    for (uint32_t f = 0; f < faces_in; ++f) {
+      const uint32_t* c = mesh.face(f);
+      if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+        out.side_faces.push_back(f);
+        continue;
+      }
+      out.tri[k] = c[0];
+      out.tri[k + 1] = c[1];
+      out.tri[k + 2] = c[2];
+      k += 3;
+    }
+    out.tri.resize(k);
+    out.tri_diagonal.resize(k);
+    return out;
+  }
   std::vector<uint32_t> corners, sorted;
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     const uint32_t* c = mesh.face(f);
     uint32_t n = mesh.face_size(f);
-    corners.assign(c, c + n);
-    bool degenerate;
-    if (n == 3) {
-      degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
-    } else {
-      sorted.assign(c, c + n);
-      std::sort(sorted.begin(), sorted.end());
-      degenerate = n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+    if (n == 3) {  // a triangle: emit's one fan triangle, without the copies
+      if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+        out.side_faces.push_back(f);
+        continue;
+      }
+      out.tri.insert(out.tri.end(), c, c + 3);
+      out.tri_diagonal.insert(out.tri_diagonal.end(), 3, 0);
+      poly_of_tri.push_back(kNone);
+      continue;
     }
-    if (degenerate) {
+    corners.assign(c, c + n);
+    sorted.assign(c, c + n);
+    std::sort(sorted.begin(), sorted.end());
+    if (n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
       out.side_faces.push_back(f);
       continue;
     }
-    emit(corners, f, n > 3);
+    emit(corners, f, true);
   }
   // Pass 2: a polygon whose diagonal is not used by exactly its two fan
   // triangles cannot be glued back from the triangle tree: keep it verbatim.
