@@ -21,6 +21,9 @@ namespace {
 
 using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 
+// The weight of a collapse's prediction error against its quadric error.
+constexpr double kRegularity = 0.1;
+
 void add_plane(Quadric& q, const double n[3], double d, double w) {
   const double p[4] = {n[0], n[1], n[2], d};
   int k = 0;
@@ -161,10 +164,10 @@ void Collapser::build() {
 
 // Vertices that must stay: those of the faces above, those sharing a grid
 // point with another (the encoder finds base vertices in the decoded base
-// by their grid point), and the vertices on each side of the grid's box
-// (every vertex at the least and the greatest grid index of an axis, so
-// the base mesh has the input's box, hence its grid, and the choice does
-// not depend on the vertex order).
+// by their grid point), and one vertex on each side of the grid's box (the
+// first in grid-point order at the least and the greatest grid index of
+// each axis; the positions are on the grid, so the base mesh has the
+// input's box, hence its grid).
 void Collapser::lock_special() {
   const size_t n = mesh_.vertex_count();
   std::unordered_map<uint64_t, uint32_t> seen;
@@ -176,14 +179,13 @@ void Collapser::lock_special() {
     auto [it, fresh] = seen.emplace(key, i);
     if (!fresh) locked_[i] = locked_[it->second] = dup_[i] = dup_[it->second] = 1;
   }
-  for (int a = 0; a < 3; ++a) {
-    uint32_t lo = 0xFFFFFFFFu, hi = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-      lo = std::min(lo, q_[3 * size_t{i} + a]);
-      hi = std::max(hi, q_[3 * size_t{i} + a]);
+  for (int a = 0; a < 3 && n; ++a) {
+    uint32_t lo = order_[0], hi = order_[0];
+    for (uint32_t i : order_) {
+      if (q_[3 * size_t{i} + a] < q_[3 * size_t{lo} + a]) lo = i;
+      if (q_[3 * size_t{i} + a] > q_[3 * size_t{hi} + a]) hi = i;
     }
-    for (uint32_t i = 0; i < n; ++i)
-      if (q_[3 * size_t{i} + a] == lo || q_[3 * size_t{i} + a] == hi) locked_[i] = extreme_[i] = 1;
+    locked_[lo] = locked_[hi] = extreme_[lo] = extreme_[hi] = 1;
   }
 }
 
@@ -280,13 +282,26 @@ std::vector<Candidate> Collapser::candidates() {
   std::vector<uint32_t> r;
   for (uint32_t u = 0; u < vf_.size(); ++u) {
     if (removed_[u] || locked_[u] || !ring(u, r)) continue;
+    // How far u lies from the centroid of its ring: the decoder predicts
+    // the new vertex there (FORMAT.md §4.8), so collapses of vertices it
+    // predicts well go first.
+    double lap2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      double c = 0;
+      for (uint32_t w : r) c += q_[3 * size_t{w} + a];
+      const double l = q_[3 * size_t{u} + a] - c / static_cast<double>(r.size());
+      lap2 += l * l;
+    }
     for (uint32_t v : r) {
       if (locked_[v]) continue;
       Quadric q = quadric_[u];
       for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
       const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
                            static_cast<double>(q_[3 * size_t{v} + 2])};
-      out.push_back({quadric_at(q, p), rank_[u], rank_[v], u, v});
+      // The quadric error, plus the squared distance above weighted by the
+      // faces' area (the quadric's weight, q[0] + q[4] + q[7]).
+      const double cost = quadric_at(q, p) + kRegularity * lap2 * (q[0] + q[4] + q[7]);
+      out.push_back({cost, rank_[u], rank_[v], u, v});
     }
   }
   std::sort(out.begin(), out.end());
