@@ -2917,7 +2917,7 @@ class LevelMesh:
 class BatchModels:
     def __init__(self):
         self.flag = probs(8)
-        self.start = UIntModel(2)
+        self.start = [UIntModel(2) for _ in range(16)]
         self.dist = [UIntModel(2) for _ in range(16)]
         self.residual = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
 
@@ -2977,10 +2977,16 @@ def decode_batch(payload, level, m):
             continue
         ring = level.ring(v)
         dd = len(ring)
-        ia = m.start.decode(d)
         dist = m.dist[min(dd, 15)].decode(d) + 1
-        if not (ia < dd and 1 <= dist < dd):
+        if not 1 <= dist < dd:
             reject('split ring neighbours')
+        middle = m.start[min(dd, 15)].decode(d)
+        if middle >= dd:
+            reject('split ring neighbours')
+        qv = level.q[v]
+        d2 = [sum((level.q[r][a] - qv[a]) ** 2 for a in range(3)) for r in ring]
+        far = max(range(dd), key=lambda i: (d2[i], -i))
+        ia = (middle + far - dist // 2) % dd
         arc = [ring[(ia + k) % dd] for k in range(dist + 1)]
         qv = level.q[v]
         pred = []

@@ -23,8 +23,8 @@ constexpr int kRingContexts = 16;
 
 struct BatchModels {
   Prob flag[kFlagContexts];
-  UIntModelT<2> start;
-  UIntModelT<2> dist[kRingContexts];  // by ring size
+  UIntModelT<2> start[kRingContexts];  // by ring size
+  UIntModelT<2> dist[kRingContexts];   // by ring size
   SIntModelT<3> residual[kScaleContexts][3];
 };
 
@@ -41,6 +41,23 @@ int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t
     for (int a = 0; a < 3; ++a) span = std::max<int64_t>(span, std::abs(int64_t{p[a]} - int64_t{level.q(v)[a]}));
   }
   return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
+}
+
+// The ring position of v's farthest neighbour (squared grid distance; ties
+// to the lower position): a collapse pulls v's ring out towards the removed
+// vertex, so the split's arc lies mostly around it.
+uint32_t farthest(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring) {
+  uint32_t best = 0;
+  uint64_t most = 0;
+  for (uint32_t i = 0; i < ring.size(); ++i) {
+    uint64_t d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t x = int64_t{level.q(ring[i])[a]} - int64_t{level.q(v)[a]};
+      d2 += static_cast<uint64_t>(x * x);
+    }
+    if (i == 0 || d2 > most) best = i, most = d2;
+  }
+  return best;
 }
 
 int flag_context(size_t degree) { return static_cast<int>(std::min<size_t>(degree, kFlagContexts + 2) - 3); }
@@ -266,8 +283,9 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     const uint32_t ia = position_in(ring, s.y), ix = position_in(ring, s.x);
     const uint32_t dist = (ix + d - ia) % d;
     if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
-    m->start.encode(e, ia);
-    m->dist[std::min<uint32_t>(d, kRingContexts - 1)].encode(e, dist - 1);
+    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    m->dist[ctx].encode(e, dist - 1);
+    m->start[ctx].encode(e, (ia + dist / 2 + d - farthest(level, v, ring)) % d);
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
@@ -339,9 +357,12 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     if (!marked[v]) continue;
     level.ring(v, ring);
     const uint32_t d = static_cast<uint32_t>(ring.size());
-    const uint32_t ia = m->start.decode(dec);
-    const uint32_t dist = m->dist[std::min<uint32_t>(d, kRingContexts - 1)].decode(dec) + 1;
-    if (ia >= d || dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    const uint32_t dist = m->dist[ctx].decode(dec) + 1;
+    if (dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t middle = m->start[ctx].decode(dec);
+    if (middle >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t ia = (middle + farthest(level, v, ring) + d - dist / 2) % d;
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
