@@ -2917,9 +2917,28 @@ class LevelMesh:
 class BatchModels:
     def __init__(self):
         self.flag = probs(8)
-        self.start = UIntModel(2)
+        self.start = [UIntModel(2) for _ in range(16)]
         self.dist = [UIntModel(2) for _ in range(16)]
         self.residual = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
+
+
+def plane_offset(level, qv, ring, nrm, order, e1, e2, qmax):
+    """§4.8: the new vertex's offset on axis order[0] from the tangent plane."""
+    top = abs(nrm[order[0]])
+    if not top > 0:
+        return 0
+    _, ex = math.frexp(top)
+    N = [math.floor(math.ldexp(nrm[a], 15 - ex) + 0.5) for a in range(3)]
+    dd = len(ring)
+    height = 0
+    for a in range(3):
+        c = (sum(level.q[r][a] for r in ring) + dd // 2) // dd
+        height += N[a] * (qv[a] - c)
+    n0 = N[order[0]]
+    t = height - 2 * (N[order[1]] * e1 + N[order[2]] * e2)
+    mm = abs(n0)
+    o = ((-t if n0 < 0 else t) + mm) // (2 * mm)
+    return min(max(o, -qmax), qmax)
 
 
 def decode_batch(payload, level, m):
@@ -2958,10 +2977,16 @@ def decode_batch(payload, level, m):
             continue
         ring = level.ring(v)
         dd = len(ring)
-        ia = m.start.decode(d)
         dist = m.dist[min(dd, 15)].decode(d) + 1
-        if not (ia < dd and 1 <= dist < dd):
+        if not 1 <= dist < dd:
             reject('split ring neighbours')
+        middle = m.start[min(dd, 15)].decode(d)
+        if middle >= dd:
+            reject('split ring neighbours')
+        qv = level.q[v]
+        d2 = [sum((level.q[r][a] - qv[a]) ** 2 for a in range(3)) for r in ring]
+        far = max(range(dd), key=lambda i: (d2[i], -i))
+        ia = (middle + far - dist // 2) % dd
         arc = [ring[(ia + k) % dd] for k in range(dist + 1)]
         qv = level.q[v]
         pred = []
@@ -2978,14 +3003,18 @@ def decode_batch(payload, level, m):
             nrm[0] += e1[1] * e2[2] - e1[2] * e2[1]
             nrm[1] += e1[2] * e2[0] - e1[0] * e2[2]
             nrm[2] += e1[0] * e2[1] - e1[1] * e2[0]
-        rank = [sum(1 for b in range(3) if abs(nrm[b]) > abs(nrm[a]) or (abs(nrm[b]) == abs(nrm[a]) and b < a))
-                for a in range(3)]
-        g = []
+        order = [0, 0, 0]
         for a in range(3):
-            x = pred[a] + m.residual[sc][rank[a]].decode(d)
+            order[sum(1 for b in range(3) if abs(nrm[b]) > abs(nrm[a]) or (abs(nrm[b]) == abs(nrm[a]) and b < a))] = a
+        g = [0, 0, 0]
+        e = [0, 0, 0]
+        for k in (1, 2, 0):
+            e[k] = m.residual[sc][k].decode(d)
+            off = plane_offset(level, qv, ring, nrm, order, e[1], e[2], qmax) if k == 0 else 0
+            x = pred[order[k]] + off + e[k]
             if not 0 <= x <= qmax:
                 reject('a new vertex off the grid')
-            g.append(x)
+            g[order[k]] = x
         if d.truncated():
             reject('refinement splits truncated')
         level.split(v, ring, ia, dist, g)

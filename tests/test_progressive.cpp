@@ -31,6 +31,11 @@ void expect_round_trip(const tsm::Mesh& m, size_t min_batches) {
   ASSERT_TRUE(s.ok()) << s.message();
   const tsm::CompareResult c = tsm::compare_meshes(m, back, tsm::kDefaultQuantizationBits);
   EXPECT_TRUE(c.equal) << c.difference;
+  // Canonical re-encoding: the decoded mesh (the decoder's vertex and face
+  // order) encodes to the same bytes.
+  const std::string again = encode_progressive(back);
+  EXPECT_EQ(again.size(), bytes.size());
+  EXPECT_TRUE(again == bytes) << "decode then encode changed the file";
   tsm::FileInfo fi;
   ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
   EXPECT_GE(fi.batches.size(), min_batches);
@@ -63,6 +68,32 @@ TEST(Progressive, RoundTripHolesAndNonManifold) {
   expect_round_trip(merged(merged(book(5), jittered(icosphere(4), 0.01f, 3)), grid_with_holes(24, 3)), 3);
 }
 TEST(Progressive, RoundTripPolygonsStayInTheBase) { expect_round_trip(merged(cube_quads(), icosphere(4)), 3); }
+
+TEST(Progressive, VertexAndFaceOrderDoNotChangeTheFile) {
+  // The plan depends on grid points and faces only: shuffled vertex ids,
+  // face order and corner rotations give the same bytes.
+  const tsm::Mesh m = icosphere(4);  // symmetric: many collapses cost the same
+  const size_t n = m.vertex_count();
+  std::mt19937 rng(7);
+  std::vector<uint32_t> perm(n);
+  for (uint32_t i = 0; i < n; ++i) perm[i] = i;
+  std::shuffle(perm.begin(), perm.end(), rng);
+  tsm::Mesh s;
+  s.positions.resize(3 * n);
+  for (size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) s.positions[3 * size_t{perm[i]} + a] = m.positions[3 * i + a];
+  std::vector<size_t> faces(m.face_count());
+  for (size_t f = 0; f < faces.size(); ++f) faces[f] = f;
+  std::shuffle(faces.begin(), faces.end(), rng);
+  for (size_t f : faces) {
+    const uint32_t* c = m.face(f);
+    const uint32_t r = static_cast<uint32_t>(rng() % 3);
+    s.add_triangle(perm[c[r]], perm[c[(r + 1) % 3]], perm[c[(r + 2) % 3]]);
+  }
+  const std::string a = encode_progressive(m), b = encode_progressive(s);
+  EXPECT_GT(a.size(), 0u);
+  EXPECT_TRUE(a == b) << a.size() << " vs " << b.size() << " bytes";
+}
 
 TEST(Progressive, LooseVerticesAfterTheBatches) {
   tsm::Mesh m = icosphere(4);

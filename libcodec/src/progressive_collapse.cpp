@@ -21,6 +21,9 @@ namespace {
 
 using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 
+// The weight of a collapse's prediction error against its quadric error.
+constexpr double kRegularity = 0.1;
+
 void add_plane(Quadric& q, const double n[3], double d, double w) {
   const double p[4] = {n[0], n[1], n[2], d};
   int k = 0;
@@ -34,11 +37,14 @@ double quadric_at(const Quadric& q, const double p[3]) {
          2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
 }
 
+// Ties by the vertices' canonical ranks (their order by grid point), so the
+// plan does not depend on the input's vertex order.
 struct Candidate {
   double cost;
+  uint32_t ru, rv;  // canonical ranks of u and v
   uint32_t u, v;
   bool operator<(const Candidate& o) const {
-    return cost < o.cost || (cost == o.cost && (u < o.u || (u == o.u && v < o.v)));
+    return cost < o.cost || (cost == o.cost && (ru < o.ru || (ru == o.ru && rv < o.rv)));
   }
 };
 
@@ -49,6 +55,7 @@ class Collapser {
   void run(CollapsePlan& plan);
 
  private:
+  void rank_vertices();
   void build();
   void lock_special();
   bool ring(uint32_t v, std::vector<uint32_t>& out) const;
@@ -74,7 +81,30 @@ class Collapser {
   std::vector<uint32_t> merged_into_;  // per removed vertex: v of its collapse
   size_t vertices_left_ = 0;
   std::vector<uint32_t> ring_u_, ring_v_;
+  std::vector<uint32_t> rank_;   // per vertex: its place in the order by grid point (then input id)
+  std::vector<uint32_t> order_;  // vertices by rank
 };
+
+// The plan depends only on the mesh as the decoder gives it back (grid
+// points and faces, whatever the vertex and face order and the corners'
+// rotation), so that decoding a progressive file and encoding it again
+// gives the same bytes: vertices are ranked by grid point, triangles are
+// taken rotated to their least-ranked corner, in the order of their ranks.
+void Collapser::rank_vertices() {
+  const size_t n = mesh_.vertex_count();
+  order_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) order_[i] = i;
+  std::sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
+    const uint32_t* qa = &q_[3 * size_t{a}];
+    const uint32_t* qb = &q_[3 * size_t{b}];
+    if (qa[0] != qb[0]) return qa[0] < qb[0];
+    if (qa[1] != qb[1]) return qa[1] < qb[1];
+    if (qa[2] != qb[2]) return qa[2] < qb[2];
+    return a < b;
+  });
+  rank_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) rank_[order_[i]] = i;
+}
 
 void Collapser::build() {
   const size_t n = mesh_.vertex_count();
@@ -86,14 +116,30 @@ void Collapser::build() {
   removed_.assign(n, 0);
   merged_into_.assign(n, 0);
   quadric_.assign(n, Quadric{});
+  std::vector<std::array<uint32_t, 3>> tris;  // canonical corner ranks
+  std::vector<std::pair<std::vector<uint32_t>, uint32_t>> others;
   for (size_t f = 0; f < mesh_.face_count(); ++f) {
     const uint32_t* c = mesh_.face(f);
-    for (uint32_t k = 0; k < mesh_.face_size(f); ++k) used_[c[k]] = 1;
-    if (mesh_.face_size(f) != 3 || c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
-      other_faces_.push_back(static_cast<uint32_t>(f));
-      for (uint32_t k = 0; k < mesh_.face_size(f); ++k) locked_[c[k]] = 1;
+    const uint32_t k = mesh_.face_size(f);
+    for (uint32_t j = 0; j < k; ++j) used_[c[j]] = 1;
+    // Rotated to its least-ranked corner.
+    uint32_t first = 0;
+    for (uint32_t j = 1; j < k; ++j)
+      if (rank_[c[j]] < rank_[c[first]]) first = j;
+    std::vector<uint32_t> r(k);
+    for (uint32_t j = 0; j < k; ++j) r[j] = rank_[c[(first + j) % k]];
+    if (k != 3 || c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
+      for (uint32_t j = 0; j < k; ++j) locked_[c[j]] = 1;
+      others.emplace_back(std::move(r), static_cast<uint32_t>(f));
       continue;
     }
+    tris.push_back({r[0], r[1], r[2]});
+  }
+  std::sort(others.begin(), others.end());
+  for (const auto& o : others) other_faces_.push_back(o.second);
+  std::sort(tris.begin(), tris.end());
+  for (const auto& r : tris) {
+    const uint32_t c[3] = {order_[r[0]], order_[r[1]], order_[r[2]]};
     const uint32_t t = static_cast<uint32_t>(tri_.size());
     tri_.push_back({c[0], c[1], c[2]});
     for (int k = 0; k < 3; ++k) vf_[c[k]].push_back(t);
@@ -118,8 +164,10 @@ void Collapser::build() {
 
 // Vertices that must stay: those of the faces above, those sharing a grid
 // point with another (the encoder finds base vertices in the decoded base
-// by their grid point), and one vertex at each side of the bounding box
-// (so the base mesh has the input's box, hence its grid).
+// by their grid point), and one vertex on each side of the grid's box (the
+// first in grid-point order at the least and the greatest grid index of
+// each axis; the positions are on the grid, so the base mesh has the
+// input's box, hence its grid).
 void Collapser::lock_special() {
   const size_t n = mesh_.vertex_count();
   std::unordered_map<uint64_t, uint32_t> seen;
@@ -131,13 +179,13 @@ void Collapser::lock_special() {
     auto [it, fresh] = seen.emplace(key, i);
     if (!fresh) locked_[i] = locked_[it->second] = dup_[i] = dup_[it->second] = 1;
   }
-  for (int a = 0; a < 3; ++a) {
-    uint32_t lo = 0, hi = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-      if (mesh_.positions[3 * size_t{i} + a] < mesh_.positions[3 * size_t{lo} + a]) lo = i;
-      if (mesh_.positions[3 * size_t{i} + a] > mesh_.positions[3 * size_t{hi} + a]) hi = i;
+  for (int a = 0; a < 3 && n; ++a) {
+    uint32_t lo = order_[0], hi = order_[0];
+    for (uint32_t i : order_) {
+      if (q_[3 * size_t{i} + a] < q_[3 * size_t{lo} + a]) lo = i;
+      if (q_[3 * size_t{i} + a] > q_[3 * size_t{hi} + a]) hi = i;
     }
-    if (n) locked_[lo] = locked_[hi] = extreme_[lo] = extreme_[hi] = 1;
+    locked_[lo] = locked_[hi] = extreme_[lo] = extreme_[hi] = 1;
   }
 }
 
@@ -234,13 +282,26 @@ std::vector<Candidate> Collapser::candidates() {
   std::vector<uint32_t> r;
   for (uint32_t u = 0; u < vf_.size(); ++u) {
     if (removed_[u] || locked_[u] || !ring(u, r)) continue;
+    // How far u lies from the centroid of its ring: the decoder predicts
+    // the new vertex there (FORMAT.md §4.8), so collapses of vertices it
+    // predicts well go first.
+    double lap2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      double c = 0;
+      for (uint32_t w : r) c += q_[3 * size_t{w} + a];
+      const double l = q_[3 * size_t{u} + a] - c / static_cast<double>(r.size());
+      lap2 += l * l;
+    }
     for (uint32_t v : r) {
       if (locked_[v]) continue;
       Quadric q = quadric_[u];
       for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
       const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
                            static_cast<double>(q_[3 * size_t{v} + 2])};
-      out.push_back({quadric_at(q, p), u, v});
+      // The quadric error, plus the squared distance above weighted by the
+      // faces' area (the quadric's weight, q[0] + q[4] + q[7]).
+      const double cost = quadric_at(q, p) + kRegularity * lap2 * (q[0] + q[4] + q[7]);
+      out.push_back({cost, rank_[u], rank_[v], u, v});
     }
   }
   std::sort(out.begin(), out.end());
@@ -274,7 +335,7 @@ void Collapser::write_base(CollapsePlan& plan) const {
   base.clear();
   plan.base_id.assign(n, kNotInBase);
   plan.loose.clear();
-  for (uint32_t i = 0; i < n; ++i) {
+  for (uint32_t i : order_) {
     if (removed_[i]) continue;
     if (!used_[i] && !extreme_[i] && !plan.batches.empty()) {
       plan.loose.push_back(i);
@@ -312,6 +373,7 @@ double Collapser::level_error() const {
 }
 
 void Collapser::run(CollapsePlan& plan) {
+  rank_vertices();
   build();
   lock_special();
   plan.batches.clear();

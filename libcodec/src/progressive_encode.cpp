@@ -43,11 +43,25 @@ void map_base(const CollapsePlan& plan, const std::vector<uint32_t>& q, const Le
 
 }  // namespace
 
-Status encode_progressive(const Mesh& mesh, const EncodeOptions& options, std::string& out) {
-  if (!mesh.attributes.empty())
+Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::string& out) {
+  if (!input.attributes.empty())
     return Status(ErrorCode::unsupported, "progressive coding carries positions and faces only, and this mesh has " +
-                                              std::to_string(mesh.attributes.size()) +
+                                              std::to_string(input.attributes.size()) +
                                               " attribute(s): encode it single-rate, or drop the attributes first");
+  // The plan works on the mesh as a decoder gives it back (positions on
+  // the grid, its vertex and face order): its choices depend only on grid
+  // points and faces, so the bytes are the same whichever order or float
+  // values the input had within its grid cells (canonical re-encoding).
+  Mesh gridded;
+  {
+    EncodeOptions fast = options;
+    fast.progressive = false;
+    fast.level = 0;
+    std::string bytes;
+    TSM_RETURN_IF_ERROR(encode(input, fast, bytes));
+    TSM_RETURN_IF_ERROR(decode(bytes, gridded));
+  }
+  const Mesh& mesh = gridded;
   const Grid grid = Grid::for_mesh(mesh, options.quantization_bits);
   const int64_t qmax = (int64_t{1} << options.quantization_bits) - 1;
   std::vector<uint32_t> q(mesh.positions.size());

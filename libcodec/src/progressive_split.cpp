@@ -23,8 +23,8 @@ constexpr int kRingContexts = 16;
 
 struct BatchModels {
   Prob flag[kFlagContexts];
-  UIntModelT<2> start;
-  UIntModelT<2> dist[kRingContexts];  // by ring size
+  UIntModelT<2> start[kRingContexts];  // by ring size
+  UIntModelT<2> dist[kRingContexts];   // by ring size
   SIntModelT<3> residual[kScaleContexts][3];
 };
 
@@ -43,6 +43,23 @@ int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t
   return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
 }
 
+// The ring position of v's farthest neighbour (squared grid distance; ties
+// to the lower position): a collapse pulls v's ring out towards the removed
+// vertex, so the split's arc lies mostly around it.
+uint32_t farthest(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring) {
+  uint32_t best = 0;
+  uint64_t most = 0;
+  for (uint32_t i = 0; i < ring.size(); ++i) {
+    uint64_t d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t x = int64_t{level.q(ring[i])[a]} - int64_t{level.q(v)[a]};
+      d2 += static_cast<uint64_t>(x * x);
+    }
+    if (i == 0 || d2 > most) best = i, most = d2;
+  }
+  return best;
+}
+
 int flag_context(size_t degree) { return static_cast<int>(std::min<size_t>(degree, kFlagContexts + 2) - 3); }
 
 // The grid position the decoder predicts for the new vertex: the centroid
@@ -59,11 +76,10 @@ void predict(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ri
   for (int a = 0; a < 3; ++a) out[a] = (sum[a] + n / 2) / n;
 }
 
-// Per axis, its rank by the size of the ring's normal component on it (0 =
-// the axis closest to the normal): residuals along the normal are smaller
-// than across it, so each rank has its models.
-void axis_ranks(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, int rank[3]) {
-  double n[3] = {0, 0, 0};
+// The ring's normal: the sum of the cross products of consecutive ring
+// edges from v, in binary64 (FORMAT.md §4.8).
+void ring_normal(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, double n[3]) {
+  n[0] = n[1] = n[2] = 0;
   const uint32_t* c = level.q(v);
   const size_t d = ring.size();
   for (size_t i = 0; i < d; ++i) {
@@ -78,11 +94,51 @@ void axis_ranks(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>&
     n[1] += e1[2] * e2[0] - e1[0] * e2[2];
     n[2] += e1[0] * e2[1] - e1[1] * e2[0];
   }
+}
+
+// The axes by the size of the normal's component on them: order[0] the
+// axis closest to the normal (ties to the lower axis). The residuals along
+// the normal are smaller than across it, so each rank has its models.
+void axis_order(const double n[3], int order[3]) {
   for (int a = 0; a < 3; ++a) {
-    rank[a] = 0;
+    int rank = 0;
     for (int b = 0; b < 3; ++b)
-      if (std::fabs(n[b]) > std::fabs(n[a]) || (std::fabs(n[b]) == std::fabs(n[a]) && b < a)) ++rank[a];
+      if (std::fabs(n[b]) > std::fabs(n[a]) || (std::fabs(n[b]) == std::fabs(n[a]) && b < a)) ++rank;
+    order[rank] = a;
   }
+}
+
+int64_t floor_div(int64_t a, int64_t b) {  // b > 0
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
+// The new vertex's offset on the normal's axis order[0] once the two other
+// residuals e1, e2 (axes order[1], order[2]) are known: the point of the
+// tangent plane (the ring's normal n, in integers of at most 2^15) that
+// lies half v's height above the ring's centroid (the curvature at v),
+// since the centroid prediction sits on the chord below the surface. In
+// integers so every decoder computes the same offset; clamped to +-qmax.
+int64_t plane_offset(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, const double n[3],
+                     const int order[3], int64_t e1, int64_t e2, int64_t qmax) {
+  const double top = std::fabs(n[order[0]]);
+  if (!(top > 0)) return 0;
+  int exp = 0;
+  std::frexp(top, &exp);
+  int64_t N[3];
+  for (int a = 0; a < 3; ++a) N[a] = static_cast<int64_t>(std::floor(std::ldexp(n[a], 15 - exp) + 0.5));
+  const uint64_t d = ring.size();
+  int64_t height = 0;  // N . (q(v) - centroid of the ring)
+  for (int a = 0; a < 3; ++a) {
+    uint64_t sum = 0;
+    for (uint32_t r : ring) sum += level.q(r)[a];
+    const int64_t c = static_cast<int64_t>((sum + d / 2) / d);
+    height += N[a] * (int64_t{level.q(v)[a]} - c);
+  }
+  const int64_t n0 = N[order[0]];
+  const int64_t t = height - 2 * (N[order[1]] * e1 + N[order[2]] * e2);
+  const int64_t m = n0 < 0 ? -n0 : n0;
+  const int64_t o = floor_div((n0 < 0 ? -t : t) + m, 2 * m);
+  return std::clamp<int64_t>(o, -qmax, qmax);
 }
 
 uint32_t position_in(const std::vector<uint32_t>& ring, uint32_t x) {
@@ -206,6 +262,7 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
   BatchModels* m = level.models().get();
   RangeEncoder e;
   std::vector<uint32_t> ring;
+  const int64_t qmax = (int64_t{1} << level.bits()) - 1;
   size_t ones = 0;
   for (uint32_t i = 0; i < n && ones < splits.size(); ++i) {
     if (level.adjacent_to_marked(i, marked) || !level.ring(i, ring)) {
@@ -226,14 +283,21 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     const uint32_t ia = position_in(ring, s.y), ix = position_in(ring, s.x);
     const uint32_t dist = (ix + d - ia) % d;
     if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
-    m->start.encode(e, ia);
-    m->dist[std::min<uint32_t>(d, kRingContexts - 1)].encode(e, dist - 1);
+    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    m->dist[ctx].encode(e, dist - 1);
+    m->start[ctx].encode(e, (ia + dist / 2 + d - farthest(level, v, ring)) % d);
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
-    int rank[3];
-    axis_ranks(level, v, ring, rank);
-    for (int a = 0; a < 3; ++a) m->residual[sc][rank[a]].encode(e, static_cast<int32_t>(int64_t{s.q[a]} - p[a]));
+    double nrm[3];
+    int order[3];
+    ring_normal(level, v, ring, nrm);
+    axis_order(nrm, order);
+    const int64_t e1 = int64_t{s.q[order[1]]} - p[order[1]], e2 = int64_t{s.q[order[2]]} - p[order[2]];
+    const int64_t o = plane_offset(level, v, ring, nrm, order, e1, e2, qmax);
+    m->residual[sc][1].encode(e, static_cast<int32_t>(e1));
+    m->residual[sc][2].encode(e, static_cast<int32_t>(e2));
+    m->residual[sc][0].encode(e, static_cast<int32_t>(int64_t{s.q[order[0]]} - p[order[0]] - o));
     ids[v] = level.split(v, ring, ia, dist, s.q);
   }
   for (const VertexSplit& s : splits) new_ids.push_back(ids[s.v]);
@@ -288,24 +352,32 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the split flags");
   }
   if (ones != splits) return corrupt("fewer split flags than the split count");
-  const uint32_t qmax = static_cast<uint32_t>((uint64_t{1} << level.bits()) - 1);
+  const int64_t qmax = (int64_t{1} << level.bits()) - 1;
   for (uint32_t v = 0; v < n; ++v) {
     if (!marked[v]) continue;
     level.ring(v, ring);
     const uint32_t d = static_cast<uint32_t>(ring.size());
-    const uint32_t ia = m->start.decode(dec);
-    const uint32_t dist = m->dist[std::min<uint32_t>(d, kRingContexts - 1)].decode(dec) + 1;
-    if (ia >= d || dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    const uint32_t dist = m->dist[ctx].decode(dec) + 1;
+    if (dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t middle = m->start[ctx].decode(dec);
+    if (middle >= d) return corrupt("a split's ring neighbours out of range");
+    const uint32_t ia = (middle + farthest(level, v, ring) + d - dist / 2) % d;
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
-    int rank[3];
-    axis_ranks(level, v, ring, rank);
+    double nrm[3];
+    int order[3];
+    ring_normal(level, v, ring, nrm);
+    axis_order(nrm, order);
     uint32_t q[3];
-    for (int a = 0; a < 3; ++a) {
-      const int64_t x = p[a] + m->residual[sc][rank[a]].decode(dec);
+    int64_t e[3] = {0, 0, 0};
+    for (int k : {1, 2, 0}) {
+      e[k] = m->residual[sc][k].decode(dec);
+      const int64_t off = k == 0 ? plane_offset(level, v, ring, nrm, order, e[1], e[2], qmax) : 0;
+      const int64_t x = p[order[k]] + off + e[k];
       if (x < 0 || x > qmax) return corrupt("a new vertex off the grid");
-      q[a] = static_cast<uint32_t>(x);
+      q[order[k]] = static_cast<uint32_t>(x);
     }
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the splits");
     level.split(v, ring, ia, dist, q);
