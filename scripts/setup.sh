@@ -27,6 +27,8 @@ PACKAGES=(
   # compare` and `tsm simplify` (tests/cgal, bench); meshoptimizer's simplifier
   # is the simplification benchmark's reference (header-only / optional)
   libcgal-dev libmeshoptimizer-dev
+  # the rate-distortion plot for the README (scripts/rd_plot.py)
+  python3-matplotlib
   # fuzzers (clang's libFuzzer)
   clang libclang-rt-14-dev
 )

@@ -14,6 +14,7 @@
 
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
+#include "tsm/compare.hpp"
 #include "tsm/tsm.h"
 #include "tsm/tsm.hpp"
 
@@ -90,7 +91,7 @@ TEST(CApi, CreateEncodeDecodeRoundTrip) {
   EXPECT_EQ(copy.indices, src.indices);
 
   Buffer buf;
-  tsm_encode_options eo{12, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options eo{12, 5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
   ASSERT_NE(buf.p, nullptr);
   ASSERT_GT(buf.n, 0u);
@@ -126,7 +127,7 @@ TEST(CApi, DefaultOptions) {
   std::string cpp;
   ASSERT_TRUE(tsm::encode(src, tsm::EncodeOptions{}, cpp).ok());
   // quantization_bits = 0 and level = -1 mean the defaults; so does NULL.
-  tsm_encode_options defaults{0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options defaults{0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   Buffer a, b;
   ASSERT_EQ(tsm_encode(m.p, &defaults, &a.p, &a.n, nullptr, 0), TSM_OK);
   ASSERT_EQ(tsm_encode(m.p, nullptr, &b.p, &b.n, nullptr, 0), TSM_OK);
@@ -227,7 +228,7 @@ TEST(CApi, InvalidMeshesRefused) {
   // Bad options.
   MeshPtr good;
   ASSERT_EQ(tsm_mesh_create(pos, 3, nullptr, 1, idx, 3, &good.p, err, sizeof err), TSM_OK);
-  tsm_encode_options bad_q{31, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0}, bad_level{14, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  tsm_encode_options bad_q{31, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, bad_level{14, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   EXPECT_EQ(tsm_encode(good.p, &bad_q, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err).find("quantization"), std::string::npos) << err;
   EXPECT_EQ(tsm_encode(good.p, &bad_level, &out, &out_n, err, sizeof err), TSM_INVALID_ARGUMENT);
@@ -557,7 +558,7 @@ TEST(CApi, AttributeBitsOption) {
   ASSERT_EQ(create_from(s.mesh, &m.p, err, sizeof err, false), TSM_OK) << err;
   add_attributes(m.p, s);
   if (HasFatalFailure()) return;
-  tsm_encode_options fine{0, -1, 0, 0, 8, 20, 0, 0, 0, 0, 0};
+  tsm_encode_options fine{0, -1, 0, 0, 8, 20, 0, 0, 0, 0, 0, 0};
   Buffer a, b;
   ASSERT_EQ(tsm_encode(m.p, nullptr, &a.p, &a.n, err, sizeof err), TSM_OK) << err;
   ASSERT_EQ(tsm_encode(m.p, &fine, &b.p, &b.n, err, sizeof err), TSM_OK) << err;
@@ -568,7 +569,7 @@ TEST(CApi, AttributeBitsOption) {
   ASSERT_TRUE(tsm::encode(s.mesh, eo, cpp).ok());
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(b.p), b.n), cpp);
   EXPECT_NE(a.n, b.n);
-  tsm_encode_options bad{0, -1, 0, 0, 0, 25, 0, 0, 0, 0, 0};
+  tsm_encode_options bad{0, -1, 0, 0, 0, 25, 0, 0, 0, 0, 0, 0};
   Buffer c;
   EXPECT_EQ(tsm_encode(m.p, &bad, &c.p, &c.n, err, sizeof err), TSM_INVALID_ARGUMENT);
   EXPECT_NE(std::string(err).find("1..24"), std::string::npos) << err;
@@ -585,7 +586,7 @@ TEST(CApi, AttributesStreamed) {
   add_attributes(m.p, s);
   if (HasFatalFailure()) return;
   Buffer buf;
-  tsm_encode_options eo{0, -1, 200, 1, 0, 0, 0, 0, 0, 0, 0};  // 7 segments
+  tsm_encode_options eo{0, -1, 200, 1, 0, 0, 0, 0, 0, 0, 0, 0};  // 7 segments
   ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
   MeshPtr whole;
   ASSERT_EQ(tsm_decode(buf.p, buf.n, nullptr, &whole.p, err, sizeof err), TSM_OK) << err;
@@ -836,3 +837,196 @@ TEST(CApi, Metadata) {
 }
 
 }  // namespace
+
+namespace {
+
+// A progressive file of a generated sphere, encoded through the C API.
+void encode_progressive_sphere(Buffer& buf, tsm::Mesh& src) {
+  src = tsm_test::icosphere(5);
+  MeshPtr m;
+  char err[256];
+  ASSERT_EQ(create_from(src, &m.p, err, sizeof err, false), TSM_OK) << err;
+  tsm_encode_options eo{};
+  eo.level = -1;
+  eo.threads = 1;
+  eo.progressive = 1;
+  ASSERT_EQ(tsm_encode(m.p, &eo, &buf.p, &buf.n, err, sizeof err), TSM_OK) << err;
+}
+
+struct Level {
+  size_t batches = 0, vertices = 0, faces = 0;
+  double error = 0;
+};
+
+}  // namespace
+
+TEST(CApi, ProgressiveStreamYieldsEveryLevel) {
+  Buffer buf;
+  tsm::Mesh src;
+  encode_progressive_sphere(buf, src);
+  if (HasFatalFailure()) return;
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(std::string_view(reinterpret_cast<const char*>(buf.p), buf.n), fi).ok());
+  ASSERT_GE(fi.batches.size(), 4u);
+  MeshPtr whole;
+  char err[256];
+  ASSERT_EQ(tsm_decode(buf.p, buf.n, nullptr, &whole.p, err, sizeof err), TSM_OK) << err;
+
+  // Chunks that hold several batches each: stop_at_levels still shows every level.
+  for (size_t chunk : {size_t{1} << 20, size_t{700}, size_t{61}}) {
+    SCOPED_TRACE("chunk " + std::to_string(chunk));
+    tsm_stream* st = tsm_stream_new(nullptr);
+    ASSERT_NE(st, nullptr);
+    tsm_stream_stop_at_levels(st, 1);
+    std::vector<Level> levels;
+    for (size_t at = 0; at < buf.n; at += chunk) {
+      int rc = tsm_stream_feed(st, buf.p + at, std::min(chunk, buf.n - at), err, sizeof err);
+      while (rc == TSM_OK) {
+        if (tsm_stream_progressive(st)) {
+          const tsm_mesh* sm = tsm_stream_mesh(st);
+          Level l{tsm_stream_batches_done(st), tsm_mesh_vertex_count(sm), tsm_mesh_face_count(sm),
+                  tsm_stream_level_error(st)};
+          if (levels.empty() || l.batches != levels.back().batches) {
+            ASSERT_TRUE(view(sm).valid());
+            levels.push_back(l);
+          }
+        }
+        if (!tsm_stream_level_pending(st)) break;
+        rc = tsm_stream_feed(st, nullptr, 0, err, sizeof err);
+      }
+      ASSERT_EQ(rc, TSM_OK) << err;
+    }
+    ASSERT_EQ(tsm_stream_finish(st, err, sizeof err), TSM_OK) << err;
+    // The base first, then one level per batch, each finer than the one before.
+    ASSERT_EQ(levels.size(), fi.batches.size() + 1);
+    EXPECT_EQ(levels[0].batches, 0u);
+    EXPECT_EQ(levels[0].vertices, fi.vertex_count);
+    EXPECT_EQ(levels[0].faces, fi.face_count);
+    for (size_t k = 1; k < levels.size(); ++k) {
+      EXPECT_EQ(levels[k].batches, k);
+      EXPECT_EQ(levels[k].vertices, fi.batches[k - 1].vertices);
+      EXPECT_EQ(levels[k].faces, fi.batches[k - 1].faces);
+      EXPECT_GT(levels[k].faces, levels[k - 1].faces);
+      EXPECT_FLOAT_EQ(static_cast<float>(levels[k].error), static_cast<float>(fi.batches[k - 1].error));
+    }
+    // The base's error is known once the first batch's bytes are in with it.
+    if (chunk > buf.n) {
+      EXPECT_FLOAT_EQ(static_cast<float>(levels[0].error), static_cast<float>(fi.base_error));
+    }
+    EXPECT_EQ(levels.back().error, 0.0);
+    const tsm::Mesh streamed = view(tsm_stream_mesh(st)), d = view(whole.p);
+    EXPECT_EQ(streamed.positions, d.positions);
+    EXPECT_EQ(streamed.indices, d.indices);
+    tsm_stream_free(st);
+  }
+
+  // Without stop_at_levels a chunk applies every batch it holds at once.
+  tsm_stream* st = tsm_stream_new(nullptr);
+  ASSERT_EQ(tsm_stream_feed(st, buf.p, buf.n, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(tsm_stream_batches_done(st), fi.batches.size());
+  EXPECT_EQ(tsm_stream_level_pending(st), 0);
+  EXPECT_EQ(tsm_stream_finish(st, err, sizeof err), TSM_OK) << err;
+  tsm_stream_free(st);
+}
+
+TEST(CApi, ProgressiveStreamFinishDecodesWhatIsPending) {
+  Buffer buf;
+  tsm::Mesh src;
+  encode_progressive_sphere(buf, src);
+  if (HasFatalFailure()) return;
+  char err[256];
+  tsm_stream* st = tsm_stream_new(nullptr);
+  tsm_stream_stop_at_levels(st, 1);
+  ASSERT_EQ(tsm_stream_feed(st, buf.p, buf.n, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(tsm_stream_progressive(st), 1);
+  EXPECT_EQ(tsm_stream_batches_done(st), 0u);
+  EXPECT_EQ(tsm_stream_level_pending(st), 1);
+  ASSERT_EQ(tsm_stream_finish(st, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(tsm_stream_level_pending(st), 0);
+  const tsm::CompareResult c = tsm::compare_meshes(src, view(tsm_stream_mesh(st)), tsm::kDefaultQuantizationBits);
+  EXPECT_TRUE(c.equal) << c.difference;
+  tsm_stream_free(st);
+
+  // A truncated progressive stream fails at finish, its last level kept.
+  st = tsm_stream_new(nullptr);
+  ASSERT_EQ(tsm_stream_feed(st, buf.p, buf.n / 2, err, sizeof err), TSM_OK) << err;
+  const size_t got = tsm_stream_batches_done(st);
+  EXPECT_GT(tsm_mesh_face_count(tsm_stream_mesh(st)), 0u);
+  EXPECT_EQ(tsm_stream_finish(st, err, sizeof err), TSM_CORRUPT_DATA);
+  EXPECT_EQ(tsm_stream_batches_done(st), got);
+  tsm_stream_free(st);
+
+  // A single-rate file is not progressive and has no level error.
+  MeshPtr m;
+  ASSERT_EQ(create_from(src, &m.p, err, sizeof err, false), TSM_OK) << err;
+  Buffer single;
+  ASSERT_EQ(tsm_encode(m.p, nullptr, &single.p, &single.n, err, sizeof err), TSM_OK) << err;
+  st = tsm_stream_new(nullptr);
+  tsm_stream_stop_at_levels(st, 1);
+  ASSERT_EQ(tsm_stream_feed(st, single.p, single.n, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(tsm_stream_progressive(st), 0);
+  EXPECT_EQ(tsm_stream_level_pending(st), 0);
+  EXPECT_EQ(tsm_stream_level_error(st), -1.0);
+  EXPECT_EQ(tsm_mesh_face_count(tsm_stream_mesh(st)), src.face_count());
+  EXPECT_EQ(tsm_stream_finish(st, err, sizeof err), TSM_OK) << err;
+  tsm_stream_free(st);
+}
+
+TEST(CApi, ProgressivePartialDecode) {
+  Buffer buf;
+  tsm::Mesh src;
+  encode_progressive_sphere(buf, src);
+  if (HasFatalFailure()) return;
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(std::string_view(reinterpret_cast<const char*>(buf.p), buf.n), fi).ok());
+  char err[256];
+  // Whole: the input exactly, complete.
+  MeshPtr full;
+  tsm_partial_report r{};
+  ASSERT_EQ(tsm_decode_partial(buf.p, buf.n, nullptr, nullptr, &full.p, &r, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(r.complete, 1);
+  EXPECT_EQ(r.batches, fi.batches.size());
+  EXPECT_EQ(r.bytes_used, buf.n);
+  EXPECT_TRUE(tsm::compare_meshes(src, view(full.p), tsm::kDefaultQuantizationBits).equal);
+
+  // A truncated copy: the finest whole level, the same as max_bytes on the whole file.
+  const size_t cut = buf.n * 2 / 3;
+  std::vector<uint8_t> prefix(buf.p, buf.p + cut);
+  MeshPtr a, b;
+  tsm_partial_report ra{}, rb{};
+  ASSERT_EQ(tsm_decode_partial(prefix.data(), prefix.size(), nullptr, nullptr, &a.p, &ra, err, sizeof err), TSM_OK)
+      << err;
+  tsm_partial_options po{};
+  po.max_bytes = cut;
+  ASSERT_EQ(tsm_decode_partial(buf.p, buf.n, &po, nullptr, &b.p, &rb, err, sizeof err), TSM_OK) << err;
+  EXPECT_EQ(ra.complete, 0);
+  EXPECT_GT(ra.batches, 0u);
+  EXPECT_LT(ra.batches, fi.batches.size());
+  EXPECT_EQ(ra.batches, rb.batches);
+  EXPECT_LE(ra.bytes_used, cut);
+  EXPECT_EQ(ra.bytes_used, rb.bytes_used);
+  EXPECT_EQ(tsm_mesh_vertex_count(a.p), fi.batches[ra.batches - 1].vertices);
+  EXPECT_EQ(tsm_mesh_face_count(a.p), fi.batches[ra.batches - 1].faces);
+  EXPECT_FLOAT_EQ(static_cast<float>(ra.error), static_cast<float>(fi.batches[ra.batches - 1].error));
+  EXPECT_EQ(view(a.p).positions, view(b.p).positions);
+  EXPECT_EQ(view(a.p).indices, view(b.p).indices);
+
+  // max_error: the first level within it.
+  const size_t k = fi.batches.size() / 2;
+  tsm_partial_options pe{};
+  pe.max_error = fi.batches[k].error;
+  MeshPtr c;
+  tsm_partial_report rc{};
+  ASSERT_EQ(tsm_decode_partial(buf.p, buf.n, &pe, nullptr, &c.p, &rc, err, sizeof err), TSM_OK) << err;
+  EXPECT_LE(rc.error, pe.max_error);
+  EXPECT_LE(rc.batches, k + 1);
+  EXPECT_GT(rc.batches, 0u);
+  EXPECT_GT(fi.batches[rc.batches - 1].error, 0.0);
+
+  // Cut inside the base: an error naming it; nothing allocated.
+  MeshPtr d;
+  EXPECT_EQ(tsm_decode_partial(buf.p, 40, nullptr, nullptr, &d.p, nullptr, err, sizeof err), TSM_CORRUPT_DATA);
+  EXPECT_EQ(d.p, nullptr);
+  EXPECT_TRUE(tsm_test::contains(err, "base mesh") || tsm_test::contains(err, "header")) << err;
+  EXPECT_EQ(tsm_decode_partial(nullptr, 5, nullptr, nullptr, &d.p, nullptr, err, sizeof err), TSM_INVALID_ARGUMENT);
+}

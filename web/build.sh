@@ -155,6 +155,8 @@ EXPORTS+=",_tsm_mesh_positions,_tsm_mesh_face_offsets,_tsm_mesh_indices,_tsm_mes
 if grep -q "tsm_stream_new" "$LIBCODEC/include/tsm/tsm.h"; then
   EXPORTS+=",_tsm_stream_new,_tsm_stream_feed,_tsm_stream_finish,_tsm_stream_segment_count"
   EXPORTS+=",_tsm_stream_segments_done,_tsm_stream_mesh,_tsm_stream_free"
+  EXPORTS+=",_tsm_stream_stop_at_levels,_tsm_stream_level_pending,_tsm_stream_progressive"
+  EXPORTS+=",_tsm_stream_batches_done,_tsm_stream_level_error"
   echo "web/build.sh: streaming C API found, exported"
 else
   echo "web/build.sh: no streaming C API in tsm.h yet; whole-file decode only"

@@ -21,7 +21,8 @@ MESHES="bunny:bun_zipper.ply dragon_res4:dragon_vrip_res4.ply dragon_res3:dragon
 dragon_res2:dragon_vrip_res2.ply dragon:dragon_vrip.ply cube_quads:edge/cube_quads.obj
 dragon_seg16k:dragon_vrip.ply:16384 bunny_seg4k:bun_zipper.ply:4096
 dragon_res4_l0:dragon_vrip_res4.ply::0 bunny_l0:bun_zipper.ply::0 bunny_l2:bun_zipper.ply::2
-dragon_res3_l1:dragon_vrip_res3.ply::1"
+dragon_res3_l1:dragon_vrip_res3.ply::1
+bunny_prog:bun_zipper.ply:::progressive dragon_res4_prog:dragon_vrip_res4.ply:::progressive"
 SEGMENTS=0
 "$TSM" encode --help 2>/dev/null | grep -q -- --segment-faces && SEGMENTS=1
 
@@ -42,7 +43,7 @@ make_ref() {  # NAME: NAME.ref.json from the native decoder's output
 want=("$@")
 list=()
 for entry in $MESHES; do
-  IFS=: read -r name rel segfaces level <<<"$entry"
+  IFS=: read -r name rel segfaces level progressive <<<"$entry"
   src="$CORPUS/$rel"
   extra="${TSM_ENCODE_ARGS:-}"
   if [ -n "$segfaces" ]; then
@@ -53,6 +54,8 @@ for entry in $MESHES; do
   # attribute residuals, version 10's fan predictor at levels 1-2) for a
   # variant of a mesh listed whole.
   [ -n "$level" ] && extra="$extra -l $level"
+  # A progressive file (a base mesh, then batches of vertex splits).
+  [ -n "$progressive" ] && extra="$extra --progressive --drop-attributes"
   if [ "${#want[@]}" -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
   [ -f "$src" ] || { echo "prepare-data: $src missing, skipped" >&2; continue; }
   list+=("$name")
@@ -65,7 +68,7 @@ for entry in $MESHES; do
     rm -f "$ref"
   fi
   make_ref "$name"
-  if [ -n "$segfaces" ] || [ -n "$level" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
+  if [ -n "$segfaces" ] || [ -n "$level" ] || [ -n "$progressive" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
   elif [ "$HAVE_DRACO" = 1 ] && { [ ! -f "$drc" ] || [ "$src" -nt "$drc" ]; }; then
     draco_encoder -i "$src" -o "$drc" -cl 10 -qp 14 >/dev/null
   fi
@@ -97,8 +100,9 @@ fi
     drcsize=null
     [ -f "$OUT/$name.drc" ] && drcsize="$(stat -c %s "$OUT/$name.drc")"
     segs="$("$TSM" info "$OUT/$name.tsm" 2>/dev/null | sed -n 's/.*segments \([0-9,]*\).*/\1/p' | tr -d , | head -1)"
-    printf '%s  {"name": "%s", "tsmBytes": %s, "drcBytes": %s, "segments": %s, "ref": %s}' "$sep" "$name" \
-      "$(stat -c %s "$OUT/$name.tsm")" "$drcsize" "${segs:-1}" "$(cat "$OUT/$name.ref.json")"
+    batches="$("$TSM" info "$OUT/$name.tsm" 2>/dev/null | sed -n 's/.* \([0-9]*\) refinement batches.*/\1/p' | head -1)"
+    printf '%s  {"name": "%s", "tsmBytes": %s, "drcBytes": %s, "segments": %s, "batches": %s, "ref": %s}' "$sep" "$name" \
+      "$(stat -c %s "$OUT/$name.tsm")" "$drcsize" "${segs:-1}" "${batches:-0}" "$(cat "$OUT/$name.ref.json")"
     sep=$',\n'
   done
   printf '\n]\n'

@@ -2,7 +2,8 @@
 // (used by decodeStreamInWorker in tsm.js). Messages in: {type:'start',
 // wasmUrl?, decodeOptions?}, {type:'chunk', bytes}, {type:'end'},
 // {type:'cancel'}; a new 'start' drops any stream left unfinished. Out:
-// {type:'segment', segment} (its arrays, attributes' and metadata's too,
+// {type:'segment', segment} (a segment or a progressive file's level; its
+// arrays, attributes' and metadata's too,
 // transferred, not copied), {type:'done'},
 // {type:'error', code, message}. Every message out carries the id of its 'start'.
 // Whole files (decodeInWorker): in {type:'decode', id, bytes, wasmUrl?,

@@ -47,6 +47,15 @@
 // value numbers, possibly naming values of earlier segments). Appending each
 // piece's values and indices gives the whole mesh's lists.
 //
+// Progressive files (`tsm encode --progressive`: a base mesh, then batches of
+// vertex splits): once the base mesh is whole, each piece is a level of
+// detail of the whole shape, { level: true, batchesDone, levelError,
+// vertexStart: 0, faceStart: 0, positions, indices, ... }: the whole mesh
+// (batches change faces in place), to draw instead of what came before.
+// One piece per level (the base, then each batch), even when a chunk holds
+// several; levelError is the encoder's error of the level (the largest
+// distance of a full-mesh vertex from it, model units), -1 while unknown.
+//
 // Metadata (entries the codec passes through, e.g. key 'gltf'): [{ key (a
 // string, UTF-8), value (Uint8Array) }] on a decoded mesh; in a stream, the
 // whole list on the piece where it first appears (that piece may have no
@@ -103,6 +112,7 @@ export class TsmDecoder {
     this.hasStreaming = typeof mod._tsm_stream_new === 'function';
     this.hasAttributes = typeof mod._tsm_mesh_attribute_count === 'function';
     this.hasMetadata = typeof mod._tsm_mesh_metadata_count === 'function';
+    this.hasLevels = typeof mod._tsm_stream_stop_at_levels === 'function';
   }
 
   /** The library's version string. */
@@ -290,9 +300,11 @@ export class TsmStream {
     this.metaCount = 0;    // metadata entries handed out (all of them once any)
     this.decodeMs = 0; // time spent decoding (in feed/finish, copies out included)
     this.failed = null;
+    this.levelBatches = -1; // progressive files: the batches of the last level handed out
     if (dec.hasStreaming) {
       this.s = this.m._tsm_stream_new(dec.options(options));
       if (!this.s) throw new TsmError(ErrorCode.LIMIT_EXCEEDED, 'out of memory');
+      if (dec.hasLevels) this.m._tsm_stream_stop_at_levels(this.s, 1);
     } else {
       // The library has no streaming API yet: gather the chunks, decode at finish.
       this.s = 0; this.parts = []; this.opts = options;
@@ -312,8 +324,20 @@ export class TsmStream {
       const t0 = now();
       const ptr = this.dec.input(data);
       const rc = this.m._tsm_stream_feed(this.s, ptr, data.length, this.dec.errPtr, ERR_SIZE);
-      return this.collect(rc, t0);
+      return this.collect(rc, t0).concat(this.pendingLevels());
     });
+  }
+
+  // Levels of a progressive file left in the chunk after the first: one
+  // piece each.
+  pendingLevels() {
+    const out = [];
+    while (this.dec.hasLevels && this.m._tsm_stream_level_pending(this.s)) {
+      const t0 = now();
+      const rc = this.m._tsm_stream_feed(this.s, 0, 0, this.dec.errPtr, ERR_SIZE);
+      out.push(...this.collect(rc, t0));
+    }
+    return out;
   }
 
   finish() {
@@ -328,8 +352,9 @@ export class TsmStream {
       return [{ ...mesh, index: 0, segmentCount: 1, segmentsDone: 1, bytesIn: this.bytesIn, decodeMs: this.decodeMs }];
     }
     return this.dec.guard(() => {
+      const levels = this.pendingLevels();
       const rc = this.m._tsm_stream_finish(this.s, this.dec.errPtr, ERR_SIZE);
-      return this.collect(rc, t0);
+      return levels.concat(this.collect(rc, t0));
     });
   }
 
@@ -353,6 +378,7 @@ export class TsmStream {
     const f1 = m._tsm_mesh_face_count(mesh);
     const done = m._tsm_stream_segments_done(this.s);
     const metaCount = this.dec.hasMetadata ? m._tsm_mesh_metadata_count(mesh) : 0;
+    if (this.dec.hasLevels && m._tsm_stream_progressive(this.s)) return this.collectLevel(mesh, v1, f1, done, metaCount);
     if (v1 === this.v && f1 === this.f && done === this.segIndex && metaCount === this.metaCount) return [];
     // Everything finished since the last call comes out as one piece (several
     // segments finished by one chunk are reported together).
@@ -369,6 +395,20 @@ export class TsmStream {
     this.v = v1; this.f = f1; this.segIndex = done;
     this.last = seg; // gets decodeMs: time spent in feed/finish so far, this call included
     return [seg];
+  }
+
+  // A progressive file's level: the whole mesh, when it changed.
+  collectLevel(mesh, v1, f1, done, metaCount) {
+    const m = this.m;
+    const batches = m._tsm_stream_batches_done(this.s);
+    if (batches === this.levelBatches && v1 === this.v && f1 === this.f) return [];
+    const level = this.dec.extract(mesh, 0, 0, v1, f1, true);
+    if (metaCount !== this.metaCount) { level.metadata = this.dec.metadata(mesh); this.metaCount = metaCount; }
+    Object.assign(level, { level: true, batchesDone: batches, levelError: m._tsm_stream_level_error(this.s),
+      index: done, segmentsDone: done, segmentCount: m._tsm_stream_segment_count(this.s), bytesIn: this.bytesIn });
+    this.levelBatches = batches; this.v = v1; this.f = f1; this.segIndex = done;
+    this.last = level;
+    return [level];
   }
 
   free() {

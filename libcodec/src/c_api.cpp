@@ -36,6 +36,17 @@ const tsm::MetadataEntry* metadata_entry(const tsm_mesh* m, size_t i, size_t* si
 
 tsm::Status invalid(const std::string& message) { return tsm::Status(tsm::ErrorCode::invalid_argument, message); }
 
+tsm::DecodeOptions decode_options(const tsm_decode_options* options) {
+  tsm::DecodeOptions o;
+  if (options) {
+    o.max_vertices = options->max_vertices;
+    o.max_faces = options->max_faces;
+    o.max_corners = options->max_corners;
+    o.threads = options->threads;
+  }
+  return o;
+}
+
 }  // namespace
 
 extern "C" {
@@ -45,19 +56,39 @@ int tsm_decode(const uint8_t* data, size_t size, const tsm_decode_options* optio
   return guarded(err, err_size, [&] {
     if (!out || (!data && size)) return tsm::Status(tsm::ErrorCode::invalid_argument, "null argument");
     *out = nullptr;
-    tsm::DecodeOptions o;
-    if (options) {
-      o.max_vertices = options->max_vertices;
-      o.max_faces = options->max_faces;
-      o.max_corners = options->max_corners;
-      o.threads = options->threads;
-    }
     auto* m = new tsm_mesh;
-    tsm::Status s = tsm::decode(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, o);
+    tsm::Status s =
+        tsm::decode(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, decode_options(options));
     if (!s.ok()) {
       delete m;
       return s;
     }
+    *out = m;
+    return s;
+  });
+}
+
+int tsm_decode_partial(const uint8_t* data, size_t size, const tsm_partial_options* partial,
+                       const tsm_decode_options* options, tsm_mesh** out, tsm_partial_report* report, char* err,
+                       size_t err_size) {
+  return guarded(err, err_size, [&] {
+    if (!out || (!data && size)) return invalid("null argument");
+    *out = nullptr;
+    if (report) *report = tsm_partial_report{};
+    tsm::PartialOptions p;
+    if (partial) {
+      p.max_bytes = partial->max_bytes;
+      p.max_error = partial->max_error > 0 ? partial->max_error : -1;
+    }
+    tsm::PartialReport r;
+    auto* m = new tsm_mesh;
+    tsm::Status s = tsm::decode_partial(std::string_view(reinterpret_cast<const char*>(data), size), m->mesh, p, &r,
+                                        decode_options(options));
+    if (!s.ok()) {
+      delete m;
+      return s;
+    }
+    if (report) *report = tsm_partial_report{r.bytes_used, r.error, r.batches, r.complete ? 1 : 0};
     *out = m;
     return s;
   });
@@ -93,12 +124,8 @@ int tsm_mesh_create(const float* positions, size_t vertex_count, const uint32_t*
 
 tsm_stream* tsm_stream_new(const tsm_decode_options* options) {
   try {
-    tsm::DecodeOptions o;
-    if (options) {
-      o.max_vertices = options->max_vertices;
-      o.max_faces = options->max_faces;
-      o.max_corners = options->max_corners;
-    }
+    tsm::DecodeOptions o = decode_options(options);
+    o.threads = 0;
     return new tsm_stream(o);
   } catch (...) {
     return nullptr;
@@ -123,6 +150,13 @@ size_t tsm_stream_segment_count(const tsm_stream* s) { return s ? s->decoder.seg
 size_t tsm_stream_segments_done(const tsm_stream* s) { return s ? s->decoder.segments_done() : 0; }
 const tsm_mesh* tsm_stream_mesh(const tsm_stream* s) { return s ? &s->mesh : nullptr; }
 void tsm_stream_free(tsm_stream* s) { delete s; }
+void tsm_stream_stop_at_levels(tsm_stream* s, int on) {
+  if (s) s->decoder.stop_at_levels(on != 0);
+}
+int tsm_stream_level_pending(const tsm_stream* s) { return s && s->decoder.level_pending() ? 1 : 0; }
+int tsm_stream_progressive(const tsm_stream* s) { return s && s->decoder.progressive() ? 1 : 0; }
+size_t tsm_stream_batches_done(const tsm_stream* s) { return s ? s->decoder.batches_done() : 0; }
+double tsm_stream_level_error(const tsm_stream* s) { return s ? s->decoder.level_error() : -1; }
 
 size_t tsm_mesh_vertex_count(const tsm_mesh* m) { return m ? m->get().vertex_count() : 0; }
 size_t tsm_mesh_face_count(const tsm_mesh* m) { return m ? m->get().face_count() : 0; }

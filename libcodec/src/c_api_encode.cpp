@@ -28,6 +28,7 @@ tsm::EncodeOptions options_from(const tsm_encode_options* options) {
     o.keep_order = options->keep_order != 0;
     o.lossless = options->lossless != 0;
     o.allow_nonfinite = options->allow_nonfinite != 0;
+    o.progressive = options->progressive != 0;
   }
   return o;
 }

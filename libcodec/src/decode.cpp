@@ -563,6 +563,9 @@ struct StreamDecoder::Impl {
   uint64_t faces = 0, corners = 0;
   LevelMesh level;      // progressive files: the level the batches refine
   uint32_t batches = 0;
+  bool base_ready = false;  // the base mesh is whole (progressive files, before the end marker)
+  double error = -1;        // the current level's error (model units), -1 unknown
+  bool stop_levels = false, pending = false;
   Status failed;
 
   Status part_done(DecodedPart& part, const PartStreams& s) {
@@ -613,20 +616,53 @@ struct StreamDecoder::Impl {
 
   Status end() {
     ended = true;
-    return batches == 0 ? base_done() : Status::Ok();
+    return base_ready ? Status::Ok() : base_done();
+  }
+
+  // The base mesh of a progressive file is whole: it is the first level.
+  // Its error is the next batch's error_before, known when that batch's
+  // bytes are in already.
+  Status base_level(size_t pos) {
+    TSM_RETURN_IF_ERROR(base_done());
+    level.init(mesh, h);
+    base_ready = true;
+    Section s;
+    std::string missing;
+    TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base));
+    BatchHeader bh;
+    std::string_view stream;
+    if (missing.empty() && read_batch(s.data, bh, stream).ok()) error = bh.error_before;
+    return Status::Ok();
   }
 
   // A progressive file's batch of vertex splits (FORMAT.md §4.8), applied
   // at once: mesh() is the next level of detail.
   Status refinement(const Section& s) {
-    if (batches == 0) {
-      TSM_RETURN_IF_ERROR(base_done());
-      level.init(mesh, h);
-    }
+    if (!base_ready) TSM_RETURN_IF_ERROR(base_level(buf.size()));
+    BatchHeader bh;
+    std::string_view stream;
+    TSM_RETURN_IF_ERROR(read_batch(s.data, bh, stream));
     Status st = decode_batch(s.data, level, BatchLimits{options.max_vertices, options.max_faces});
     if (!st.ok()) return Status(st.code(), "batch " + std::to_string(batches) + ": " + st.message());
     ++batches;
+    error = bh.error_after;
     return Status::Ok();
+  }
+
+  // The next section's id, when its first bytes are in (0 otherwise).
+  uint16_t next_id(size_t pos) const {
+    if (buf.size() < pos + 2) return 0;
+    return static_cast<uint16_t>(static_cast<uint8_t>(buf[pos]) | static_cast<uint8_t>(buf[pos + 1]) << 8);
+  }
+
+  // The base is shown as soon as it is whole and a refinement section
+  // begins, before that section's bytes are all in.
+  bool base_now_whole(size_t pos) const {
+    const bool segments_in =
+        h.segment_count == 1
+            ? std::any_of(whole.begin(), whole.end(), [](const Section& w) { return w.id == kSectionMesh; })
+            : done == h.segment_count;
+    return !base_ready && segments_in && next_id(pos) == kSectionRefinement;
   }
 
   Status feed(std::string_view bytes) {
@@ -641,7 +677,15 @@ struct StreamDecoder::Impl {
       TSM_RETURN_IF_ERROR(check_user_limits(h, options));
       have_header = true;
     }
+    pending = false;
     while (!ended) {
+      if (base_now_whole(pos)) {
+        TSM_RETURN_IF_ERROR(base_level(pos));
+        if (stop_levels) {
+          pending = pos < buf.size();
+          break;
+        }
+      }
       Section s;
       TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base));
       if (!missing.empty()) break;
@@ -656,9 +700,13 @@ struct StreamDecoder::Impl {
         TSM_RETURN_IF_ERROR(read_metadata(s.data, mesh.metadata));
       else if (s.id == kSectionSegment)
         TSM_RETURN_IF_ERROR(segment(s));
-      else if (s.id == kSectionRefinement)
+      else if (s.id == kSectionRefinement) {
         TSM_RETURN_IF_ERROR(refinement(s));
-      else if (s.id == kSectionLoose && batches > 0)
+        if (stop_levels) {
+          pending = pos < buf.size();
+          break;
+        }
+      } else if (s.id == kSectionLoose && batches > 0)
         TSM_RETURN_IF_ERROR(decode_loose(s.data, level, BatchLimits{options.max_vertices, options.max_faces}));
       else if (s.id == kSectionOrder)
         order = std::move(s);
@@ -687,6 +735,7 @@ Status StreamDecoder::feed(std::string_view bytes) {
 
 Status StreamDecoder::finish() {
   if (!impl_->failed.ok()) return impl_->failed;
+  while (impl_->pending && !impl_->ended) TSM_RETURN_IF_ERROR(feed({}));
   if (impl_->ended) return Status::Ok();
   std::string missing;
   if (!impl_->have_header) {
@@ -707,6 +756,10 @@ uint32_t StreamDecoder::segment_count() const { return impl_->have_header ? impl
 uint32_t StreamDecoder::segments_done() const { return impl_->done; }
 uint32_t StreamDecoder::batches_done() const { return impl_->batches; }
 bool StreamDecoder::done() const { return impl_->ended && impl_->failed.ok(); }
+bool StreamDecoder::progressive() const { return impl_->base_ready; }
+double StreamDecoder::level_error() const { return impl_->error; }
+void StreamDecoder::stop_at_levels(bool on) { impl_->stop_levels = on; }
+bool StreamDecoder::level_pending() const { return impl_->pending && impl_->failed.ok(); }
 const Mesh& StreamDecoder::mesh() const { return impl_->mesh; }
 Mesh StreamDecoder::take_mesh() { return std::move(impl_->mesh); }
 

@@ -1,5 +1,7 @@
 // The demo: fetches a .tsm file, streams the body into the decoder (on this
-// thread or in a Web Worker) and draws each segment as it is decoded.
+// thread or in a Web Worker) and draws each segment as it is decoded; a
+// progressive file's whole shape is drawn coarse first and redrawn at each
+// finer level as the bytes arrive.
 // Query: ?mesh=NAME&worker=1&throttle=BYTES_PER_SECOND&chunk=BYTES (mesh= loads at once).
 // window.tsmDemo holds the state and, when done, the counts and checksums
 // the browser test compares with the native decoder's.
@@ -18,7 +20,9 @@ function show(s) {
     `${s.name}: ${s.finished ? 'done' : 'loading'}${s.worker ? ' (Web Worker)' : ''}\n` +
     `bytes received ${kb(s.bytes)}${s.total ? ' of ' + kb(s.total) : ''}   ` +
     `triangles decoded ${s.triangles.toLocaleString()}   vertices ${s.vertices.toLocaleString()}   ` +
-    `segments ${s.segmentsDone}/${s.segmentCount || '?'}\n` +
+    `segments ${s.segmentsDone}/${s.segmentCount || '?'}` +
+    (s.levels.length ? `   level ${s.levels.length - 1} (batches ${s.levels[s.levels.length - 1].batches}, ` +
+      `error ${s.levels[s.levels.length - 1].error >= 0 ? s.levels[s.levels.length - 1].error.toPrecision(3) : '?'})` : '') + '\n' +
     `decode time ${s.decodeMs.toFixed(1)} ms   first triangles at ${s.firstMs == null ? '-' : s.firstMs.toFixed(1) + ' ms'}   ` +
     `total ${s.totalMs == null ? '-' : s.totalMs.toFixed(1) + ' ms'} (from the request to the last segment)`;
 }
@@ -45,7 +49,7 @@ async function main() {
     if (running) return;
     const name = $('mesh').value, inWorker = $('worker').checked, throttle = Number($('throttle').value);
     const s = { name, worker: inWorker, bytes: 0, total: 0, triangles: 0, vertices: 0, faces: 0, corners: 0, segmentsDone: 0,
-      segmentCount: 0, decodeMs: 0, firstMs: null, totalMs: null, pieces: 0, finished: false };
+      segmentCount: 0, decodeMs: 0, firstMs: null, totalMs: null, pieces: 0, finished: false, levels: [] };
     Object.assign(state, { state: 'loading', stats: s, result: null, error: null });
     view.clear();
     let hIdx = 0x811c9dc5, hPos = 0x811c9dc5, hOff = fnv1a(new Uint32Array(1)), polygons = false;
@@ -69,6 +73,16 @@ async function main() {
       if (inWorker && !worker) worker = createTsmWorker();
       const segments = inWorker ? decodeStreamInWorker(counted, { worker }) : tsm.decodeStream(counted);
       for await (const seg of segments) {
+        if (seg.level) {
+          // A progressive file's level of detail: the whole mesh, drawn instead of the last one.
+          view.clear();
+          hIdx = hPos = 0x811c9dc5; hOff = fnv1a(new Uint32Array(1)); polygons = false;
+          Object.assign(s, { triangles: 0, faces: 0, vertices: 0, corners: 0 });
+          // (the loose vertices after the last batch come as that level again)
+          if (s.levels.length && s.levels[s.levels.length - 1].batches === seg.batchesDone) s.levels.pop();
+          s.levels.push({ batches: seg.batchesDone, vertices: seg.vertexCount, faces: seg.faceCount, error: seg.levelError,
+            bytesIn: seg.bytesIn, ms: performance.now() - t0 });
+        }
         const tris = seg.faceOffsets ? seg.indices.length - 2 * seg.faceCount : seg.faceCount;
         if (s.firstMs == null && seg.faceCount) s.firstMs = performance.now() - t0;
         s.triangles += tris; s.faces += seg.faceCount; s.vertices += seg.vertexCount; s.corners += seg.indices.length;
@@ -87,7 +101,8 @@ async function main() {
       show(s);
       const result = { name, worker: inWorker, vertexCount: s.vertices, faceCount: s.faces, cornerCount: s.corners,
         triangles: !polygons, indexHash: hex(hIdx), positionHash: hex(hPos), bytes: s.bytes,
-        pieces: s.pieces, segmentCount: s.segmentCount, decodeMs: s.decodeMs, firstMs: s.firstMs, totalMs: s.totalMs };
+        pieces: s.pieces, segmentCount: s.segmentCount, decodeMs: s.decodeMs, firstMs: s.firstMs, totalMs: s.totalMs,
+        levels: s.levels };
       if (polygons) result.faceOffsetHash = hex(hOff);
       // wait for the frame with the whole mesh before saying done
       await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));

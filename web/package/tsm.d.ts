@@ -77,6 +77,12 @@ export interface Segment extends Omit<DecodedMesh, 'metadata'> {
   decodeMs: number;
   /** Present on the piece where the metadata first appears. */
   metadata?: MetadataEntry[];
+  /** Progressive files: true on a level of detail, the whole current mesh (draw it instead of what came before). */
+  level?: boolean;
+  /** With level: refinement batches applied (0 = the base). */
+  batchesDone?: number;
+  /** With level: the encoder's error of the level (model units), -1 while unknown. */
+  levelError?: number;
 }
 
 export interface LoadOptions {

@@ -80,6 +80,25 @@ function twoPrimitiveGltf() {
   fs.writeFileSync(file, JSON.stringify(doc));
   return file;
 }
+// A progressive file: the whole shape first (the base, then one level per
+// batch, each with more faces and no larger error), the last level the native
+// decoder's mesh (checked above), and, loaded slowly, the base before the
+// last byte (the server sends chunks of 16 KiB or more).
+function levelProblems(m, result, throttle) {
+  const out = [];
+  const levels = result.levels || [];
+  if (levels.length !== m.batches + 1) out.push(`levels: ${levels.length}, expected ${m.batches + 1} (the base and each batch)`);
+  levels.forEach((l, k) => {
+    if (l.batches !== k) out.push(`level ${k}: ${l.batches} batches`);
+    if (k && !(l.faces > levels[k - 1].faces && l.vertices > levels[k - 1].vertices))
+      out.push(`level ${k}: ${l.faces} faces after ${levels[k - 1].faces}`);
+    if (k && levels[k - 1].error >= 0 && !(l.error <= levels[k - 1].error)) out.push(`level ${k}: error ${l.error} after ${levels[k - 1].error}`);
+  });
+  if (levels.length && levels[levels.length - 1].error !== 0) out.push(`last level's error ${levels[levels.length - 1].error}`);
+  if (throttle && levels.length && !(levels[0].bytesIn < m.tsmBytes)) out.push(`the base came at byte ${levels[0].bytesIn} of ${m.tsmBytes}`);
+  return out;
+}
+
 const newer = (a, b) => !fs.existsSync(b) || fs.statSync(a).mtimeMs > fs.statSync(b).mtimeMs;
 // Encodes the files natively and prints the native decoder's figures; null
 // (and a reason) when the native tool or library is missing.
@@ -117,7 +136,7 @@ try {
   page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
   for (const m of meshes) {
     const runs = [[false, 0], [true, 0]];
-    if (m.segments > 1) runs.push([false, throttleFor(m)], [true, throttleFor(m)]);
+    if (m.segments > 1 || m.batches > 0) runs.push([false, throttleFor(m)], [true, throttleFor(m)]);
     for (const [worker, throttle] of runs) {
       const label = `${m.name}${worker ? ' (worker)' : ''}${throttle ? ` (${(throttle / 1e6).toFixed(2)} MB/s)` : ''}`;
       const before = problems.length;
@@ -139,6 +158,7 @@ try {
         if (result.segmentCount !== m.segments) diffs.push(`segments: browser ${result.segmentCount}, native ${m.segments}`);
         if (throttle && !(result.pieces >= 2 && result.firstMs < result.totalMs / 2))
           diffs.push(`not progressive: ${result.pieces} piece(s), first triangles at ${result.firstMs} ms of ${result.totalMs} ms`);
+        if (m.batches > 0) diffs.push(...levelProblems(m, result, throttle));
       }
       diffs.push(...problems.slice(before));
       const file = path.join(shots, `${m.name}${worker ? '-worker' : ''}${throttle ? '-throttled' : ''}.png`);
@@ -150,7 +170,9 @@ try {
         passed++;
         console.log(`ok   ${label}: ${result.vertexCount} vertices, ${result.faceCount} faces, indices ${result.indexHash}, ` +
           `${result.segmentCount} segment(s) in ${result.pieces} piece(s), decode ${result.decodeMs.toFixed(1)} ms, ` +
-          `first triangles ${result.firstMs.toFixed(1)} ms, all ${result.totalMs.toFixed(1)} ms  [${path.relative(root, file)}]`);
+          `first triangles ${result.firstMs.toFixed(1)} ms, all ${result.totalMs.toFixed(1)} ms` +
+          `${m.batches ? `, ${result.levels.length} levels (base ${result.levels[0].faces} faces at byte ${result.levels[0].bytesIn})` : ''}` +
+          `  [${path.relative(root, file)}]`);
       }
     }
   }
@@ -208,6 +230,43 @@ try {
       r.leftAfter >= 1 && same(r.reused1, want.dragon_res4) && same(r.reused2, want.bunny_seg4k) && r.sourceIntact;
     if (ok) { passed++; console.log(`ok   API: byte-by-byte feed (${r.bytewise.pieces} pieces), odd chunks, reused worker left early`); }
     else { failed++; console.log(`FAIL API: ${JSON.stringify(r)}`); }
+  }
+  // Progressive files by hand: streamed in odd chunks, on this thread and in
+  // a worker, the last level's arrays equal element by element those of a
+  // whole-file decode (whose checksums are the native decoder's), one level per
+  // batch.
+  for (const m of meshes.filter((x) => x.batches > 0)) {
+    const r = await page.evaluate(async (name) => {
+      const { loadTsm, decodeStreamInWorker } = await import('/dist/tsm.js');
+      const { fnv1a, hex } = await import('/hash.js');
+      const tsm = await loadTsm();
+      const bytes = new Uint8Array(await (await fetch(`/data/${name}.tsm`)).arrayBuffer());
+      const whole = tsm.decode(bytes);
+      function* sliced(b, k) { for (let i = 0; i < b.length; i += k) yield b.subarray(i, i + k); }
+      const equal = (a, b) => a.length === b.length && a.every((x, i) => Object.is(x, b[i]));
+      const run = async (pieces) => {
+        let last = null, levels = 0, faces = [];
+        for await (const p of pieces) {
+          if (!p.level) continue;
+          if (!last || p.batchesDone !== last.batchesDone) { levels++; faces.push(p.faceCount); }
+          last = p;
+        }
+        return { levels, grows: faces.every((f, i) => i === 0 || f > faces[i - 1]),
+          same: !!last && equal(last.positions, whole.positions) && equal(last.indices, whole.indices) };
+      };
+      return {
+        indexHash: hex(fnv1a(whole.indices)), positionHash: hex(fnv1a(whole.positions)),
+        odd: await run(tsm.decodeStream(sliced(bytes, 997))),
+        once: await run(tsm.decodeStream(bytes)),
+        worker: await run(decodeStreamInWorker(sliced(bytes, 4096))),
+      };
+    }, m.name);
+    const want = m.batches + 1;
+    const runs = [r.odd, r.once, r.worker];
+    const ok = r.indexHash === m.ref.indexHash && r.positionHash === m.ref.positionHash &&
+      runs.every((x) => x.levels === want && x.grows && x.same);
+    if (ok) { passed++; console.log(`ok   progressive ${m.name}: ${want} levels streamed (997-byte chunks, whole, worker), last = tsm decode's arrays`); }
+    else { failed++; console.log(`FAIL progressive ${m.name}: ${JSON.stringify(r)} (want ${want} levels, native ${m.ref.indexHash}/${m.ref.positionHash})`); }
   }
   // Attributes: the browser's values and indices are the native decoder's.
   {

@@ -52,6 +52,7 @@ typedef struct tsm_encode_options {
   int keep_order;      /* nonzero: the decoded mesh keeps the input's vertex, face and corner order */
   int lossless;        /* nonzero: every float32 coordinate comes back bit for bit (quantization_bits unused) */
   int allow_nonfinite; /* with lossless, nonzero: NaN and infinite coordinates are kept (else refused) */
+  int progressive;     /* nonzero: a base mesh then batches of vertex splits (positions and faces only) */
 } tsm_encode_options;
 
 /* Decodes a .tsm buffer. options may be NULL. On success *out owns a mesh. */
@@ -105,6 +106,56 @@ size_t tsm_stream_segments_done(const tsm_stream* s);
  * segments <= k. */
 const tsm_mesh* tsm_stream_mesh(const tsm_stream* s);
 void tsm_stream_free(tsm_stream* s);
+
+/* Progressive files (a base mesh, then batches of vertex splits): the stream's
+ * mesh is a level of detail of the whole shape, from the base (shown as soon as
+ * it is whole) to the full mesh; batches change faces in place, so a client
+ * redraws the whole mesh at each level rather than appending. To see every
+ * level, even when one chunk holds several batches:
+ *
+ *   tsm_stream_stop_at_levels(s, 1);
+ *   while (read a chunk) {
+ *     int rc = tsm_stream_feed(s, chunk, n, err, sizeof err);
+ *     while (rc == TSM_OK) {
+ *       if (tsm_stream_progressive(s)) draw(tsm_stream_mesh(s), tsm_stream_batches_done(s),
+ *                                           tsm_stream_level_error(s));
+ *       if (!tsm_stream_level_pending(s)) break;
+ *       rc = tsm_stream_feed(s, NULL, 0, err, sizeof err);
+ *     }
+ *   }
+ */
+/* Nonzero: tsm_stream_feed returns after each new level (the base, then each
+ * batch), keeping the bytes after it for the next feed (which may be empty). */
+void tsm_stream_stop_at_levels(tsm_stream* s, int on);
+/* Nonzero when the last feed stopped at a level with bytes left to decode. */
+int tsm_stream_level_pending(const tsm_stream* s);
+/* Nonzero once the base mesh is whole and a refinement batch follows it. */
+int tsm_stream_progressive(const tsm_stream* s);
+/* Refinement batches applied so far (0 = the base). */
+size_t tsm_stream_batches_done(const tsm_stream* s);
+/* The encoder's error of the current level (the largest distance of a full-mesh
+ * vertex from the level, in the mesh's units, as the file records it); -1 when
+ * unknown (single-rate files, the base before the first batch's bytes are in). */
+double tsm_stream_level_error(const tsm_stream* s);
+
+/* Decoding a prefix of a progressive file: the finest level whose batches are
+ * whole within the bytes (and within max_bytes when nonzero), stopping at the
+ * first level whose error is at most max_error when max_error > 0. A
+ * single-rate file decodes only whole; an error when even the base mesh is cut
+ * off or a byte in use is damaged. partial, options and report may be NULL. */
+typedef struct tsm_partial_options {
+  uint64_t max_bytes; /* 0 = all the bytes given */
+  double max_error;   /* <= 0: refine as far as the bytes go */
+} tsm_partial_options;
+typedef struct tsm_partial_report {
+  uint64_t bytes_used; /* bytes of the file the level needed */
+  double error;        /* the encoder's error of the level decoded */
+  uint32_t batches;    /* refinement batches applied */
+  int complete;        /* nonzero: the whole file was there and decoded */
+} tsm_partial_report;
+int tsm_decode_partial(const uint8_t* data, size_t size, const tsm_partial_options* partial,
+                       const tsm_decode_options* options, tsm_mesh** out, tsm_partial_report* report, char* err,
+                       size_t err_size);
 
 size_t tsm_mesh_vertex_count(const tsm_mesh* mesh);
 size_t tsm_mesh_face_count(const tsm_mesh* mesh);

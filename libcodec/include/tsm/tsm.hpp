@@ -94,6 +94,21 @@ class StreamDecoder {
   uint32_t segments_done() const;
   uint32_t batches_done() const;   // progressive files: refinement batches applied
   bool done() const;               // the end marker was read, no error
+  // Progressive files (FORMAT.md §4.8): true once the base mesh is whole
+  // and the next section is a refinement batch; mesh() is then a level of
+  // detail of the whole shape (batches change faces in place: a client
+  // redraws it rather than appending).
+  bool progressive() const;
+  // The encoder's error of the level mesh() holds (model units; the file
+  // records it per batch), or -1 while unknown (the base before the first
+  // batch's bytes are in, single-rate files).
+  double level_error() const;
+  // With stop_at_levels(true), feed() returns after each new level of a
+  // progressive file (the base, then each batch), keeping the bytes after
+  // it; level_pending() then says more may be decodable, and feed() with
+  // no bytes continues. finish() decodes whatever is pending first.
+  void stop_at_levels(bool on);
+  bool level_pending() const;
   const Mesh& mesh() const;
   Mesh take_mesh();                // moves the mesh out (call when done)
 
