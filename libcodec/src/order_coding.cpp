@@ -261,8 +261,9 @@ void window_candidates(const Mesh& m, const std::vector<uint32_t>& taken_faces, 
   const size_t j = taken_faces.size();
   for (size_t t = 1; t <= kWindowFaces && t <= j && out.size() < kWindowCorners; ++t) {
     const uint32_t g = taken_faces[j - t], n = m.face_size(g);
-    for (uint32_t c = 0; c < n && out.size() < kWindowCorners; ++c) {
-      const uint32_t x = m.face(g)[(rot[j - t] + c) % n];
+    const uint32_t* c = m.face(g);
+    for (uint32_t q = 0, k = rot[j - t]; q < n && out.size() < kWindowCorners; ++q, k = k + 1 == n ? 0 : k + 1) {
+      const uint32_t x = c[k];
       if (left[x] == 0 || stamp[x] == j + 1) continue;
       stamp[x] = static_cast<uint32_t>(j + 1);
       out.push_back(x);
