@@ -6,6 +6,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -519,4 +521,17 @@ TEST(Lossless, CommandLineFlags) {
   EXPECT_EQ(back.indices, m.indices);
   ASSERT_EQ(back.positions.size(), m.positions.size());
   EXPECT_EQ(std::memcmp(back.positions.data(), m.positions.data(), 4 * m.positions.size()), 0);
+  // tsm info names both.
+  ASSERT_EQ(std::system((cli + " info " + dir.file("l.tsm") + " > " + dir.file("info.txt") + " 2>&1").c_str()), 0);
+  std::ifstream f(dir.file("info.txt"));
+  const std::string info((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(info.find("lossless: every float32 coordinate exact"), std::string::npos) << info;
+  EXPECT_NE(info.find("keep-order:"), std::string::npos) << info;
+  EXPECT_EQ(info.find("quantization"), std::string::npos) << info;
+  // -q means nothing with --lossless: refused (exit 2), no file written.
+  EXPECT_EQ(std::system((cli + " encode --lossless -q 12 " + dir.file("in.ply") + " -o " + dir.file("q.tsm") +
+                         " > /dev/null 2>&1")
+                            .c_str()),
+            2 << 8);
+  EXPECT_FALSE(std::ifstream(dir.file("q.tsm")).good());
 }
