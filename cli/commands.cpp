@@ -654,7 +654,8 @@ FileResult info_one(const std::string& input) {
   const uint64_t side = fi.file_bytes - fi.connectivity_bytes - fi.geometry_bytes - attribute_values;
   using ull = unsigned long long;
   r.json = strf("{\"file\": \"%s\", \"status\": \"ok\", \"format_version\": %u, \"bytes\": %llu, \"vertices\": %llu, "
-                "\"faces\": %llu, \"corners\": %llu, \"quantization_bits\": %d, \"level\": %d, \"segments\": %u, "
+                "\"faces\": %llu, \"corners\": %llu, \"quantization_bits\": %d, \"lossless\": %s, \"keep_order\": %s, "
+                "\"level\": %d, \"segments\": %u, "
                 "\"bbox_min\": [%.9g, %.9g, %.9g], \"step\": %.9g, \"bits_per_vertex\": %.4f, "
                 "\"connectivity_bits_per_vertex\": %.4f, \"geometry_bits_per_vertex\": %.4f, "
                 "\"attribute_bits_per_vertex\": %.4f, \"side_bits_per_vertex\": %.4f, \"components\": %llu, \"vertex_runs\": %llu, "
@@ -663,7 +664,8 @@ FileResult info_one(const std::string& input) {
                 "\"ancestors\": %d, \"lattice_planes\": [%u, %u, %u], \"sections\": [",
                 json_escape(input).c_str(), fi.format_version, static_cast<ull>(fi.file_bytes),
                 static_cast<ull>(fi.vertex_count), static_cast<ull>(fi.face_count), static_cast<ull>(fi.corner_count),
-                fi.quantization_bits, fi.level, fi.segment_count, fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2],
+                fi.quantization_bits, fi.lossless ? "true" : "false", fi.keep_order ? "true" : "false", fi.level,
+                fi.segment_count, fi.bbox_min[0], fi.bbox_min[1], fi.bbox_min[2],
                 fi.step, bpv, per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(attribute_values),
                 per_vertex(side),
                 static_cast<ull>(fi.components), static_cast<ull>(fi.vertex_runs), static_cast<ull>(fi.triangle_runs),
@@ -701,7 +703,12 @@ FileResult info_one(const std::string& input) {
             thousands(fi.face_count).c_str(), thousands(fi.corner_count).c_str(), fi.segment_count);
   if (fi.welded_points)
     t += strf("  welded: %s points (positions and connectivity coded on them)\n", thousands(fi.welded_points).c_str());
-  t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
+  if (fi.lossless)
+    t += strf("  lossless: every float32 coordinate exact (grid step %.6g, %d bits; the rest as exceptions), level %d\n",
+              fi.step, fi.quantization_bits, fi.level);
+  else
+    t += strf("  quantization %d bits (step %.6g), level %d\n", fi.quantization_bits, fi.step, fi.level);
+  if (fi.keep_order) t += "  keep-order: decodes in the input's vertex order, face order and first corners\n";
   if (fi.attributes.empty())
     t += strf("  bits/vertex: %.3f total = %.3f connectivity + %.3f geometry + %.3f header and side data\n", bpv,
               per_vertex(fi.connectivity_bytes), per_vertex(fi.geometry_bytes), per_vertex(side));

@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
   enc->add_flag("--keep-order", ea.keep_order,
                 "The decoded mesh keeps the input's vertex order, face order and first corners (costs bytes)");
   enc->add_flag("--lossless", ea.lossless,
-                "Every float32 coordinate comes back bit for bit (-q is not used)");
+                "Every float32 coordinate comes back bit for bit (not with -q: there is no quantization grid)");
   enc->add_flag("-f,--force", ea.force, "Overwrite existing output files (never an input)");
   enc->add_flag("--fallback", ea.fallback,
                 "glTF output: keep an uncompressed copy of each compressed primitive, for viewers without "
@@ -346,6 +346,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     int code = app.exit(e);
     return code == 0 ? 0 : kExitUsage;
+  }
+  if (*enc && ea.lossless && enc->count("-q") > 0) {
+    std::fprintf(stderr,
+                 "tsm: error: -q sets a quantization grid, and --lossless uses none (every float32 coordinate comes "
+                 "back bit for bit): drop -q, or drop --lossless to quantize\n");
+    return kExitUsage;
   }
   try {
     if (*enc) return cmd_encode(ea);

@@ -3081,6 +3081,78 @@ def apply_exceptions(payload, positions):
 
 # ---------------------------------------------------------------- §4.8 the order section
 
+SWEEP_AXES = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+
+
+def ordered_bits(x):
+    b = bits32(x)
+    return (~b & 0xFFFFFFFF) if b & 0x80000000 else b | 0x80000000
+
+
+def slab_of(x, e):
+    """floor(x / 2^e), exact, clamped to -2^62 .. 2^62 - 1; NaN: 2^62."""
+    if math.isnan(x):
+        return 1 << 62
+    q = math.ldexp(x, -e)
+    if q >= 2.0 ** 62:
+        return (1 << 62) - 1
+    if q <= -2.0 ** 62:
+        return -(1 << 62)
+    return math.floor(q)
+
+
+class Sweep:
+    """§4.9: the items not taken yet in a given order (a Fenwick tree of 0/1)."""
+    def __init__(self, positions, ax, e):
+        self.init(sorted(range(len(positions)), key=lambda v: (slab_of(positions[v][ax[0]], e),
+                                                               ordered_bits(positions[v][ax[1]]),
+                                                               ordered_bits(positions[v][ax[2]]), v)))
+
+    @classmethod
+    def of_order(cls, order):
+        s = cls.__new__(cls)
+        s.init(order)
+        return s
+
+    def init(self, order):
+        n = len(order)
+        self.order = order
+        self.at = [0] * n
+        for i, v in enumerate(self.order):
+            self.at[v] = i
+        self.tree = [0] * (n + 1)
+        for i in range(1, n + 1):
+            self.tree[i] += 1
+            up = i + (i & -i)
+            if up <= n:
+                self.tree[up] += self.tree[i]
+        self.top = 1
+        while self.top * 2 <= n:
+            self.top *= 2
+
+    def rank(self, v):
+        r, i = 0, self.at[v]
+        while i > 0:
+            r += self.tree[i]
+            i &= i - 1
+        return r
+
+    def take(self, v):
+        i = self.at[v] + 1
+        while i < len(self.tree):
+            self.tree[i] -= 1
+            i += i & -i
+
+    def at_rank(self, r):
+        i, step = 0, self.top
+        while step:
+            if i + step < len(self.tree) and self.tree[i + step] <= r:
+                i += step
+                r -= self.tree[i]
+            step >>= 1
+        return self.order[i]
+
+
 def decode_order(payload, faces, positions):
     """§4.8: per input vertex its decoded vertex, per input face its decoded
     face and first corner."""
@@ -3100,11 +3172,16 @@ def decode_order(payload, faces, positions):
     nbr = [sorted(x) for x in nbr]
     d = RangeDecoder(payload)
     vertex_pick = [UIntModel() for _ in range(5)]
-    corner_pick = [UIntModel() for _ in range(5)]
+    window_pick = [UIntModel() for _ in range(5)]
     face_pick = [UIntModel() for _ in range(5)]
-    vertex_jump, corner_jump = SIntModel(), SIntModel()
+    turn = [UIntModel() for _ in range(2)]
+    vertex_jump, face_jump = SIntModel(), SIntModel()
     used = [False] * vc
     vertices, input_of = [], [0] * vc
+    axes, slab = d.direct(3), d.direct(8) - 128
+    if axes > 5:
+        reject('order section: sweep axes %d out of range' % axes)
+    sweep = Sweep(positions, SWEEP_AXES[axes], slab)
     for i in range(vc):
         cand = []
         if i:
@@ -3125,53 +3202,71 @@ def decode_order(payload, faces, positions):
         if pick:
             v = cand[pick - 1]
         else:
-            v = (vertices[-1] + 1 if i else 0) + vertex_jump.decode(d)
-            if not 0 <= v < vc or used[v]:
-                reject('order section: vertex %d is not an unused vertex of the mesh' % i)
+            r = (sweep.rank(vertices[-1]) if i else 0) + vertex_jump.decode(d)
+            if not 0 <= r < vc - i:
+                reject('order section: vertex %d jumps past the unused vertices' % i)
+            v = sweep.at_rank(r)
+        sweep.take(v)
         used[v] = True
         vertices.append(v)
         input_of[v] = i
         if d.truncated():
             reject('order section: cut off')
+    fsweep_key = []
+    for f, c in enumerate(faces):
+        fsweep_key.append((min(sweep.at[x] for x in c), f))
+    fsweep = Sweep.of_order([f for _, f in sorted(fsweep_key)])
+    left = [0] * vc                        # per vertex: its unused faces
+    for c in faces:
+        for x in set(c):
+            left[x] += 1
     taken = [False] * fc
     order, rot, new_faces = [], [], []
     for j in range(fc):
-        cand = []
-        if j:
-            for x in new_faces[-1]:
-                if x not in cand:
+        cand = []                          # the window: corners of the last 16 faces
+        for t in range(1, min(16, j) + 1):
+            g, r = faces[order[j - t]], rot[j - t]
+            for q in range(len(g)):
+                x = g[(r + q) % len(g)]
+                if len(cand) < 64 and left[x] and x not in cand:
                     cand.append(x)
-        pick = corner_pick[min(len(cand), 4)].decode(d) if cand else 0
+        pick = window_pick[min(len(cand), 4)].decode(d) if cand else 0
         if pick > len(cand):
             reject('order section: face %d picks a corner it does not have' % j)
         if pick:
-            u = cand[pick - 1]
+            x = cand[pick - 1]
+            prev = set(faces[order[-1]]) if j else set()
+            first, later = [], []
+            for f in inc[x]:
+                if taken[f]:
+                    continue
+                shared = len(set(faces[f]) & prev)
+                for k, y in enumerate(faces[f]):
+                    if y == x:
+                        (first if shared >= 2 else later).append((f, k))
+            fcand = first + later
+            if not fcand:
+                reject('order section: face %d: no unused face at its corner' % j)
+            q = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
+            if q >= len(fcand):
+                reject('order section: face %d picks a face it does not have' % j)
+            f, k = fcand[q]
         else:
-            u = (new_faces[-1][0] if j else 0) + corner_jump.decode(d)
-            if not 0 <= u < vc:
-                reject('order section: face %d: first corner out of range' % j)
-        x = vertices[u]
-        prev = set(faces[order[-1]]) if j else set()
-        first, later = [], []
-        for f in inc[x]:
-            if taken[f]:
-                continue
-            shared = len(set(faces[f]) & prev)
-            for k, y in enumerate(faces[f]):
-                if y == x:
-                    (first if shared >= 2 else later).append((f, k))
-        fcand = first + later
-        if not fcand:
-            reject('order section: face %d: no unused face at its first corner' % j)
-        k = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
-        if k >= len(fcand):
-            reject('order section: face %d picks a face it does not have' % j)
-        f, r = fcand[k]
-        taken[f] = True
-        order.append(f)
-        rot.append(r)
+            r = (fsweep.rank(order[-1]) if j else 0) + face_jump.decode(d)
+            if not 0 <= r < fc - j:
+                reject('order section: face %d jumps past the unused faces' % j)
+            f, k = fsweep.at_rank(r), 0
         c = faces[f]
-        new_faces.append([input_of[c[(r + t) % len(c)]] for t in range(len(c))])
+        t = turn[1 if pick else 0].decode(d) if len(c) > 1 else 0
+        if t >= len(c):
+            reject('order section: face %d turns past its corners' % j)
+        taken[f] = True
+        fsweep.take(f)
+        for x in set(c):
+            left[x] -= 1
+        order.append(f)
+        rot.append((k + t) % len(c))
+        new_faces.append([input_of[c[(rot[-1] + q) % len(c)]] for q in range(len(c))])
         if d.truncated():
             reject('order section: cut off')
     return order, rot, vertices, new_faces

@@ -490,7 +490,9 @@ Status inspect(std::string_view bytes, FileInfo& info) {
   for (int a = 0; a < 3; ++a) info.bbox_min[a] = h.origin[a];
   info.step = (h.flags & kHeaderExactGrid) ? h.exact_step : grid_step(h);
   info.file_bytes = bytes.size();
+  info.lossless = (h.flags & kHeaderExactGrid) != 0;
   for (const Section& s : sections) {
+    if (s.id == kSectionOrder) info.keep_order = true;
     SectionInfo si;
     si.id = s.id;
     si.name = section_name(s.id);

@@ -172,6 +172,10 @@ struct FileInfo {
   double bbox_min[3] = {0, 0, 0};
   double step = 0;
   uint64_t file_bytes = 0;
+  // Lossless (FORMAT.md §5.1: every coordinate on an exact float32 grid, the
+  // misses in the exceptions section) and keep-order (an order section,
+  // §4.9: the encoder's input order of vertices, faces and first corners).
+  bool lossless = false, keep_order = false;
   std::vector<SectionInfo> sections;
   // Topology figures (from decoding the connectivity streams).
   uint64_t components = 0, vertex_runs = 0, triangle_runs = 0, jump_edges = 0, stitches = 0,
