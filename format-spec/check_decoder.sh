@@ -49,8 +49,8 @@ result() {  # name status
   cases=$((cases + 1))
   [ "$2" -eq 0 ] || failed="$failed $1"
 }
-encode() {  # name mesh q level [segment_faces [flag]]
-  "$tsm" encode "$2" -o "$work/$1.tsm" -q "$3" -l "$4" --segment-faces "${5:-0}" ${6:+"$6"} -f --quiet
+encode() {  # name mesh q level [segment_faces [flag]] (q "" = none: --lossless takes no -q)
+  "$tsm" encode "$2" -o "$work/$1.tsm" ${3:+-q "$3"} -l "$4" --segment-faces "${5:-0}" ${6:+"$6"} -f --quiet
 }
 check() {  # name mesh q level [segment_faces]: positions, faces and attributes through PLY
   if encode "$@" && "$tsm" decode "$work/$1.tsm" -o "$work/$1.ply" -f --quiet; then
@@ -127,10 +127,10 @@ check progressive_irregular "$work/irregular.obj" 12 6 0 --progressive
 check progressive_mixed "$work/mixed.obj" 12 6 0 --progressive
 corpus_case check progressive_dragon "$dragon" 11 6 0 --progressive
 # lossless files (§5.1): the exact grid and its exceptions
-check lossless_mixed "$work/mixed.obj" 12 6 0 --lossless
-check lossless_segments "$work/irregular.obj" 12 0 600 --lossless
-corpus_case check lossless_dragon "$dragon" 11 6 0 --lossless
-corpus_case check lossless_bunny "$corpus/bun_zipper.ply" 11 2 0 --lossless
+check lossless_mixed "$work/mixed.obj" "" 6 0 --lossless
+check lossless_segments "$work/irregular.obj" "" 0 600 --lossless
+corpus_case check lossless_dragon "$dragon" "" 6 0 --lossless
+corpus_case check lossless_bunny "$corpus/bun_zipper.ply" "" 2 0 --lossless
 
 # ---- attributes (§8.12)
 for l in 0 9; do acheck attributes_obj_l$l "$work/attributes.obj" 12 $l; done
@@ -139,7 +139,7 @@ acheck attributes_obj_segments "$work/attributes.obj" 12 6 60
 acheck attributes_ply_segments "$work/attributes.ply" 12 6 100
 acheck keep_order_attributes_obj "$work/attributes.obj" 12 6 60 --keep-order
 acheck keep_order_attributes_ply "$work/attributes.ply" 12 6 0 --keep-order
-acheck lossless_attributes_ply "$work/attributes.ply" 12 6 0 --lossless
+acheck lossless_attributes_ply "$work/attributes.ply" "" 6 0 --lossless
 edge=$corpus/edge
 for f in cube_att.obj cube_att.ply sphere.obj test_nm.obj Box.ply test_pos_color.ply test_more_datatypes.ply; do
   corpus_case acheck "$(echo "$f" | tr . _)" "$edge/$f" 11 6
