@@ -357,6 +357,17 @@ TEST(IndexedCorners, CodedAsSplitVertices) {
     Mesh back;
     ASSERT_TRUE(decode(bytes, back).ok());
     EXPECT_EQ(back.attributes[0].value_count(), m.attributes[0].value_count()) << name;
+    // The mapping names each decoded vertex's input vertex (asking changes no byte).
+    EncodeOptions eo;
+    eo.quantization_bits = 12;
+    std::string mapped;
+    EncodeMapping map;
+    ASSERT_TRUE(encode(m, eo, mapped, &map).ok()) << name;
+    EXPECT_TRUE(mapped == bytes) << name;
+    ASSERT_EQ(map.vertex_from.size(), back.vertex_count()) << name;
+    for (size_t v = 0; v < back.vertex_count(); ++v)
+      for (int a = 0; a < 3; ++a)
+        EXPECT_NEAR(back.positions[3 * v + a], m.positions[3 * size_t{map.vertex_from[v]} + a], 1e-3) << name;
   }
   // Where a value repeats on the grid (two vn entries alike), the lists
   // could not be rebuilt by value: coded as corner values, still exact.
