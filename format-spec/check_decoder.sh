@@ -167,8 +167,8 @@ done
 # the truck's OBJ with its v, vt and vn lists deduplicated, as exporters
 # write them: corner values shared across vertices (normals predicted by
 # face or angle, §8.12 predictors 3 and 4, in the corner domain)
-if [ -f "$work/CesiumMilkTruck_obj.obj" ]; then
-  python3 - "$work/CesiumMilkTruck_obj.obj" "$work/truck_dedup.obj" <<'PY'
+dedup_obj() {  # in out
+  python3 - "$1" "$2" <<'PY'
 import sys
 lists, faces = {'v': [], 'vt': [], 'vn': []}, []
 for line in open(sys.argv[1]):
@@ -189,10 +189,18 @@ with open(sys.argv[2], 'w') as out:
         corners = []
         for c in f:
             t = c.split('/')
-            corners.append('/'.join(str(index[k][int(x) - 1] + 1) for k, x in zip(('v', 'vt', 'vn'), t)))
+            corners.append('/'.join(str(index[k][int(x) - 1] + 1) if x else '' for k, x in zip(('v', 'vt', 'vn'), t)))
         out.write('f %s\n' % ' '.join(corners))
 PY
+}
+if [ -f "$work/CesiumMilkTruck_obj.obj" ]; then
+  dedup_obj "$work/CesiumMilkTruck_obj.obj" "$work/truck_dedup.obj"
   acheck truck_dedup_obj "$work/truck_dedup.obj" 11 6
+fi
+# the Fox's the same way: coded as split vertices, points out (§8.13)
+if [ -f "$work/Fox_obj.obj" ]; then
+  dedup_obj "$work/Fox_obj.obj" "$work/fox_dedup.obj"
+  acheck fox_dedup_obj "$work/fox_dedup.obj" 11 6
 fi
 # predictor 2 (texture placement): vertex and corner domain, whole and segmented
 acheck uv_vertex "$work/uv_vertex.ply" 12 6

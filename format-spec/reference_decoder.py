@@ -2586,11 +2586,11 @@ def decode_part(streams, counts, bits, earlier, trace):
     if n > len(sa) - p or p + n >= len(sa):
         reject('split stream cut off')
     split, order, sa = sa[p:p + n], sa[p + n], sa[p + n + 1:]
-    if order > 1:
+    if order > 3:
         reject('attribute order')
     wfaces, walk_out, walk_point, orig = decode_split_layout(split, vc, info['points'], q, faces)
     lst = [w for w in range(len(walk_out)) if orig[w] == w]      # the originals, in the order coded
-    if order == 1:
+    if order & 1:
         lst.sort(key=lambda w: walk_out[w])
     rank = {w: k for k, w in enumerate(lst)}
     afaces = [[rank[orig[x]] for x in f] for f in wfaces]
@@ -2607,7 +2607,40 @@ def decode_part(streams, counts, bits, earlier, trace):
                 for w in range(vc):
                     vals[walk_out[w]] = a[key][rank[orig[w]]]
                 a[key] = vals
-    return [[walk_out[x] for x in f] for f in wfaces], out_q, glob, info, attrs
+    out_faces = [[walk_out[x] for x in f] for f in wfaces]
+    if order & 2:
+        return points_out(out_faces, q, glob, info, attrs, walk_out, walk_point)
+    return out_faces, out_q, glob, info, attrs
+
+
+def points_out(faces, q, glob, info, attrs, walk_out, walk_point):
+    """§8.13 points out: one output vertex per point; a vertex attribute takes
+    the value of the point's first vertex; a corner attribute coded per vertex
+    gets its value list back (distinct values as binary32 bits, in the order the
+    corners first use them)."""
+    point = [0] * len(walk_out)
+    for w, o in enumerate(walk_out):
+        point[o] = walk_point[w]
+    first = [None] * len(q)
+    for o, p in enumerate(point):
+        if first[p] is None:
+            first[p] = o
+    for a in attrs:
+        h = a['header']
+        if h.domain == 0:
+            for key in ('ints', 'values'):
+                a[key] = [a[key][first[p]] for p in range(len(q))]
+        elif h.per_vertex:
+            ids, ints, vals, idx = {}, [], [], []
+            for o in a['indices']:
+                bits = tuple(struct.pack('<f', x) for x in a['values'][o])
+                if bits not in ids:
+                    ids[bits] = len(vals)
+                    ints.append(a['ints'][o])
+                    vals.append(a['values'][o])
+                idx.append(ids[bits])
+            a['ints'], a['values'], a['indices'] = ints, vals, idx
+    return [[point[x] for x in f] for f in faces], list(q), [NONE] * len(q), info, attrs
 
 
 def split_reduced(v):
@@ -2792,6 +2825,7 @@ def decode(data, trace=None):
             for k in ('components', 'jump_edges', 'virtual', 'stitches', 'side_faces', 'polygons'):
                 info[k] += pinfo[k]
     info['segments'] = len(parts)
+    vc = len(q)                          # §8.13 points out: the points, not the header's split vertices
     attrs = join_attributes(part_attrs)                              # step 29, §8.12
     info['metadata'] = read_metadata(sections[9]) if sections.get(9) is not None else None   # step 30, §4.6
     info['metadata_skipped'] = 9 in sections and sections[9] is None  # zstd-coded, no zstandard module

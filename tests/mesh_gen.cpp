@@ -342,4 +342,66 @@ tsm::Mesh flat_shaded_textured_sphere(int level) {
   return m;
 }
 
+// An open cylinder with a vt list: one texture coordinate per (ring,
+// column), the seam's column twice (u = 0 and u = 1), corners naming them.
+Mesh indexed_uv_cylinder(int around, int rings) {
+  Mesh m;
+  const uint32_t n = static_cast<uint32_t>(around);
+  for (int r = 0; r <= rings; ++r)
+    for (uint32_t i = 0; i < n; ++i) {
+      const float t = 6.2831853f * static_cast<float>(i) / static_cast<float>(n);
+      m.add_vertex(std::cos(t), std::sin(t), static_cast<float>(r) / static_cast<float>(rings));
+    }
+  tsm::Attribute uv;
+  uv.name = "texcoord";
+  uv.kind = tsm::AttributeKind::texcoord;
+  uv.domain = tsm::AttributeDomain::corner;
+  uv.components = 2;
+  for (int r = 0; r <= rings; ++r)
+    for (uint32_t i = 0; i <= n; ++i) {
+      uv.values.push_back(static_cast<float>(i) / static_cast<float>(n));
+      uv.values.push_back(static_cast<float>(r) / static_cast<float>(rings));
+    }
+  auto vid = [&](int r, uint32_t i) { return static_cast<uint32_t>(r) * n + i % n; };
+  auto tid = [&](int r, uint32_t i) { return static_cast<uint32_t>(r) * (n + 1) + i; };
+  for (int r = 0; r < rings; ++r)
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t v[4] = {vid(r, i), vid(r, i + 1), vid(r + 1, i + 1), vid(r + 1, i)};
+      const uint32_t t[4] = {tid(r, i), tid(r, i + 1), tid(r + 1, i + 1), tid(r + 1, i)};
+      static const int kTriangles[2][3] = {{0, 1, 2}, {0, 2, 3}};
+      for (const int* tri : kTriangles) {
+        const uint32_t f[3] = {v[tri[0]], v[tri[1]], v[tri[2]]};
+        m.add_face(f, 3);
+        for (int k = 0; k < 3; ++k) uv.indices.push_back(t[tri[k]]);
+      }
+    }
+  m.attributes = {uv};
+  return m;
+}
+
+// A flat-shaded sphere as an OBJ exporter writes it: one vertex per
+// position, one normal per face in a vn list, each corner naming its face's.
+Mesh indexed_flat_sphere(int level) {
+  Mesh m = icosphere(level);
+  tsm::Attribute n;
+  n.name = "normal";
+  n.kind = tsm::AttributeKind::normal;
+  n.domain = tsm::AttributeDomain::corner;
+  n.components = 3;
+  for (uint32_t f = 0; f < m.face_count(); ++f) {
+    const uint32_t* c = m.face(f);
+    const float* p0 = &m.positions[3 * size_t{c[0]}];
+    const float* p1 = &m.positions[3 * size_t{c[1]}];
+    const float* p2 = &m.positions[3 * size_t{c[2]}];
+    const float a[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const float b[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    float x[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    const float len = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    for (float& v : x) n.values.push_back(v / len);
+    for (int k = 0; k < 3; ++k) n.indices.push_back(f);
+  }
+  m.attributes = {n};
+  return m;
+}
+
 }  // namespace tsm_test

@@ -57,4 +57,14 @@ tsm::Mesh flat_shaded(const tsm::Mesh& in);
 // point, so each point has one texture wedge and a normal wedge per face).
 tsm::Mesh flat_shaded_textured_sphere(int level);
 
+// An open cylinder as an OBJ exporter writes it: one vertex per position, a
+// `texcoord` corner attribute whose list has one value per (ring, column),
+// the seam's column twice (u = 0 and u = 1), the corners naming them.
+tsm::Mesh indexed_uv_cylinder(int around, int rings);
+
+// icosphere(level) flat-shaded as an OBJ exporter writes it: one vertex per
+// position, a `normal` corner attribute with one value per face (a vn list),
+// each corner naming its face's.
+tsm::Mesh indexed_flat_sphere(int level);
+
 }  // namespace tsm_test

@@ -39,8 +39,8 @@
 #include "container_forge.hpp"
 #include "mesh_gen.hpp"
 #include "test_util.hpp"
-#include "tsm/tsm.hpp"
 #include "tsm/io.hpp"
+#include "tsm/tsm.hpp"
 
 // --- Counting allocator -----------------------------------------------------
 
@@ -252,6 +252,8 @@ std::vector<std::string> damage_files() {
   out.push_back(encode_ok(tsm_test::flipped_face_sphere(1), 16));
   // Welded, with a split stream and wedge values (FORMAT.md §8.12-§8.13).
   out.push_back(encode_ok(tsm_test::flat_shaded_textured_sphere(1), 12));
+  // Split vertices with points out (an indexed vn list, §8.13).
+  out.push_back(encode_ok(tsm_test::indexed_flat_sphere(1), 12));
   out.push_back(encode_ok(tsm_test::icosphere(2), 12, tsm::kDefaultLevel, 40));  // 8 segments
   out.push_back(encode_ok(tsm_test::copies(tsm_test::cube_quads(), 4), 9, tsm::kDefaultLevel, 5));
   Mesh with_metadata = tsm_test::icosphere(2);

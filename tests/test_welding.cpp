@@ -5,6 +5,7 @@
 // the oracle, canonical on re-encoding, positions-only meshes never welded.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -326,5 +327,72 @@ TEST(Welding, CorpusAssetsThroughObj) {
     ASSERT_TRUE(write_mesh(path, m).ok()) << rel;
     ASSERT_TRUE(read_mesh(path, obj).ok()) << rel;
     expect_exact(obj, std::string(rel) + " via OBJ", 11);
+  }
+}
+
+namespace {
+
+uint64_t coded_vertices(const std::string& bytes) {
+  FileInfo info;
+  EXPECT_TRUE(inspect(bytes, info).ok());
+  return info.vertex_count;
+}
+
+}  // namespace
+
+// FORMAT.md §8.13 "points out": index-list corner attributes (OBJ vt/vn
+// lists, PLY per-corner lists) coded as the split vertices a glTF exporter
+// would make; the decoder gives back one vertex per position and the value
+// lists. Exact by the oracle (corners, values, their sharing), canonical.
+TEST(IndexedCorners, CodedAsSplitVertices) {
+  for (const auto& [name, m] : {std::pair<std::string, Mesh>{"flat sphere (vn per face)", indexed_flat_sphere(2)},
+                                {"uv cylinder (vt list with a seam)", indexed_uv_cylinder(24, 6)}}) {
+    ASSERT_TRUE(m.valid()) << name;
+    const std::string bytes = expect_exact(m, name);
+    // The flat sphere through the split vertices; the cylinder (seven split
+    // vertices) is smaller as corner values with texture placement.
+    if (name[0] == 'f') {
+      EXPECT_GT(coded_vertices(bytes), m.vertex_count()) << name << ": coded as split vertices";
+    }
+    Mesh back;
+    ASSERT_TRUE(decode(bytes, back).ok());
+    EXPECT_EQ(back.attributes[0].value_count(), m.attributes[0].value_count()) << name;
+    // The mapping names each decoded vertex's input vertex (asking changes no byte).
+    EncodeOptions eo;
+    eo.quantization_bits = 12;
+    std::string mapped;
+    EncodeMapping map;
+    ASSERT_TRUE(encode(m, eo, mapped, &map).ok()) << name;
+    EXPECT_TRUE(mapped == bytes) << name;
+    ASSERT_EQ(map.vertex_from.size(), back.vertex_count()) << name;
+    for (size_t v = 0; v < back.vertex_count(); ++v)
+      for (int a = 0; a < 3; ++a)
+        EXPECT_NEAR(back.positions[3 * v + a], m.positions[3 * size_t{map.vertex_from[v]} + a], 1e-3) << name;
+  }
+  // Where a value repeats on the grid (two vn entries alike), the lists
+  // could not be rebuilt by value: coded as corner values, still exact.
+  Mesh twice = indexed_flat_sphere(1);
+  Attribute& n = twice.attributes[0];
+  n.values.insert(n.values.end(), n.values.begin(), n.values.begin() + 3);
+  n.indices[1] = static_cast<uint32_t>(n.value_count() - 1);
+  const std::string bytes = expect_exact(twice, "a repeated vn entry");
+  EXPECT_EQ(coded_vertices(bytes), twice.vertex_count());
+}
+
+// A PLY holds corner values one per corner; its reader shares equal ones
+// again, so a decoded indexed mesh written as PLY re-encodes to its bytes.
+TEST(IndexedCorners, ThroughPlyTheSameBytes) {
+  const std::string dir = ::testing::TempDir();
+  for (const auto& [name, m] : {std::pair<std::string, Mesh>{"flat_sphere", indexed_flat_sphere(2)},
+                                {"uv_cylinder", indexed_uv_cylinder(24, 6)}}) {
+    std::string bytes, again;
+    ASSERT_TRUE(encode(m, EncodeOptions(), bytes).ok());
+    Mesh back, read;
+    ASSERT_TRUE(decode(bytes, back).ok());
+    const std::string path = dir + "/indexed_" + name + ".ply";
+    ASSERT_TRUE(write_mesh(path, back).ok());
+    ASSERT_TRUE(read_mesh(path, read).ok());
+    ASSERT_TRUE(encode(read, EncodeOptions(), again).ok());
+    EXPECT_TRUE(again == bytes) << name << ": " << again.size() << " vs " << bytes.size();
   }
 }

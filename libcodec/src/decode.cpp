@@ -6,7 +6,9 @@
 // decodes for the figures of `tsm info`.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <map>
 
 #include "attributes.hpp"
 #include "byte_io.hpp"
@@ -113,6 +115,8 @@ struct DecodedPart {
   std::vector<AttributeCost> attribute_costs;  // filled for inspect() only
   std::vector<uint32_t> split_q, split_corners;  // welded: per output vertex, per corner (walk ids)
   uint64_t per_vertex = 0;                       // bit i: corner attribute i coded per vertex (§8.12)
+  std::vector<uint32_t> split_point;             // points out (§8.13): per output vertex, its point
+  std::vector<uint32_t> point_q;                 // points out: the points' grid indices
   bool want_costs = false;
   Status status;
 };
@@ -130,7 +134,7 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
   if (!r.varint(len) || len > r.remaining() || !r.bytes(static_cast<size_t>(len), split))
     return corrupt("a welded part's split stream is cut off");
   uint8_t order = 0;
-  if (!r.u8(order) || order > 1) return corrupt("a welded part's attribute order is missing or not 0 or 1");
+  if (!r.u8(order) || order > 3) return corrupt("a welded part's attribute order byte is missing or above 3");
   attributes = attributes.substr(r.offset());
   std::vector<uint32_t> walk_point;
   std::vector<uint32_t> point_q = std::move(out.q);
@@ -140,8 +144,7 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
   list.clear();
   for (uint32_t w = 0; w < n; ++w)
     if (walk_orig[w] == w) list.push_back(w);
-  if (order == 1)
-    std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
+  if (order & 1) std::sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) { return walk_out[x] < walk_out[y]; });
   std::vector<uint32_t> rank(n, kNone);
   for (uint32_t k = 0; k < list.size(); ++k) rank[list[k]] = k;
   // The faces on the originals for the attributes; the positions per output vertex.
@@ -155,7 +158,54 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
     for (int a = 0; a < 3; ++a) out.split_q[3 * size_t{walk_out[w]} + a] = point_q[3 * size_t{walk_point[w]} + a];
   out.split_corners = std::move(corner_walk);
   out.global.assign(list.size(), kNone);  // the attributes' vertices
+  if (order & 2) {
+    out.split_point.assign(n, 0);
+    for (size_t w = 0; w < n; ++w) out.split_point[walk_out[w]] = walk_point[w];
+    out.point_q = std::move(point_q);
+  }
   return Status::Ok();
+}
+
+// FORMAT.md §8.13, points out: one output vertex per point (the split
+// vertices were the corners' value combinations of an indexed mesh). A
+// vertex attribute takes the value of the point's first vertex; a corner
+// attribute coded per vertex gets its value list back: the distinct values
+// (as float bits) in the order the corners first use them.
+void points_out(DecodedPart& out) {
+  const std::vector<uint32_t>& point = out.split_point;
+  const size_t np = out.point_q.size() / 3, n = point.size();
+  std::vector<uint32_t> first(np, kNone);
+  for (uint32_t o = 0; o < n; ++o)
+    if (first[point[o]] == kNone) first[point[o]] = o;
+  for (size_t i = 0; i < out.faces.attributes.size(); ++i) {
+    Attribute& at = out.faces.attributes[i];
+    const size_t k = at.components;
+    if (at.values.size() != k * n) continue;
+    if (at.domain == AttributeDomain::vertex) {
+      std::vector<float> values(k * np);
+      for (size_t p = 0; p < np; ++p)
+        std::copy_n(at.values.begin() + static_cast<std::ptrdiff_t>(first[p] * k), k,
+                    values.begin() + static_cast<std::ptrdiff_t>(p * k));
+      at.values = std::move(values);
+    } else if (out.per_vertex >> i & 1) {
+      std::map<std::vector<uint32_t>, uint32_t> id;
+      std::vector<float> values;
+      std::vector<uint32_t> bits(k);
+      for (uint32_t& x : at.indices) {
+        std::memcpy(bits.data(), &at.values[k * x], 4 * k);
+        auto it = id.emplace(bits, static_cast<uint32_t>(id.size())).first;
+        if (it->second == values.size() / k)
+          values.insert(values.end(), at.values.begin() + static_cast<std::ptrdiff_t>(k * x),
+                        at.values.begin() + static_cast<std::ptrdiff_t>(k * (x + 1)));
+        x = it->second;
+      }
+      at.values = std::move(values);
+    }
+  }
+  for (uint32_t& x : out.faces.indices) x = point[x];
+  out.q = std::move(out.point_q);
+  out.global.assign(np, kNone);
+  out.split_point = std::vector<uint32_t>();
 }
 
 // After a welded part's attributes: the output vertices (positions, the
@@ -222,6 +272,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.per_vertex = &out.per_vertex;
   TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
   if (out.cstats.welded) to_output(walk_out, walk_orig, list, out);
+  if (!out.split_point.empty()) points_out(out);
   return Status::Ok();
 }
 

@@ -6,7 +6,9 @@
 // to their own bytes (canonical rounds) and the smallest of those tried,
 // and lay the streams out as container sections.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <tuple>
@@ -21,10 +23,10 @@
 #include "order_coding.hpp"
 #include "parallel.hpp"
 #include "progressive_encode.hpp"
+#include "byte_io.hpp"
 #include "range_coder.hpp"
 #include "segments.hpp"
 #include "split_layout.hpp"
-#include "byte_io.hpp"
 #include "tsm/quantization.hpp"
 #include "tsm/tsm.hpp"
 
@@ -823,7 +825,7 @@ bool match_faces(const Mesh& a, const Mesh& b, std::vector<uint32_t>& face, std:
 // order (canonical re-encoding). `welded` is false when no two vertices on
 // faces share a grid position (nothing is coded then).
 Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<AttributeHeader>& headers,
-                     const EncodeOptions& options, EncodedPart& out, bool& welded) {
+                     const EncodeOptions& options, EncodedPart& out, bool& welded, uint8_t order_flags = 0) {
   welded = false;
   const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
   std::vector<uint8_t> used(V, 0);
@@ -967,11 +969,135 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
   ByteWriter bw(head);
   bw.varint(split.size());
   bw.bytes(split);
-  bw.u8(point_order ? 1 : 0);
+  bw.u8(static_cast<uint8_t>((point_order ? 1 : 0) | order_flags));
   out.attributes = head + best.attributes;
   out.vertex_from.assign(V, kNone);
   for (size_t w = 0; w < walk_out.size(); ++w) out.vertex_from[walk_out[w]] = walk_input[w];
   welded = true;
+  return Status::Ok();
+}
+
+// Whether the corner attributes of `mesh` can go through the split route
+// (FORMAT.md §8.13, points out): some corner attribute whose values are
+// shared by index, no two vertices on faces at one grid position, every
+// vertex on a face, and per corner attribute every value used and no two
+// values equal on their grid (the decoder rebuilds the lists by value).
+bool split_route_fits(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<AttributeHeader>& headers) {
+  const uint64_t per_vertex = per_vertex_corner_attributes(mesh);
+  bool indexed = false;
+  for (size_t i = 0; i < headers.size(); ++i)
+    indexed = indexed || (headers[i].domain == AttributeDomain::corner && !(per_vertex >> i & 1));
+  if (!indexed) return false;
+  const size_t V = mesh.vertex_count();
+  std::vector<uint8_t> used(V, 0);
+  for (uint32_t x : mesh.indices) used[x] = 1;
+  std::vector<std::array<uint32_t, 3>> at;
+  at.reserve(V);
+  for (size_t v = 0; v < V; ++v) {
+    if (!used[v]) return false;
+    at.push_back({qin[3 * v], qin[3 * v + 1], qin[3 * v + 2]});
+  }
+  std::sort(at.begin(), at.end());
+  if (std::adjacent_find(at.begin(), at.end()) != at.end()) return false;
+  for (size_t i = 0; i < headers.size(); ++i) {
+    if (headers[i].domain != AttributeDomain::corner) continue;
+    const Attribute& a = mesh.attributes[i];
+    const uint32_t n = attribute_key_size(headers[i]);
+    std::vector<uint8_t> uses(a.value_count(), 0);
+    for (uint32_t x : a.indices) uses[x] = 1;
+    std::vector<std::vector<int32_t>> keys(a.value_count(), std::vector<int32_t>(n));
+    for (size_t j = 0; j < a.value_count(); ++j) {
+      if (!uses[j]) return false;
+      attribute_key(headers[i], &a.values[a.components * j], keys[j].data());
+    }
+    std::sort(keys.begin(), keys.end());
+    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) return false;
+  }
+  return true;
+}
+
+// The split vertices of an indexed mesh: one per distinct (vertex, corner
+// value ids) combination, numbered by vertex and then by the first corner
+// using them (as the decoder numbers a welded part's vertices, so a decoded
+// mesh splits to the same vertices). Corner attributes become one value per
+// split vertex; `from` gets per split vertex its input vertex.
+Mesh split_vertices(const Mesh& mesh, std::vector<uint32_t>& from) {
+  std::vector<size_t> corner_attrs;
+  for (size_t i = 0; i < mesh.attributes.size(); ++i)
+    if (mesh.attributes[i].domain == AttributeDomain::corner) corner_attrs.push_back(i);
+  std::map<std::vector<uint32_t>, uint32_t> id;
+  std::vector<uint32_t> corner_split(mesh.indices.size()), first_corner;
+  std::vector<uint32_t> key(1 + corner_attrs.size());
+  for (size_t k = 0; k < mesh.indices.size(); ++k) {
+    key[0] = mesh.indices[k];
+    for (size_t j = 0; j < corner_attrs.size(); ++j) key[1 + j] = mesh.attributes[corner_attrs[j]].indices[k];
+    auto it = id.emplace(key, static_cast<uint32_t>(id.size())).first;
+    if (it->second == first_corner.size()) first_corner.push_back(static_cast<uint32_t>(k));
+    corner_split[k] = it->second;
+  }
+  const uint32_t n = static_cast<uint32_t>(first_corner.size());
+  std::vector<uint32_t> order(n), rank(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+    return mesh.indices[first_corner[x]] < mesh.indices[first_corner[y]];
+  });
+  for (uint32_t r = 0; r < n; ++r) rank[order[r]] = r;
+  Mesh s;
+  from.resize(n);
+  s.positions.resize(3 * size_t{n});
+  for (uint32_t r = 0; r < n; ++r) {
+    from[r] = mesh.indices[first_corner[order[r]]];
+    std::copy_n(&mesh.positions[3 * size_t{from[r]}], 3, &s.positions[3 * size_t{r}]);
+  }
+  s.face_offsets = mesh.face_offsets;
+  s.indices.resize(mesh.indices.size());
+  for (size_t k = 0; k < mesh.indices.size(); ++k) s.indices[k] = rank[corner_split[k]];
+  s.metadata = mesh.metadata;
+  for (const Attribute& a : mesh.attributes) {
+    Attribute b = described_like(a);
+    const size_t c = a.components;
+    if (a.domain == AttributeDomain::face) {
+      b.values = a.values;
+    } else {
+      b.values.resize(c * n);
+      for (uint32_t r = 0; r < n; ++r) {
+        const uint32_t k = first_corner[order[r]];
+        const size_t v = a.domain == AttributeDomain::vertex ? from[r] : a.indices[k];
+        std::copy_n(&a.values[c * v], c, &b.values[c * size_t{r}]);
+      }
+      if (a.domain == AttributeDomain::corner) b.indices = s.indices;
+    }
+    s.attributes.push_back(std::move(b));
+  }
+  return s;
+}
+
+// FORMAT.md §8.13, points out: a mesh whose corner attributes are index
+// lists (OBJ vt/vn, PLY per-corner lists) coded as the split vertices a
+// glTF exporter would make, through the welded path; the decoder gives
+// back one vertex per point and the value lists. `vertex_from`: per output
+// vertex (point), its input vertex. `done` is false when nothing was coded.
+Status encode_split_route(const Mesh& mesh, const std::vector<uint32_t>& qin, const EncodeOptions& options,
+                          EncodedPart& out, std::vector<uint32_t>& vertex_from, uint64_t& split_count, bool& done) {
+  done = false;
+  std::vector<uint32_t> from;
+  const Mesh s = split_vertices(mesh, from);
+  if (s.vertex_count() == mesh.vertex_count()) return Status::Ok();
+  std::vector<uint32_t> qs(3 * s.vertex_count());
+  for (size_t v = 0; v < s.vertex_count(); ++v) std::copy_n(&qin[3 * size_t{from[v]}], 3, &qs[3 * v]);
+  const std::vector<AttributeHeader> headers = attribute_headers(s, options.attribute_bits);
+  bool welded = false;
+  TSM_RETURN_IF_ERROR(encode_welded(s, qs, headers, options, out, welded, 2));
+  if (!welded) return Status::Ok();
+  vertex_from.clear();
+  for (uint32_t x : out.vertex_from) {
+    const uint32_t v = from[x];
+    if (vertex_from.empty() || vertex_from.back() != v) vertex_from.push_back(v);
+  }
+  if (vertex_from.size() != mesh.vertex_count())
+    return Status(ErrorCode::internal, "the split route's points do not map to the input's vertices");
+  split_count = s.vertex_count();
+  done = true;
   return Status::Ok();
 }
 
@@ -1071,6 +1197,31 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::o
   const uint32_t max_faces = options.segment_faces ? options.segment_faces : kDefaultSegmentFaces;
   const std::vector<std::vector<uint32_t>> segments = split_faces(mesh, qin, max_faces);
   h.segment_count = static_cast<uint32_t>(segments.size());
+  std::string mesh_section;
+  if (segments.size() == 1) {
+    EncodedPart p;
+    bool welded = false;
+    if (!headers.empty()) TSM_RETURN_IF_ERROR(encode_welded(mesh, qin, headers, options, p, welded));
+    if (!welded) TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
+    MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
+    mesh_section = write_mesh_payload(mp);
+    vertex_from = welded ? std::move(p.vertex_from) : std::move(p.order);
+    // Index-list corner attributes: also as split vertices, kept when smaller.
+    if (!welded && !options.lossless && !options.keep_order && split_route_fits(mesh, qin, headers)) {
+      EncodedPart ps;
+      std::vector<uint32_t> from;
+      uint64_t split_count = 0;
+      bool done = false;
+      TSM_RETURN_IF_ERROR(encode_split_route(mesh, qin, options, ps, from, split_count, done));
+      MeshPayload ms{ps.streams.vertex_tree, ps.streams.triangle_tree, ps.streams.topology, ps.geometry, ps.attributes};
+      std::string section = done ? write_mesh_payload(ms) : std::string();
+      if (done && section.size() < mesh_section.size()) {
+        mesh_section = std::move(section);
+        vertex_from = std::move(from);
+        h.vertex_count = split_count;
+      }
+    }
+  }
   ContainerWriter& cw = cw_out.emplace(h);
   // Metadata first, so that a streaming client has it before any geometry.
   if (!mesh.metadata.empty()) {
@@ -1078,13 +1229,7 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::o
     cw.add_section(kSectionMetadata, md, md.size() > (1u << 20) ? 3 : 9);
   }
   if (segments.size() == 1) {
-    EncodedPart p;
-    bool welded = false;
-    if (!headers.empty()) TSM_RETURN_IF_ERROR(encode_welded(mesh, qin, headers, options, p, welded));
-    if (!welded) TSM_RETURN_IF_ERROR(encode_part(mesh, qin, {}, headers, options, p));
-    MeshPayload mp{p.streams.vertex_tree, p.streams.triangle_tree, p.streams.topology, p.geometry, p.attributes};
-    cw.add_section(kSectionMesh, write_mesh_payload(mp), 0);
-    vertex_from = welded ? std::move(p.vertex_from) : std::move(p.order);
+    cw.add_section(kSectionMesh, mesh_section, 0);
   } else {
     TSM_RETURN_IF_ERROR(encode_segments(mesh, qin, segments, headers, options, cw, vertex_from));
   }

@@ -34,7 +34,7 @@
 // becomes a corner-domain texcoord, any other list with the same 1..4 values
 // per corner on every face a corner-domain attribute named after it ('normal'
 // with 3 is kind normal, 'color' with 3 or 4 kind color). Corner-domain
-// values come one per corner (indices 0..corners-1). A 'texcoord' list whose
+// values are shared where equal (the same float bits). A 'texcoord' list whose
 // count is not 2 per corner is an error; other lists that do not fit are
 // skipped with a note. Lists of the 'vertex' element are skipped.
 //
@@ -55,9 +55,9 @@
 // f32 float); corner-domain ones as face list properties after
 // vertex_indices ('texcoord', 'normal', 'color' for the first of each kind,
 // else the attribute's name) holding each corner's value. PLY has no shared
-// value list, so a corner attribute reads back with one value per corner:
-// the same value at every corner, but repeated values are no longer shared
-// and values no corner uses are gone. Names that are not PLY tokens or that
+// value list: the reader shares equal values (same float bits) among the
+// corners, in first-use order, so the lists tsm wrote (distinct values) come
+// back, but values no corner uses are gone. Names that are not PLY tokens or that
 // two properties of an element would share, and integer-typed values that
 // are not integers of their type's range, make the writer fail. PLY has no
 // place for Mesh::metadata: WriteInfo::notes names the entries left out.
@@ -67,6 +67,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -705,6 +706,26 @@ class PlyReader {
     return std::string();
   }
 
+  // A corner list's values, one per corner as read, shared where equal
+  // (the same float bits), in the order the corners first use them: the
+  // value lists of the mesh tsm wrote, so it re-encodes to the same bytes.
+  static void share_corner_values(Attribute& a, size_t corners) {
+    const size_t k = a.components;
+    std::map<std::vector<uint32_t>, uint32_t> id;
+    std::vector<uint32_t> bits(k);
+    std::vector<float> values;
+    a.indices.resize(corners);
+    for (size_t i = 0; i < corners; ++i) {
+      std::memcpy(bits.data(), &a.values[k * i], 4 * k);
+      auto it = id.emplace(bits, static_cast<uint32_t>(id.size())).first;
+      if (it->second == values.size() / k)
+        values.insert(values.end(), a.values.begin() + static_cast<std::ptrdiff_t>(k * i),
+                      a.values.begin() + static_cast<std::ptrdiff_t>(k * (i + 1)));
+      a.indices[i] = it->second;
+    }
+    a.values = std::move(values);
+  }
+
   // Hands the attributes read to the mesh.
   void finish_attributes() {
     for (AttrBuild& b : attrs_) {
@@ -722,8 +743,7 @@ class PlyReader {
         a.components = b.k;
         if (a.name == "normal" && b.k == 3) a.kind = AttributeKind::normal;
         if (a.name == "color" && b.k >= 3) a.kind = AttributeKind::color;
-        a.indices.resize(out_.indices.size());
-        for (size_t i = 0; i < a.indices.size(); ++i) a.indices[i] = static_cast<uint32_t>(i);
+        share_corner_values(a, out_.indices.size());
       }
       if (b.inexact > 0) {
         a.type = AttributeType::f32;
