@@ -164,6 +164,21 @@ std::vector<uint32_t> anchor_keys(const Mesh& mesh, const ConnectivityEncoding& 
   return by_input;
 }
 
+// The output vertices on no triangle (on_triangle[v] == 0) take their input
+// ids in the cut's order: stably by anchor `key`, then grid position.
+void order_off_triangles(const std::vector<uint32_t>& qin, const std::vector<uint32_t>& key,
+                         const std::vector<uint8_t>& on_triangle, ConnectivityEncoding& ce) {
+  std::vector<uint32_t> at, ids;
+  for (uint32_t v = 0; v < ce.layout.vertex_count; ++v)
+    if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
+  std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+    if (key[a] != key[b]) return key[a] < key[b];
+    return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
+                                        &qin[3 * size_t{b}] + 3);
+  });
+  for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
+}
+
 // Puts the output vertices on no triangle in the order the cut gives them
 // with anchors (stably by anchor `key`, then grid position): a vertex on no
 // triangle is a component of its own, coded alike wherever it comes, so
@@ -179,15 +194,7 @@ bool sort_by_anchor(const Mesh& mesh, const std::vector<uint32_t>& qin, const st
   for (uint32_t v = 0; v < n; ++v) input_on[ce.vertex_order[v]] = on_triangle[v];
   for (uint32_t v : mesh.indices)
     if (!input_on[v]) return false;
-  std::vector<uint32_t> at, ids;
-  for (uint32_t v = 0; v < n; ++v)
-    if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
-  std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
-    if (key[a] != key[b]) return key[a] < key[b];
-    return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
-                                        &qin[3 * size_t{b}] + 3);
-  });
-  for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
+  order_off_triangles(qin, key, on_triangle, ce);
   return true;
 }
 
@@ -347,17 +354,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     // vertices on no triangle, sorted as its cut sorts them (stably by
     // anchor, then grid position).
     const std::vector<uint32_t> key = anchor_keys(mesh, ce, view, options.quantization_bits);
-    if (!key.empty() && !in_anchor_order(ce, key)) {
-      std::vector<uint32_t> at, ids;
-      for (uint32_t v = 0; v < n; ++v)
-        if (!on_triangle[v]) at.push_back(v), ids.push_back(ce.vertex_order[v]);
-      std::stable_sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
-        if (key[a] != key[b]) return key[a] < key[b];
-        return std::lexicographical_compare(&qin[3 * size_t{a}], &qin[3 * size_t{a}] + 3, &qin[3 * size_t{b}],
-                                            &qin[3 * size_t{b}] + 3);
-      });
-      for (size_t k = 0; k < at.size(); ++k) ce.vertex_order[at[k]] = ids[k];
-    }
+    if (!key.empty() && !in_anchor_order(ce, key)) order_off_triangles(qin, key, on_triangle, ce);
   }
   // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
   // streams and its base.
