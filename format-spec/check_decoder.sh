@@ -196,6 +196,9 @@ PY
 if [ -f "$work/CesiumMilkTruck_obj.obj" ]; then
   dedup_obj "$work/CesiumMilkTruck_obj.obj" "$work/truck_dedup.obj"
   acheck truck_dedup_obj "$work/truck_dedup.obj" 11 6
+  # with ranks (§8.13 points out): positions sharing an 8-bit grid point,
+  # normals equal at 8 bits
+  acheck truck_dedup_ranks "$work/truck_dedup.obj" 8 6 0 --normal-bits=8
 fi
 # the Fox's the same way: coded as split vertices, points out (§8.13)
 if [ -f "$work/Fox_obj.obj" ]; then

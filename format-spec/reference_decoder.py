@@ -2586,8 +2586,16 @@ def decode_part(streams, counts, bits, earlier, trace):
     if n > len(sa) - p or p + n >= len(sa):
         reject('split stream cut off')
     split, order, sa = sa[p:p + n], sa[p + n], sa[p + n + 1:]
-    if order > 3:
+    if order > 7 or order in (4, 5):
         reject('attribute order')
+    ranks = b''
+    if order & 4:                                                   # §8.13 points out: the rank stream
+        if not sa:
+            reject('rank stream cut off')
+        m, p = read_varint(sa, 0, len(sa))
+        if m == 0 or m > len(sa) - p:
+            reject('rank stream empty or cut off')
+        ranks, sa = sa[p:p + m], sa[p + m:]
     wfaces, walk_out, walk_point, orig = decode_split_layout(split, vc, info['points'], q, faces)
     lst = [w for w in range(len(walk_out)) if orig[w] == w]      # the originals, in the order coded
     if order & 1:
@@ -2609,38 +2617,87 @@ def decode_part(streams, counts, bits, earlier, trace):
                 a[key] = vals
     out_faces = [[walk_out[x] for x in f] for f in wfaces]
     if order & 2:
-        return points_out(out_faces, q, glob, info, attrs, walk_out, walk_point)
+        return points_out(out_faces, q, glob, info, attrs, walk_out, walk_point, ranks)
     return out_faces, out_q, glob, info, attrs
 
 
-def points_out(faces, q, glob, info, attrs, walk_out, walk_point):
-    """§8.13 points out: one output vertex per point; a vertex attribute takes
-    the value of the point's first vertex; a corner attribute coded per vertex
-    gets its value list back (distinct values as binary32 bits, in the order the
-    corners first use them)."""
-    point = [0] * len(walk_out)
+def point_value_ranks(ranks, point, attrs, n):
+    """§8.13 points out, the ranks: per output vertex whose point has more than
+    one output vertex, its rank; then per corner attribute coded per vertex,
+    per output vertex whose value (binary32 bits) another shares, its rank.
+    Each below the count sharing it. All 0 when the stream is empty."""
+    prank = [0] * n
+    vrank = [None] * len(attrs)
+    if not ranks:
+        return prank, vrank
+    d = RangeDecoder(ranks)
+    pm, vm = UIntModel(), UIntModel()
+    share = {}
+    for p in point:
+        share[p] = share.get(p, 0) + 1
+    for o in range(n):
+        if share[point[o]] > 1:
+            prank[o] = pm.decode(d)
+            if prank[o] >= share[point[o]]:
+                reject('points-out rank')
+    for i, a in enumerate(attrs):
+        if a['header'].domain != 2 or not a['header'].per_vertex:
+            continue
+        bits = [tuple(struct.pack('<f', x) for x in a['values'][o]) for o in range(n)]
+        count = {}
+        for b in bits:
+            count[b] = count.get(b, 0) + 1
+        vrank[i] = [0] * n
+        for o in range(n):
+            if count[bits[o]] > 1:
+                vrank[i][o] = vm.decode(d)
+                if vrank[i][o] >= count[bits[o]]:
+                    reject('points-out value rank')
+    if d.overrun > 8:
+        reject('rank stream cut off')
+    return prank, vrank
+
+
+def points_out(faces, q, glob, info, attrs, walk_out, walk_point, ranks):
+    """§8.13 points out: one output vertex per (point, rank), in that order; a
+    vertex attribute takes the value of the vertex's first split vertex; a
+    corner attribute coded per vertex gets its value list back: the corners in
+    order, a value (binary32 bits) not listed yet listed with every rank the
+    output vertices give it, ranks ascending."""
+    n = len(walk_out)
+    point = [0] * n
     for w, o in enumerate(walk_out):
         point[o] = walk_point[w]
-    first = [None] * len(q)
-    for o, p in enumerate(point):
-        if first[p] is None:
-            first[p] = o
-    for a in attrs:
+    prank, vrank = point_value_ranks(ranks, point, attrs, n)
+    keys = sorted(set(zip(point, prank)))
+    vid_of = {k: v for v, k in enumerate(keys)}
+    vid = [vid_of[(point[o], prank[o])] for o in range(n)]
+    first = [None] * len(keys)
+    for o in range(n):
+        if first[vid[o]] is None:
+            first[vid[o]] = o
+    for i, a in enumerate(attrs):
         h = a['header']
         if h.domain == 0:
             for key in ('ints', 'values'):
-                a[key] = [a[key][first[p]] for p in range(len(q))]
+                a[key] = [a[key][first[v]] for v in range(len(keys))]
         elif h.per_vertex:
-            ids, ints, vals, idx = {}, [], [], []
+            r = vrank[i] or [0] * n
+            bits = [tuple(struct.pack('<f', x) for x in a['values'][o]) for o in range(n)]
+            have = {}
+            for o in range(n):
+                have.setdefault(bits[o], set()).add(r[o])
+            base, ints, vals, idx = {}, [], [], []
             for o in a['indices']:
-                bits = tuple(struct.pack('<f', x) for x in a['values'][o])
-                if bits not in ids:
-                    ids[bits] = len(vals)
-                    ints.append(a['ints'][o])
-                    vals.append(a['values'][o])
-                idx.append(ids[bits])
+                lst = sorted(have[bits[o]])
+                if bits[o] not in base:
+                    base[bits[o]] = len(vals)
+                    ints.extend([a['ints'][o]] * len(lst))
+                    vals.extend([a['values'][o]] * len(lst))
+                idx.append(base[bits[o]] + lst.index(r[o]))
             a['ints'], a['values'], a['indices'] = ints, vals, idx
-    return [[point[x] for x in f] for f in faces], list(q), [NONE] * len(q), info, attrs
+    out_q = [q[p] for p, _ in keys]
+    return [[vid[x] for x in f] for f in faces], out_q, [NONE] * len(keys), info, attrs
 
 
 def split_reduced(v):

@@ -369,14 +369,105 @@ TEST(IndexedCorners, CodedAsSplitVertices) {
       for (int a = 0; a < 3; ++a)
         EXPECT_NEAR(back.positions[3 * v + a], m.positions[3 * size_t{map.vertex_from[v]} + a], 1e-3) << name;
   }
-  // Where a value repeats on the grid (two vn entries alike), the lists
-  // could not be rebuilt by value: coded as corner values, still exact.
+  // A value repeated in the list (two vn entries alike): the split vertices
+  // carry its rank, so the list comes back with both entries.
   Mesh twice = indexed_flat_sphere(1);
   Attribute& n = twice.attributes[0];
   n.values.insert(n.values.end(), n.values.begin(), n.values.begin() + 3);
   n.indices[1] = static_cast<uint32_t>(n.value_count() - 1);
   const std::string bytes = expect_exact(twice, "a repeated vn entry");
-  EXPECT_EQ(coded_vertices(bytes), twice.vertex_count());
+  EXPECT_GT(coded_vertices(bytes), twice.vertex_count());
+}
+
+namespace {
+
+// A corner used by face `f` (its first corner naming vertex `v`), or -1.
+int corner_of(const Mesh& m, size_t f, uint32_t v) {
+  for (uint32_t k = m.face_offsets[f]; k < m.face_offsets[f + 1]; ++k)
+    if (m.indices[k] == v) return static_cast<int>(k);
+  return -1;
+}
+
+}  // namespace
+
+// FORMAT.md §8.13 points out, the ranks: values that differ in the input
+// but are equal on their grid, and input vertices at one grid position,
+// come back apart (exact by the oracle, which counts the corners sharing
+// each value and vertex), and re-encoding gives the same bytes.
+TEST(IndexedCorners, RanksKeepCoincidingValuesAndPointsApart) {
+  // Every third vn entry (one per face) doubled by a copy nudged below the
+  // normal grid's step, used by its face's first corner.
+  Mesh values = indexed_flat_sphere(2);
+  {
+    Attribute& n = values.attributes[0];
+    const uint32_t count = static_cast<uint32_t>(n.value_count());
+    for (uint32_t j = 0; j < count; j += 3) {
+      const uint32_t copy = static_cast<uint32_t>(n.value_count());
+      for (int c = 0; c < 3; ++c) n.values.push_back(n.values[3 * size_t{j} + c] + 1e-6f);
+      for (size_t k = 0; k < n.indices.size(); ++k)
+        if (n.indices[k] == j) {
+          n.indices[k] = copy;
+          break;
+        }
+    }
+  }
+  ASSERT_TRUE(values.valid());
+  const std::string a = expect_exact(values, "vn entries equal on the grid");
+  EXPECT_GT(coded_vertices(a), values.vertex_count()) << "coded as split vertices";
+  Mesh back;
+  ASSERT_TRUE(decode(a, back).ok());
+  EXPECT_EQ(back.attributes[0].value_count(), values.attributes[0].value_count());
+
+  // Input vertices sharing a grid position: per face of a band, the corner
+  // at vertex v moved to a copy of v a hair away (same grid point).
+  Mesh points = indexed_flat_sphere(2);
+  const size_t V = points.vertex_count();
+  std::vector<uint8_t> moved(V, 0);
+  for (size_t f = 0; f < points.face_count(); f += 4) {
+    const uint32_t v = points.indices[points.face_offsets[f]];
+    if (v % 2 || moved[v]) continue;
+    moved[v] = 1;
+    const uint32_t copy = static_cast<uint32_t>(points.vertex_count());
+    for (int c = 0; c < 3; ++c) points.positions.push_back(points.positions[3 * size_t{v} + c] + 1e-7f);
+    points.indices[static_cast<size_t>(corner_of(points, f, v))] = copy;
+  }
+  ASSERT_GT(points.vertex_count(), V);
+  ASSERT_TRUE(points.valid());
+  const std::string b = expect_exact(points, "vertices sharing a grid position");
+  EXPECT_GT(coded_vertices(b), points.vertex_count()) << "coded as split vertices";
+
+  // Both at once, at a coarse grid.
+  Mesh both = points;
+  both.attributes[0] = values.attributes[0];
+  ASSERT_TRUE(both.valid());
+  expect_exact(both, "both", 8);
+}
+
+// A file with ranks (FORMAT.md §8.13 points out), each byte flipped in turn:
+// refused with a message, or a valid mesh; never a crash.
+TEST(IndexedCorners, DamagedRanksRefusedOrValid) {
+  Mesh m = indexed_flat_sphere(1);
+  Attribute& n = m.attributes[0];
+  n.values.insert(n.values.end(), n.values.begin(), n.values.begin() + 3);
+  n.indices[1] = static_cast<uint32_t>(n.value_count() - 1);
+  std::string bytes;
+  ASSERT_TRUE(encode(m, EncodeOptions(), bytes).ok());
+  ASSERT_GT(coded_vertices(bytes), m.vertex_count());
+  // Flip every byte once: each decode fails cleanly or gives a valid mesh.
+  int refused = 0;
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::string bad = bytes;
+    bad[i] = static_cast<char>(bad[i] ^ 0xFF);
+    Mesh out;
+    const Status s = decode(bad, out);
+    if (!s.ok()) {
+      EXPECT_FALSE(s.message().empty());
+      ++refused;
+    } else {
+      EXPECT_TRUE(out.valid());
+    }
+  }
+  EXPECT_GT(refused, 0);
 }
 
 // A PLY holds corner values one per corner; its reader shares equal ones

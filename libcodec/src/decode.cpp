@@ -117,6 +117,7 @@ struct DecodedPart {
   uint64_t per_vertex = 0;                       // bit i: corner attribute i coded per vertex (§8.12)
   std::vector<uint32_t> split_point;             // points out (§8.13): per output vertex, its point
   std::vector<uint32_t> point_q;                 // points out: the points' grid indices
+  std::string_view rank_stream;                  // points out: the ranks (empty: all 0)
   bool want_costs = false;
   Status status;
 };
@@ -134,7 +135,11 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
   if (!r.varint(len) || len > r.remaining() || !r.bytes(static_cast<size_t>(len), split))
     return corrupt("a welded part's split stream is cut off");
   uint8_t order = 0;
-  if (!r.u8(order) || order > 3) return corrupt("a welded part's attribute order byte is missing or above 3");
+  if (!r.u8(order) || order > 7 || order == 4 || order == 5)
+    return corrupt("a welded part's attribute order byte is missing, above 7, or says ranks without points out");
+  if ((order & 4) &&
+      (!r.varint(len) || len == 0 || len > r.remaining() || !r.bytes(static_cast<size_t>(len), out.rank_stream)))
+    return corrupt("a points-out part's rank stream is empty or cut off");
   attributes = attributes.substr(r.offset());
   std::vector<uint32_t> walk_point;
   std::vector<uint32_t> point_q = std::move(out.q);
@@ -166,46 +171,128 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
   return Status::Ok();
 }
 
-// FORMAT.md §8.13, points out: one output vertex per point (the split
-// vertices were the corners' value combinations of an indexed mesh). A
-// vertex attribute takes the value of the point's first vertex; a corner
-// attribute coded per vertex gets its value list back: the distinct values
-// (as float bits) in the order the corners first use them.
-void points_out(DecodedPart& out) {
+// FORMAT.md §8.13, points out: the ranks. Per output vertex whose point
+// has more than one output vertex, its rank among the input vertices at
+// that point; then per corner attribute coded per vertex, per output vertex
+// whose value (binary32 bits) is shared by another, its rank among the
+// input values equal to it. Each rank is below the count sharing it.
+Status decode_ranks(const DecodedPart& out, std::vector<uint32_t>& point_rank,
+                    std::vector<std::vector<uint32_t>>& value_rank) {
   const std::vector<uint32_t>& point = out.split_point;
   const size_t np = out.point_q.size() / 3, n = point.size();
-  std::vector<uint32_t> first(np, kNone);
-  for (uint32_t o = 0; o < n; ++o)
-    if (first[point[o]] == kNone) first[point[o]] = o;
+  point_rank.assign(n, 0);
+  value_rank.assign(out.faces.attributes.size(), std::vector<uint32_t>());
+  if (out.rank_stream.empty()) return Status::Ok();
+  RangeDecoder d(out.rank_stream);
+  UIntModel point_model, value_model;
+  std::vector<uint32_t> share(np, 0);
+  for (uint32_t p : point) ++share[p];
+  for (size_t o = 0; o < n; ++o) {
+    if (share[point[o]] < 2) continue;
+    point_rank[o] = point_model.decode(d);
+    if (point_rank[o] >= share[point[o]]) return corrupt("a points-out rank is not below its point's vertex count");
+  }
+  for (size_t i = 0; i < out.faces.attributes.size(); ++i) {
+    const Attribute& at = out.faces.attributes[i];
+    const size_t k = at.components;
+    if (at.domain != AttributeDomain::corner || !(out.per_vertex >> i & 1) || at.values.size() != k * n) continue;
+    std::map<std::vector<uint32_t>, uint32_t> count;
+    std::vector<std::vector<uint32_t>> bits(n, std::vector<uint32_t>(k));
+    for (size_t o = 0; o < n; ++o) {
+      std::memcpy(bits[o].data(), &at.values[k * o], 4 * k);
+      ++count[bits[o]];
+    }
+    value_rank[i].assign(n, 0);
+    for (size_t o = 0; o < n; ++o) {
+      const uint32_t c = count[bits[o]];
+      if (c < 2) continue;
+      value_rank[i][o] = value_model.decode(d);
+      if (value_rank[i][o] >= c) return corrupt("a points-out value rank is not below its value's count");
+    }
+  }
+  if (d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("a points-out rank stream is cut off");
+  return Status::Ok();
+}
+
+// FORMAT.md §8.13, points out: a corner attribute's value list from its
+// values per output vertex (`rank`: per output vertex, empty when all 0).
+// The corners in order: a value (binary32 bits) not listed yet is listed
+// with every rank the output vertices give it, ranks ascending; each corner
+// uses the entry of its vertex's (value, rank).
+void rebuild_value_list(Attribute& at, const std::vector<uint32_t>& rank) {
+  const size_t k = at.components, n = at.values.size() / k;
+  std::map<std::vector<uint32_t>, std::vector<uint32_t>> ranks;  // per value: its ranks, ascending, unique
+  std::vector<std::vector<uint32_t>> bits(n, std::vector<uint32_t>(k));
+  for (size_t o = 0; o < n; ++o) {
+    std::memcpy(bits[o].data(), &at.values[k * o], 4 * k);
+    ranks[bits[o]].push_back(rank.empty() ? 0 : rank[o]);
+  }
+  for (auto& [value, list] : ranks) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  std::map<std::vector<uint32_t>, uint32_t> base;  // per listed value: the entry of its lowest rank
+  std::vector<float> values;
+  for (uint32_t& x : at.indices) {
+    const std::vector<uint32_t>& list = ranks[bits[x]];
+    auto it = base.find(bits[x]);
+    if (it == base.end()) {
+      it = base.emplace(bits[x], static_cast<uint32_t>(values.size() / k)).first;
+      for (size_t j = 0; j < list.size(); ++j)
+        values.insert(values.end(), at.values.begin() + static_cast<std::ptrdiff_t>(k * x),
+                      at.values.begin() + static_cast<std::ptrdiff_t>(k * (x + 1)));
+    }
+    const uint32_t r = rank.empty() ? 0 : rank[x];
+    x = it->second + static_cast<uint32_t>(std::lower_bound(list.begin(), list.end(), r) - list.begin());
+  }
+  at.values = std::move(values);
+}
+
+// FORMAT.md §8.13, points out: one output vertex per (point, rank), in
+// that order (the split vertices were the corners' value combinations of
+// an indexed mesh). A vertex attribute takes the value of the vertex's
+// first split vertex; a corner attribute coded per vertex gets its value
+// list back: the distinct (value as float bits, rank) in the order the
+// corners first use them.
+Status points_out(DecodedPart& out) {
+  std::vector<uint32_t> point_rank;
+  std::vector<std::vector<uint32_t>> value_rank;
+  TSM_RETURN_IF_ERROR(decode_ranks(out, point_rank, value_rank));
+  const std::vector<uint32_t>& point = out.split_point;
+  const size_t n = point.size();
+  std::vector<uint64_t> keys(n);
+  for (size_t o = 0; o < n; ++o) keys[o] = uint64_t{point[o]} << 32 | point_rank[o];
+  std::vector<uint64_t> sorted = keys;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  const size_t nv = sorted.size();
+  std::vector<uint32_t> vid(n), first(nv, kNone);
+  for (uint32_t o = 0; o < n; ++o) {
+    vid[o] = static_cast<uint32_t>(std::lower_bound(sorted.begin(), sorted.end(), keys[o]) - sorted.begin());
+    if (first[vid[o]] == kNone) first[vid[o]] = o;
+  }
   for (size_t i = 0; i < out.faces.attributes.size(); ++i) {
     Attribute& at = out.faces.attributes[i];
     const size_t k = at.components;
     if (at.values.size() != k * n) continue;
     if (at.domain == AttributeDomain::vertex) {
-      std::vector<float> values(k * np);
-      for (size_t p = 0; p < np; ++p)
-        std::copy_n(at.values.begin() + static_cast<std::ptrdiff_t>(first[p] * k), k,
-                    values.begin() + static_cast<std::ptrdiff_t>(p * k));
+      std::vector<float> values(k * nv);
+      for (size_t v = 0; v < nv; ++v)
+        std::copy_n(at.values.begin() + static_cast<std::ptrdiff_t>(first[v] * k), k,
+                    values.begin() + static_cast<std::ptrdiff_t>(v * k));
       at.values = std::move(values);
     } else if (out.per_vertex >> i & 1) {
-      std::map<std::vector<uint32_t>, uint32_t> id;
-      std::vector<float> values;
-      std::vector<uint32_t> bits(k);
-      for (uint32_t& x : at.indices) {
-        std::memcpy(bits.data(), &at.values[k * x], 4 * k);
-        auto it = id.emplace(bits, static_cast<uint32_t>(id.size())).first;
-        if (it->second == values.size() / k)
-          values.insert(values.end(), at.values.begin() + static_cast<std::ptrdiff_t>(k * x),
-                        at.values.begin() + static_cast<std::ptrdiff_t>(k * (x + 1)));
-        x = it->second;
-      }
-      at.values = std::move(values);
+      rebuild_value_list(at, value_rank[i]);
     }
   }
-  for (uint32_t& x : out.faces.indices) x = point[x];
-  out.q = std::move(out.point_q);
-  out.global.assign(np, kNone);
+  for (uint32_t& x : out.faces.indices) x = vid[x];
+  out.q.assign(3 * nv, 0);
+  for (size_t v = 0; v < nv; ++v)
+    for (int a = 0; a < 3; ++a) out.q[3 * v + a] = out.point_q[3 * size_t{point[first[v]]} + a];
+  out.point_q = std::vector<uint32_t>();
+  out.global.assign(nv, kNone);
   out.split_point = std::vector<uint32_t>();
+  return Status::Ok();
 }
 
 // After a welded part's attributes: the output vertices (positions, the
@@ -272,7 +359,7 @@ Status decode_part(const PartStreams& s, uint64_t earlier_vertices, int bits, De
   ap.per_vertex = &out.per_vertex;
   TSM_RETURN_IF_ERROR(decode_attributes(attributes, ap, out.faces.attributes, &out.alias));
   if (out.cstats.welded) to_output(walk_out, walk_orig, list, out);
-  if (!out.split_point.empty()) points_out(out);
+  if (!out.split_point.empty()) TSM_RETURN_IF_ERROR(points_out(out));
   return Status::Ok();
 }
 

@@ -976,39 +976,22 @@ Status encode_welded(const Mesh& mesh, const std::vector<uint32_t>& qin, const s
 
 // Whether the corner attributes of `mesh` can go through the split route
 // (FORMAT.md §8.13, points out): some corner attribute whose values are
-// shared by index, no two vertices on faces at one grid position, every
-// vertex on a face, and per corner attribute every value used and no two
-// values equal on their grid (the decoder rebuilds the lists by value).
-bool split_route_fits(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<AttributeHeader>& headers) {
+// shared by index, every vertex on a face, and per corner attribute every
+// value used (the decoder rebuilds the lists from the corners).
+bool split_route_fits(const Mesh& mesh, const std::vector<AttributeHeader>& headers) {
   const uint64_t per_vertex = per_vertex_corner_attributes(mesh);
   bool indexed = false;
   for (size_t i = 0; i < headers.size(); ++i)
     indexed = indexed || (headers[i].domain == AttributeDomain::corner && !(per_vertex >> i & 1));
   if (!indexed) return false;
-  const size_t V = mesh.vertex_count();
-  std::vector<uint8_t> used(V, 0);
+  std::vector<uint8_t> used(mesh.vertex_count(), 0);
   for (uint32_t x : mesh.indices) used[x] = 1;
-  std::vector<std::array<uint32_t, 3>> at;
-  at.reserve(V);
-  for (size_t v = 0; v < V; ++v) {
-    if (!used[v]) return false;
-    at.push_back({qin[3 * v], qin[3 * v + 1], qin[3 * v + 2]});
-  }
-  std::sort(at.begin(), at.end());
-  if (std::adjacent_find(at.begin(), at.end()) != at.end()) return false;
-  for (size_t i = 0; i < headers.size(); ++i) {
-    if (headers[i].domain != AttributeDomain::corner) continue;
-    const Attribute& a = mesh.attributes[i];
-    const uint32_t n = attribute_key_size(headers[i]);
+  if (std::find(used.begin(), used.end(), 0) != used.end()) return false;
+  for (const Attribute& a : mesh.attributes) {
+    if (a.domain != AttributeDomain::corner) continue;
     std::vector<uint8_t> uses(a.value_count(), 0);
     for (uint32_t x : a.indices) uses[x] = 1;
-    std::vector<std::vector<int32_t>> keys(a.value_count(), std::vector<int32_t>(n));
-    for (size_t j = 0; j < a.value_count(); ++j) {
-      if (!uses[j]) return false;
-      attribute_key(headers[i], &a.values[a.components * j], keys[j].data());
-    }
-    std::sort(keys.begin(), keys.end());
-    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) return false;
+    if (std::find(uses.begin(), uses.end(), 0) != uses.end()) return false;
   }
   return true;
 }
@@ -1017,8 +1000,8 @@ bool split_route_fits(const Mesh& mesh, const std::vector<uint32_t>& qin, const 
 // value ids) combination, numbered by vertex and then by the first corner
 // using them (as the decoder numbers a welded part's vertices, so a decoded
 // mesh splits to the same vertices). Corner attributes become one value per
-// split vertex; `from` gets per split vertex its input vertex.
-Mesh split_vertices(const Mesh& mesh, std::vector<uint32_t>& from) {
+// split vertex; `first` gets per split vertex the first corner using it.
+Mesh split_vertices(const Mesh& mesh, std::vector<uint32_t>& first) {
   std::vector<size_t> corner_attrs;
   for (size_t i = 0; i < mesh.attributes.size(); ++i)
     if (mesh.attributes[i].domain == AttributeDomain::corner) corner_attrs.push_back(i);
@@ -1040,10 +1023,12 @@ Mesh split_vertices(const Mesh& mesh, std::vector<uint32_t>& from) {
   });
   for (uint32_t r = 0; r < n; ++r) rank[order[r]] = r;
   Mesh s;
-  from.resize(n);
+  std::vector<uint32_t> from(n);
+  first.resize(n);
   s.positions.resize(3 * size_t{n});
   for (uint32_t r = 0; r < n; ++r) {
-    from[r] = mesh.indices[first_corner[order[r]]];
+    first[r] = first_corner[order[r]];
+    from[r] = mesh.indices[first[r]];
     std::copy_n(&mesh.positions[3 * size_t{from[r]}], 3, &s.positions[3 * size_t{r}]);
   }
   s.face_offsets = mesh.face_offsets;
@@ -1069,30 +1054,129 @@ Mesh split_vertices(const Mesh& mesh, std::vector<uint32_t>& from) {
   return s;
 }
 
+// FORMAT.md §8.13, points out: per input vertex its rank among the input
+// vertices at its grid position (by id), and the input vertices in the
+// decoder's output order: by point (in the order the output split vertices
+// `split_input`, given as input vertices, first reach them), then by rank.
+std::vector<uint32_t> point_ranks(const Mesh& mesh, const std::vector<uint32_t>& qin,
+                                  const std::vector<uint32_t>& split_input, std::vector<uint32_t>& output_order) {
+  using Grid3 = std::array<uint32_t, 3>;
+  auto grid = [&](uint32_t v) { return Grid3{qin[3 * v], qin[3 * v + 1], qin[3 * v + 2]}; };
+  std::map<Grid3, std::vector<uint32_t>> at;
+  std::vector<uint32_t> rank(mesh.vertex_count());
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    std::vector<uint32_t>& here = at[grid(v)];
+    rank[v] = static_cast<uint32_t>(here.size());
+    here.push_back(v);
+  }
+  output_order.clear();
+  for (uint32_t v : split_input) {
+    std::vector<uint32_t>& here = at[grid(v)];
+    output_order.insert(output_order.end(), here.begin(), here.end());
+    here.clear();
+  }
+  return rank;
+}
+
+// FORMAT.md §8.13, points out: per value of a corner attribute its rank
+// among the values equal to it on the grid, by index in the list.
+std::vector<uint32_t> value_ranks(const Attribute& a, const AttributeHeader& h) {
+  std::map<std::vector<int32_t>, uint32_t> count;
+  std::vector<uint32_t> rank(a.value_count());
+  std::vector<int32_t> key(attribute_key_size(h));
+  for (size_t x = 0; x < a.value_count(); ++x) {
+    attribute_key(h, &a.values[size_t{a.components} * x], key.data());
+    rank[x] = count[key]++;
+  }
+  return rank;
+}
+
+// FORMAT.md §8.13, points out: the rank stream, per output split vertex
+// (`split_of`: its split vertex; `first`: per split vertex its first
+// corner): the point ranks where a point has several split vertices, then
+// per corner attribute coded per vertex (`per_vertex`) the value ranks
+// where a value is shared. Empty when every rank is 0.
+std::string rank_stream(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint32_t>& split_of,
+                        const std::vector<uint32_t>& first, const std::vector<uint32_t>& point_rank,
+                        const std::vector<AttributeHeader>& headers, uint64_t per_vertex) {
+  const size_t n = split_of.size();
+  RangeEncoder e;
+  UIntModel point_model, value_model;
+  bool any = false;
+  std::map<std::array<uint32_t, 3>, uint32_t> share;
+  auto grid = [&](size_t o) {
+    const uint32_t v = mesh.indices[first[split_of[o]]];
+    return std::array<uint32_t, 3>{qin[3 * v], qin[3 * v + 1], qin[3 * v + 2]};
+  };
+  for (size_t o = 0; o < n; ++o) ++share[grid(o)];
+  for (size_t o = 0; o < n; ++o) {
+    if (share[grid(o)] < 2) continue;
+    const uint32_t r = point_rank[mesh.indices[first[split_of[o]]]];
+    point_model.encode(e, r);
+    any = any || r != 0;
+  }
+  for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+    const Attribute& a = mesh.attributes[i];
+    if (a.domain != AttributeDomain::corner || !(per_vertex >> i & 1)) continue;
+    const std::vector<uint32_t> rank = value_ranks(a, headers[i]);
+    std::vector<std::vector<int32_t>> keys(n, std::vector<int32_t>(attribute_key_size(headers[i])));
+    std::map<std::vector<int32_t>, uint32_t> count;
+    for (size_t o = 0; o < n; ++o) {
+      attribute_key(headers[i], &a.values[size_t{a.components} * a.indices[first[split_of[o]]]], keys[o].data());
+      ++count[keys[o]];
+    }
+    for (size_t o = 0; o < n; ++o) {
+      if (count[keys[o]] < 2) continue;
+      const uint32_t r = rank[a.indices[first[split_of[o]]]];
+      value_model.encode(e, r);
+      any = any || r != 0;
+    }
+  }
+  return any ? e.finish() : std::string();
+}
+
 // FORMAT.md §8.13, points out: a mesh whose corner attributes are index
 // lists (OBJ vt/vn, PLY per-corner lists) coded as the split vertices a
-// glTF exporter would make, through the welded path; the decoder gives
-// back one vertex per point and the value lists. `vertex_from`: per output
-// vertex (point), its input vertex. `done` is false when nothing was coded.
+// glTF exporter would make, through the welded path, with the ranks that
+// tell apart input vertices sharing a grid position and values equal on
+// their grid; the decoder gives back one vertex per (point, rank) and the
+// value lists. `vertex_from`: per output vertex, its input vertex. `done`
+// is false when nothing was coded.
 Status encode_split_route(const Mesh& mesh, const std::vector<uint32_t>& qin, const EncodeOptions& options,
                           EncodedPart& out, std::vector<uint32_t>& vertex_from, uint64_t& split_count, bool& done) {
   done = false;
-  std::vector<uint32_t> from;
-  const Mesh s = split_vertices(mesh, from);
+  std::vector<uint32_t> first;
+  const Mesh s = split_vertices(mesh, first);
   if (s.vertex_count() == mesh.vertex_count()) return Status::Ok();
   std::vector<uint32_t> qs(3 * s.vertex_count());
-  for (size_t v = 0; v < s.vertex_count(); ++v) std::copy_n(&qin[3 * size_t{from[v]}], 3, &qs[3 * v]);
+  for (size_t v = 0; v < s.vertex_count(); ++v) std::copy_n(&qin[3 * size_t{mesh.indices[first[v]]}], 3, &qs[3 * v]);
   const std::vector<AttributeHeader> headers = attribute_headers(s, options.attribute_bits);
+  if (per_vertex_corner_attributes(s) == 0) return Status::Ok();
   bool welded = false;
   TSM_RETURN_IF_ERROR(encode_welded(s, qs, headers, options, out, welded, 2));
   if (!welded) return Status::Ok();
-  vertex_from.clear();
-  for (uint32_t x : out.vertex_from) {
-    const uint32_t v = from[x];
-    if (vertex_from.empty() || vertex_from.back() != v) vertex_from.push_back(v);
-  }
+  std::vector<uint32_t> split_input(out.vertex_from.size());
+  for (size_t o = 0; o < split_input.size(); ++o) split_input[o] = mesh.indices[first[out.vertex_from[o]]];
+  const std::vector<uint32_t> point_rank = point_ranks(mesh, qin, split_input, vertex_from);
   if (vertex_from.size() != mesh.vertex_count())
     return Status(ErrorCode::internal, "the split route's points do not map to the input's vertices");
+  const std::string ranks =
+      rank_stream(mesh, qin, out.vertex_from, first, point_rank, attribute_headers(mesh, options.attribute_bits),
+                  per_vertex_corner_attributes(s));
+  // The rank stream goes after the order byte (the split stream's length,
+  // the stream, the byte), which says so by its bit 2.
+  if (!ranks.empty()) {
+    ByteReader r(out.attributes);
+    uint64_t len = 0;
+    if (!r.varint(len)) return Status(ErrorCode::internal, "the welded part lost its split stream");
+    const size_t at = r.offset() + static_cast<size_t>(len) + 1;
+    out.attributes[at - 1] = static_cast<char>(out.attributes[at - 1] | 4);
+    std::string head;
+    ByteWriter bw(head);
+    bw.varint(ranks.size());
+    bw.bytes(ranks);
+    out.attributes.insert(at, head);
+  }
   split_count = s.vertex_count();
   done = true;
   return Status::Ok();
@@ -1204,7 +1288,7 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::o
     mesh_section = write_mesh_payload(mp);
     vertex_from = welded ? std::move(p.vertex_from) : std::move(p.order);
     // Index-list corner attributes: also as split vertices, kept when smaller.
-    if (!welded && !options.lossless && !options.keep_order && split_route_fits(mesh, qin, headers)) {
+    if (!options.lossless && !options.keep_order && split_route_fits(mesh, headers)) {
       EncodedPart ps;
       std::vector<uint32_t> from;
       uint64_t split_count = 0;
