@@ -118,6 +118,7 @@ struct DecodedPart {
   std::vector<uint32_t> split_point;             // points out (§8.13): per output vertex, its point
   std::vector<uint32_t> point_q;                 // points out: the points' grid indices
   std::string_view rank_stream;                  // points out: the ranks (empty: all 0)
+  uint64_t merged_vertices = 0;                  // points out: split vertices less output vertices
   bool want_costs = false;
   Status status;
 };
@@ -292,6 +293,7 @@ Status points_out(DecodedPart& out) {
   out.point_q = std::vector<uint32_t>();
   out.global.assign(nv, kNone);
   out.split_point = std::vector<uint32_t>();
+  out.merged_vertices = n - nv;
   return Status::Ok();
 }
 
@@ -662,6 +664,8 @@ Status inspect(std::string_view bytes, FileInfo& info) {
     info.welded_points += st.points;
     info.table_coded_attributes += parts[k].table_coded_attributes;
     info.references += parts[k].counts.reference_count;
+    // A points-out part (§8.13): the header counts its split vertices.
+    info.vertex_count -= parts[k].merged_vertices;
     SegmentSummary sum;
     sum.vertices = parts[k].counts.vertex_count;
     sum.references = parts[k].counts.reference_count;
