@@ -92,7 +92,10 @@ function levelProblems(m, result, throttle) {
     if (l.batches !== k) out.push(`level ${k}: ${l.batches} batches`);
     if (k && !(l.faces > levels[k - 1].faces && l.vertices > levels[k - 1].vertices))
       out.push(`level ${k}: ${l.faces} faces after ${levels[k - 1].faces}`);
-    if (k && levels[k - 1].error >= 0 && !(l.error <= levels[k - 1].error)) out.push(`level ${k}: error ${l.error} after ${levels[k - 1].error}`);
+    // The encoder's error per level (a maximum distance): finer levels need
+    // not lower it at every batch, but none is coarser than the base.
+    if (k && levels[0].error >= 0 && !(l.error >= 0 && l.error <= levels[0].error))
+      out.push(`level ${k}: error ${l.error}, the base's ${levels[0].error}`);
   });
   if (levels.length && levels[levels.length - 1].error !== 0) out.push(`last level's error ${levels[levels.length - 1].error}`);
   if (throttle && levels.length && !(levels[0].bytesIn < m.tsmBytes)) out.push(`the base came at byte ${levels[0].bytesIn} of ${m.tsmBytes}`);
