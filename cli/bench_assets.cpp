@@ -60,38 +60,6 @@ std::string glb_json(const std::string& glb) {
   return glb.substr(20, length);
 }
 
-// Runs a program (searched on PATH) with its output to `log`; its exit code,
-// or -1 when it cannot be started.
-int run_program(const std::vector<std::string>& args, const std::string& log) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) return -1;
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
-
-// What a program said when it failed, for the note under the table: its
-// first line naming an error, else its last non-empty line.
-std::string last_line(const std::string& log) {
-  std::string text, line, last;
-  slurp(log, text);
-  std::istringstream in(text);
-  while (std::getline(in, line)) {
-    if (line.find("rror") != std::string::npos) return line;
-    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
-  }
-  return last;
-}
-
 // Medians of `runs` decodes of a compressed .glb to a plain one.
 void time_decode(const std::string& glb, const std::string& name, const std::string& dir, int runs, AssetTool& t) {
   GltfTranscodeOptions plain;
@@ -182,6 +150,39 @@ std::string cell_ratio(const AssetTool& a, const AssetTool& b) {
 }
 
 }  // namespace
+
+// Runs a program (searched on PATH) with its output to `log`; its exit code,
+// or -1 when it cannot be started.
+int run_program(const std::vector<std::string>& args, const std::string& log) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) return -1;
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// What a program said when it failed, for the note under the table: its
+// first line naming an error, else its last non-empty line.
+std::string last_line(const std::string& log) {
+  std::string text, line, last;
+  slurp(log, text);
+  std::istringstream in(text);
+  while (std::getline(in, line)) {
+    if (line.find("rror") != std::string::npos) return line;
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  }
+  return last;
+}
+
 
 bool is_gltf_path(const std::string& path) {
   std::string ext = fs::path(path).extension().string();

@@ -45,6 +45,14 @@ AssetRow bench_asset(const std::string& path, int q, int level, int runs, bool q
 // web/test/gltf-bench.mjs; false and `error` when that cannot run.
 bool browser_times(std::vector<AssetRow>& rows, const std::string& work_dir, int runs, std::string& error);
 
+// Runs a program (searched on PATH) with its output and errors to `log`;
+// its exit code, or -1 when it cannot be started.
+int run_program(const std::vector<std::string>& args, const std::string& log);
+
+// What a program said when it failed, for a note under a table: the log's
+// first line naming an error, else its last non-empty line.
+std::string last_line(const std::string& log);
+
 void print_asset_table(const std::vector<AssetRow>& rows, bool browser);
 nlohmann::ordered_json asset_rows_json(const std::vector<AssetRow>& rows);
 

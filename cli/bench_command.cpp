@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench_assets.hpp"
+#include "bench_attribute_files.hpp"
 #include "bench_draco.hpp"
 #include "bench_simplify.hpp"
 #include "bench_timing.hpp"
@@ -113,6 +114,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
   std::vector<Row> rows;
   std::vector<ReadRow> reads;
   std::vector<AssetRow> assets;
+  std::vector<AttributeFileRow> attribute_files;
   std::vector<SimplifyRow> simplified;
   // The compressed glTF files, kept until the browser has decoded them.
   std::string work_dir = (std::filesystem::temp_directory_path() / "tsm-bench-XXXXXX").string();
@@ -147,8 +149,14 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
         std::fprintf(stderr, "tsm bench: skipped: %s\n", printable(s.message()).c_str());
         continue;
       }
-      // Positions and faces only, as the in-process Draco adapter codes them:
-      // attributes are compared by bench/tsm_bench_attributes.
+      if (has_common_attributes(mesh))
+        for (int q : qbits) {
+          attribute_files.push_back(bench_attribute_file(path, mesh, q, level, quiet, work_dir));
+          const AttributeFileRow& a = attribute_files.back();
+          if (!a.error.empty()) failures.push_back(rr.mesh + ": with attributes: " + a.error);
+          else if (!a.tsm_exact) failures.push_back(rr.mesh + ": with attributes: round trip not exact");
+        }
+      // Positions and faces only from here, as the in-process Draco adapter codes them.
       mesh.attributes.clear();
       if (have_draco) {
         size_t v = 0, f = 0;
@@ -285,6 +293,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
       doc["reads"].push_back(
           {{"mesh", r.mesh}, {"tsm_ms", rounded(r.tsm_ms, 1e3)}, {"draco_ms", rounded(r.draco_ms, 1e3)}});
     doc["assets"] = asset_rows_json(assets);
+    doc["attribute_files"] = attribute_file_rows_json(attribute_files);
     if (!simplify_bounds.empty()) doc["simplify"] = simplify_rows_json(simplified);
     doc["failures"] = failures.size();
     std::printf("%s\n", doc.dump(2, ' ', false, ojson::error_handler_t::replace).c_str());
@@ -322,6 +331,7 @@ int run_bench(const std::vector<std::string>& meshes_in, bool json, const std::v
     }
   }
   if (!assets.empty()) print_asset_table(assets, browser);
+  if (!attribute_files.empty()) print_attribute_file_table(attribute_files);
   if (!simplified.empty()) print_simplify_table(simplified);
   if (!reads.empty()) {
     std::printf("\n| mesh | tsm read ms | Draco read ms | Draco/tsm |\n|---|---:|---:|---:|\n");

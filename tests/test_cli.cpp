@@ -380,6 +380,38 @@ TEST_F(Cli, BenchSimplifiesBesideMeshoptimizer) {
   EXPECT_EQ(r.code, 2) << r.out << r.err;
 }
 
+// A mesh with normals and texture coordinates gets a row in the attributes
+// table: tsm's bytes by part and its exact round trip with the attributes,
+// and Draco's smallest file of the same values (draco_encoder, installed by
+// scripts/setup.sh, so in CI it must work).
+TEST_F(Cli, BenchComparesAttributes) {
+  ASSERT_TRUE(tsm::write_mesh(file("flat.obj"), tsm_test::flat_shaded_textured_sphere(2)).ok());
+  Result r = tsm("bench " + q("flat.obj") + " --runs 1 -q 11 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  ASSERT_EQ(doc["attribute_files"].size(), 1u) << r.out;
+  const auto& row = doc["attribute_files"][0];
+  EXPECT_EQ(row["mesh"], "flat.obj");
+  EXPECT_EQ(row["faces"], 320);
+  EXPECT_EQ(row["points"], 162) << "the split vertices of one point count once";
+  EXPECT_TRUE(row["tsm_exact"].get<bool>()) << r.out;
+  const std::string parts = row["tsm_parts"].get<std::string>();
+  EXPECT_NE(parts.find("normal "), std::string::npos) << parts;
+  EXPECT_NE(parts.find("texcoord "), std::string::npos) << parts;
+  if (!row.contains("draco_cl10_bytes")) {
+    EXPECT_FALSE(tsm_test::running_in_ci()) << "draco_encoder (draco-tools) is required in CI: " << r.out;
+    EXPECT_NE(row["draco_inputs"].get<std::string>().find("not installed"), std::string::npos) << r.out;
+  } else {
+    EXPECT_GT(row["draco_cl10_bytes"].get<size_t>(), 100u) << r.out;
+    EXPECT_NE(row["draco_inputs"].get<std::string>().find("shared lists: "), std::string::npos) << r.out;
+  }
+  // A mesh without those attributes has no row.
+  write_input("small.ply");
+  r = tsm("bench " + q("small.ply") + " --runs 1 -q 8 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.out)["attribute_files"].empty()) << r.out;
+}
+
 // ---------------------------------------------------------------- many files, pipes, safety
 
 // Lines of a text.
