@@ -1,4 +1,4 @@
-// Connectivity alone (issue 3's figures). Usage:
+// Connectivity alone. Usage:
 //   tsm_bench_connectivity [--runs N] [--fresh-pages] MESH...
 //     linearity: encode_connectivity and decode_connectivity on each mesh,
 //     medians of several runs (interleaved: run r of every mesh, then run

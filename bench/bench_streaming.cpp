@@ -1,4 +1,4 @@
-// Segments and streaming (issue 7's figures): for each mesh and segment size,
+// Segments and streaming: for each mesh and segment size,
 // the file size and its cost against one segment, the references, decode
 // time with 1 and 2 threads (medians), and streaming: the bytes that must be
 // in before the first triangles come out, the time to first triangles when

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The installed library as a user sees it (issue 42): installs the built tree
+# The installed library as a user sees it: installs the built tree
 # into a fresh prefix, then builds tests/consumer/ outside the tree twice,
 # with find_package(tsm) and with `pkg-config --static tsm`, and runs both.
 # usage: check_install.sh CMAKE BUILD_DIR SOURCE_DIR WORK_DIR CXX [EXTRA_CXX_FLAGS]

@@ -1,5 +1,5 @@
 // Exact round trip of the Topological Surgery connectivity on every kind of
-// mesh a user can hand us (issue: connectivity), through the public API.
+// mesh a user can hand us, through the public API.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Segments and streaming (issue: streaming decode and parallel coding): a
+// Segments and streaming: a
 // mesh coded as several segments decodes to the same mesh, whole or fed in
 // any chunks, with the first segment's triangles out before the last bytes
 // are in; the bytes do not depend on the thread count.
