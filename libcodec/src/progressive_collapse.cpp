@@ -23,8 +23,12 @@ namespace {
 
 using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 
-// The weight of a collapse's prediction error against its quadric error.
+// The weights of a collapse's prediction error and of its edge's squared
+// length against its quadric error: short edges first keep the levels'
+// triangles regular (where the quadric is flat, e.g. a scan's cut bottom),
+// which makes the splits' residuals smaller.
 constexpr double kRegularity = 0.1;
+constexpr double kLength = 0.02;
 // The weight of a border edge's plane (through the edge, across its face)
 // per squared edge length.
 constexpr double kBorderWeight = 1.0;
@@ -353,9 +357,14 @@ std::vector<Candidate> Collapser::candidates() {
       for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
       const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
                            static_cast<double>(q_[3 * size_t{v} + 2])};
-      // The quadric error, plus the squared distance above weighted by the
+      double len2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = p[a] - static_cast<double>(q_[3 * size_t{u} + a]);
+        len2 += d * d;
+      }
+      // The quadric error, plus the squared distances above weighted by the
       // faces' area (the quadric's weight, q[0] + q[4] + q[7]).
-      const double cost = quadric_at(q, p) + kRegularity * lap2 * (q[0] + q[4] + q[7]);
+      const double cost = quadric_at(q, p) + (kRegularity * lap2 + kLength * len2) * (q[0] + q[4] + q[7]);
       out.push_back({cost, rank_[u], rank_[v], u, v});
     }
   }
