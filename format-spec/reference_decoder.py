@@ -2944,9 +2944,10 @@ class LevelMesh:
                     self.vf[c].append(f)
 
     def ring(self, v):
-        """v's closed fan (§4.8) listed from its least vertex, or None."""
+        """v's closed fan (§4.8) listed from its least vertex, or its open
+        fan from its first vertex then GHOST, or None."""
         fs = self.vf[v]
-        if len(fs) < 3:
+        if not fs:
             return None
         edges = []
         for f in fs:
@@ -2961,16 +2962,24 @@ class LevelMesh:
         if any(edges[i][0] == edges[i - 1][0] for i in range(1, len(edges))):
             return None
         nxt = dict(edges)
+        ends = set(b for _, b in edges)
+        starts = [a for a, _ in edges if a not in ends]
+        if len(starts) > 1 or (not starts and len(edges) < 3):
+            return None
         ring = []
-        at = edges[0][0]
+        at = starts[0] if starts else edges[0][0]
         for _ in edges:
             ring.append(at)
             if at not in nxt:
                 return None
             at = nxt[at]
-        if at != ring[0] or len(set(ring)) != len(ring):
+        if starts:
+            ring.append(at)
+        elif at != ring[0]:
             return None
-        return ring
+        if len(set(ring)) != len(ring):
+            return None
+        return ring + [GHOST] if starts else ring
 
     def adjacent_to_marked(self, v, marked):
         return any(c < len(marked) and marked[c] for f in self.vf[v] for c in self.faces[f])
@@ -2996,21 +3005,24 @@ class LevelMesh:
                 keep.append(f)
         self.vf[v] = keep
         y, x = ring[ia], ring[(ia + dist) % d]
-        f1 = len(self.faces)
-        self.faces.append([v, u, x])
-        self.faces.append([v, y, u])
-        for w in (v, u, x):
-            self.vf[w].append(f1)
-        for w in (v, y, u):
-            self.vf[w].append(f1 + 1)
+        for face in ([v, u, x], [v, y, u]):
+            if GHOST in face:
+                continue
+            for w in face:
+                self.vf[w].append(len(self.faces))
+            self.faces.append(face)
+
+
+GHOST = -1                      # §4.8: closes a border vertex's open fan
 
 
 class BatchModels:
     def __init__(self):
-        self.flag = probs(8)
-        self.start = [UIntModel(2) for _ in range(16)]
-        self.dist = [UIntModel(2) for _ in range(16)]
+        self.flag = probs(16)
+        self.start = [UIntModel(2) for _ in range(32)]
+        self.dist = [UIntModel(2) for _ in range(32)]
         self.residual = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
+        self.border = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
 
 
 def plane_offset(level, qv, ring, nrm, order, e1, e2, qmax):
@@ -3020,10 +3032,11 @@ def plane_offset(level, qv, ring, nrm, order, e1, e2, qmax):
         return 0
     _, ex = math.frexp(top)
     N = [math.floor(math.ldexp(nrm[a], 15 - ex) + 0.5) for a in range(3)]
-    dd = len(ring)
+    real = [r for r in ring if r != GHOST]
+    dd = len(real)
     height = 0
     for a in range(3):
-        c = (sum(level.q[r][a] for r in ring) + dd // 2) // dd
+        c = (sum(level.q[r][a] for r in real) + dd // 2) // dd
         height += N[a] * (qv[a] - c)
     n0 = N[order[0]]
     t = height - 2 * (N[order[1]] * e1 + N[order[2]] * e2)
@@ -3040,6 +3053,9 @@ def decode_batch(payload, level, m):
     if not all(math.isfinite(e) and e >= 0 for e in (before, after)):
         reject('refinement error')
     splits, p = read_varint(payload, 8, len(payload))
+    border_count, p = read_varint(payload, p, len(payload))
+    if border_count > splits:
+        reject('border split count')
     stream = payload[p:]
     n = len(level.q)
     if splits == 0 or splits > n or splits > max_decisions(len(stream)) // 4:
@@ -3055,7 +3071,7 @@ def decode_batch(payload, level, m):
         ring = level.ring(i)
         if ring is None:
             continue
-        b = d.bit(m.flag, min(len(ring), 10) - 3)
+        b = d.bit(m.flag, min(len(ring), 10) - 3 + (8 if ring[-1] == GHOST else 0))
         marked[i] = b
         ones += b
         if d.truncated():
@@ -3068,26 +3084,34 @@ def decode_batch(payload, level, m):
             continue
         ring = level.ring(v)
         dd = len(ring)
-        dist = m.dist[min(dd, 15)].decode(d) + 1
+        ctx = min(dd, 15) + (16 if ring[-1] == GHOST else 0)
+        dist = m.dist[ctx].decode(d) + 1
         if not 1 <= dist < dd:
             reject('split ring neighbours')
-        middle = m.start[min(dd, 15)].decode(d)
+        middle = m.start[ctx].decode(d)
         if middle >= dd:
             reject('split ring neighbours')
         qv = level.q[v]
-        d2 = [sum((level.q[r][a] - qv[a]) ** 2 for a in range(3)) for r in ring]
+        d2 = [sum((level.q[r][a] - qv[a]) ** 2 for a in range(3)) if r != GHOST else -1 for r in ring]
         far = max(range(dd), key=lambda i: (d2[i], -i))
         ia = (middle + far - dist // 2) % dd
         arc = [ring[(ia + k) % dd] for k in range(dist + 1)]
+        border = arc[0] == GHOST or arc[-1] == GHOST
+        if border:                       # u on v's border: v and its border neighbour
+            known = [arc[1] if arc[0] == GHOST else arc[-2]]
+        else:
+            known = [r for r in arc if r != GHOST]
         qv = level.q[v]
         pred = []
         for a in range(3):
-            total = qv[a] + sum(level.q[r][a] for r in arc)
-            pred.append((total + (dist + 2) // 2) // (dist + 2))
-        span = max(abs(level.q[r][a] - qv[a]) for r in arc for a in range(3))
+            total = qv[a] + sum(level.q[r][a] for r in known)
+            pred.append((total + (len(known) + 1) // 2) // (len(known) + 1))
+        span = max(abs(level.q[r][a] - qv[a]) for r in arc if r != GHOST for a in range(3))
         sc = min(bit_length(span), 23)
         nrm = [0.0, 0.0, 0.0]
         for i in range(dd):
+            if GHOST in (ring[i], ring[(i + 1) % dd]):
+                continue
             ra, rb = level.q[ring[i]], level.q[ring[(i + 1) % dd]]
             e1 = [float(ra[k]) - float(qv[k]) for k in range(3)]
             e2 = [float(rb[k]) - float(qv[k]) for k in range(3)]
@@ -3099,9 +3123,10 @@ def decode_batch(payload, level, m):
             order[sum(1 for b in range(3) if abs(nrm[b]) > abs(nrm[a]) or (abs(nrm[b]) == abs(nrm[a]) and b < a))] = a
         g = [0, 0, 0]
         e = [0, 0, 0]
+        models = m.border[sc] if border else m.residual[sc]
         for k in (1, 2, 0):
-            e[k] = m.residual[sc][k].decode(d)
-            off = plane_offset(level, qv, ring, nrm, order, e[1], e[2], qmax) if k == 0 else 0
+            e[k] = models[k].decode(d)
+            off = plane_offset(level, qv, ring, nrm, order, e[1], e[2], qmax) if k == 0 and not border else 0
             x = pred[order[k]] + off + e[k]
             if not 0 <= x <= qmax:
                 reject('a new vertex off the grid')
@@ -3109,6 +3134,9 @@ def decode_batch(payload, level, m):
         if d.truncated():
             reject('refinement splits truncated')
         level.split(v, ring, ia, dist, g)
+        border_count -= 1 if border else 0
+    if border_count != 0:
+        reject('border split count')
 
 
 def decode_loose(payload, level):

@@ -3,7 +3,9 @@
 // batch by batch, and hostile refinement bytes are refused.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
+#include <set>
 
 #include "container.hpp"
 #include "mesh_gen.hpp"
@@ -166,6 +168,54 @@ TEST(Progressive, PrefixesDecodeToGrowingLevels) {
   ASSERT_TRUE(tsm::decode_partial(bytes, full, {}, &rep).ok());
   EXPECT_TRUE(rep.complete);
   EXPECT_EQ(full.face_count(), m.face_count());
+}
+
+// The border loops of a triangle mesh (edges no face has the other way
+// round), or -1 when a vertex has several border edges leaving it.
+int border_loops(const tsm::Mesh& m, size_t* border_vertices) {
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (size_t f = 0; f < m.face_count(); ++f)
+    for (uint32_t k = 0; k < 3; ++k) ++directed[{m.face(f)[k], m.face(f)[(k + 1) % 3]}];
+  std::map<uint32_t, uint32_t> next;
+  for (const auto& e : directed)
+    if (!directed.count({e.first.second, e.first.first}) && !next.emplace(e.first.first, e.first.second).second)
+      return -1;
+  *border_vertices = next.size();
+  int loops = 0;
+  std::set<uint32_t> seen;
+  for (const auto& e : next) {
+    if (seen.count(e.first)) continue;
+    ++loops;
+    for (uint32_t v = e.first; seen.insert(v).second;) {
+      auto it = next.find(v);
+      if (it == next.end()) return -1;
+      v = it->second;
+    }
+  }
+  return loops;
+}
+
+TEST(Progressive, BordersCoarsenAndHolesStay) {
+  const tsm::Mesh m = jittered(grid_with_holes(40, 3), 0.005f, 11);
+  size_t input_border = 0, border = 0;
+  const int loops = border_loops(m, &input_border);
+  ASSERT_GE(loops, 4);  // the outline and the holes
+  const std::string bytes = encode_progressive(m);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  ASSERT_FALSE(fi.batches.empty());
+  // Every level has the input's borders: none closed, opened or pinched.
+  size_t levels = 0, base_border = 0;
+  for (size_t cut = 0; cut <= bytes.size(); cut += 97) {
+    tsm::Mesh level;
+    if (!tsm::decode_partial(std::string_view(bytes).substr(0, cut), level, {}, nullptr).ok()) continue;
+    EXPECT_EQ(border_loops(level, &border), loops) << "at byte " << cut;
+    if (levels++ == 0) base_border = border;
+  }
+  EXPECT_GE(levels, 3u);
+  // The borders are coarsened too (they stayed whole in the base before).
+  EXPECT_LT(base_border * 3, input_border);
+  expect_round_trip(m, 3);
 }
 
 TEST(Progressive, StopsAtMaxBytesAndMaxError) {

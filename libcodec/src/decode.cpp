@@ -602,7 +602,7 @@ Status inspect_batches(const Header& h, const std::vector<Section>& sections, Fi
     TSM_RETURN_IF_ERROR(read_batch(s.data, bh, stream));
     if (info.batches.empty()) info.base_error = bh.error_before;
     vertices += bh.splits;
-    faces += 2 * bh.splits;
+    faces += 2 * bh.splits - bh.border;
     FileInfo::Batch b;
     b.bytes = 7 + varint_bytes(s.stored_bytes) + varint_bytes(s.raw_bytes) + s.stored_bytes;
     b.vertices = vertices;

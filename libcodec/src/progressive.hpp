@@ -20,6 +20,11 @@ float grid_value(const Header& h, double step, int axis, uint32_t q);
 
 struct BatchModels;  // progressive_split.cpp
 
+// The ghost closing a boundary vertex's open fan into a ring (FORMAT.md
+// §4.8): the last ring entry of a vertex on a border, standing for the
+// outside; faces with it are not in the mesh.
+constexpr uint32_t kGhost = 0xFFFFFFFEu;
+
 // The decoder's current level of detail: the mesh, the grid index of every
 // vertex and, per vertex, the faces that use it.
 class LevelMesh {
@@ -28,8 +33,9 @@ class LevelMesh {
   void init(Mesh& mesh, const Header& h);
   // The ordered neighbours r_0 .. r_{d-1} of v when its faces are d
   // triangles forming one closed, consistently oriented fan (faces
-  // (v, r_i, r_{i+1 mod d})), starting at the neighbour of least id; false
-  // otherwise.
+  // (v, r_i, r_{i+1 mod d})), starting at the neighbour of least id; or,
+  // when they form one open fan (v on a border), its neighbours from the
+  // fan's first to its last, then kGhost; false otherwise.
   bool ring(uint32_t v, std::vector<uint32_t>& ring) const;
   bool adjacent_to_marked(uint32_t v, const std::vector<uint8_t>& marked) const;
   // Splits v (FORMAT.md §4.8): the faces (v, r_i, r_{i+1}) for i = ia ..
@@ -57,7 +63,7 @@ class LevelMesh {
 
 // One vertex split as the encoder hands it to encode_batch (level ids): v is
 // split, the faces from y to x (in v's ring order) go to the new vertex at
-// grid index q.
+// grid index q; y or x may be kGhost (the new vertex on v's border).
 struct VertexSplit {
   uint32_t v = 0, y = 0, x = 0;
   uint32_t q[3] = {0, 0, 0};
@@ -65,25 +71,27 @@ struct VertexSplit {
 
 // The ring of v from the edges opposite v in its triangles (each (a, b): the
 // corners after v): the closed fan of FORMAT.md §4.8, listed from its least
-// vertex; false when the edges do not form one (a repeated or degenerate
-// edge, a vertex twice, more than one cycle). Sorts `edge`.
+// vertex, or the open fan from its first vertex then kGhost; false when the
+// edges do not form one (a repeated or degenerate edge, a vertex twice,
+// several cycles or paths). Sorts `edge`.
 bool ring_from_edges(uint32_t v, std::vector<std::pair<uint32_t, uint32_t>>& edge, std::vector<uint32_t>& ring);
 
 // A refinement payload (FORMAT.md §4.8): the error of the level before and
 // after the batch (symmetric Hausdorff distance to the input, model units),
-// the number of splits, then the range-coded splits.
+// the number of splits and of those putting the new vertex on a border
+// (they add one face, the others two), then the range-coded splits.
 struct BatchHeader {
   float error_before = 0, error_after = 0;
-  uint64_t splits = 0;
+  uint64_t splits = 0, border = 0;
 };
 std::string write_batch(const BatchHeader& h, std::string_view stream);
 Status read_batch(std::string_view payload, BatchHeader& h, std::string_view& stream);
 
 // Codes a batch of splits (in any order, pairwise independent) and applies
 // them to `level`; appends the new vertices' ids (in the order of `splits`)
-// to `new_ids`.
+// to `new_ids`; `border`: how many put the new vertex on a border.
 Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, std::string& stream,
-                    std::vector<uint32_t>& new_ids);
+                    std::vector<uint32_t>& new_ids, uint64_t& border);
 
 struct BatchLimits {
   uint64_t max_vertices = 0, max_faces = 0;  // 0 = none

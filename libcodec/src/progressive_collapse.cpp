@@ -4,9 +4,11 @@
 // (a vertex u merged into a neighbour v, so every vertex keeps its grid
 // position and each split gives back one exactly), in quadric-error order,
 // grouped into batches of independent collapses (their faces pairwise
-// disjoint). What the collapses cannot handle (boundaries, non-manifold
-// vertices, polygons, degenerate faces, coincident grid points) stays in
-// the base mesh.
+// disjoint). A border vertex merges into a neighbour along its border (the
+// border's shape held by quadric planes across its edges), so holes are
+// neither closed nor opened. What the collapses cannot handle
+// (non-manifold vertices, polygons, degenerate faces, coincident grid
+// points) stays in the base mesh.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,8 +23,15 @@ namespace {
 
 using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 
-// The weight of a collapse's prediction error against its quadric error.
+// The weights of a collapse's prediction error and of its edge's squared
+// length against its quadric error: short edges first keep the levels'
+// triangles regular (where the quadric is flat, e.g. a scan's cut bottom),
+// which makes the splits' residuals smaller.
 constexpr double kRegularity = 0.1;
+constexpr double kLength = 0.02;
+// The weight of a border edge's plane (through the edge, across its face)
+// per squared edge length.
+constexpr double kBorderWeight = 1.0;
 
 void add_plane(Quadric& q, const double n[3], double d, double w) {
   const double p[4] = {n[0], n[1], n[2], d};
@@ -58,7 +67,9 @@ class Collapser {
   void rank_vertices();
   void build();
   void lock_special();
+  void add_border_planes();
   bool ring(uint32_t v, std::vector<uint32_t>& out) const;
+  bool keeps_fan(uint32_t w);
   void cross(const uint32_t t[3], uint32_t from, uint32_t to, int64_t n[3]) const;
   bool valid(uint32_t u, uint32_t v, CollapseRecord& rec);
   void collapse(const CollapseRecord& rec);
@@ -80,7 +91,7 @@ class Collapser {
   std::vector<Quadric> quadric_;
   std::vector<uint32_t> merged_into_;  // per removed vertex: v of its collapse
   size_t vertices_left_ = 0;
-  std::vector<uint32_t> ring_u_, ring_v_;
+  std::vector<uint32_t> ring_u_, ring_v_, ring_w_;
   std::vector<uint32_t> rank_;   // per vertex: its place in the order by grid point (then input id)
   std::vector<uint32_t> order_;  // vertices by rank
 };
@@ -162,6 +173,41 @@ void Collapser::build() {
   vertices_left_ = n;
 }
 
+// A border edge (a, b) (no triangle has (b, a)) adds to both ends the plane
+// through it perpendicular to its face, so collapses along the border keep
+// its shape within their quadric error.
+void Collapser::add_border_planes() {
+  std::vector<std::pair<uint32_t, uint32_t>> directed;
+  directed.reserve(3 * tri_.size());
+  for (const auto& c : tri_)
+    for (int k = 0; k < 3; ++k) directed.emplace_back(c[k], c[(k + 1) % 3]);
+  std::sort(directed.begin(), directed.end());
+  auto pos = [&](uint32_t v, double p[3]) {
+    for (int a = 0; a < 3; ++a) p[a] = q_[3 * size_t{v} + a];
+  };
+  for (const auto& c : tri_)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = c[k], b = c[(k + 1) % 3];
+      if (std::binary_search(directed.begin(), directed.end(), std::make_pair(b, a))) continue;
+      double pa[3], pb[3], pc[3], e[3], f[3], n[3], m[3];
+      pos(a, pa), pos(b, pb), pos(c[(k + 2) % 3], pc);
+      for (int i = 0; i < 3; ++i) e[i] = pb[i] - pa[i], f[i] = pc[i] - pa[i];
+      n[0] = e[1] * f[2] - e[2] * f[1];
+      n[1] = e[2] * f[0] - e[0] * f[2];
+      n[2] = e[0] * f[1] - e[1] * f[0];
+      m[0] = e[1] * n[2] - e[2] * n[1];
+      m[1] = e[2] * n[0] - e[0] * n[2];
+      m[2] = e[0] * n[1] - e[1] * n[0];
+      const double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+      if (len == 0) continue;
+      for (double& x : m) x /= len;
+      const double d = -(m[0] * pa[0] + m[1] * pa[1] + m[2] * pa[2]);
+      const double w = kBorderWeight * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+      add_plane(quadric_[a], m, d, w);
+      add_plane(quadric_[b], m, d, w);
+    }
+}
+
 // Vertices that must stay: those of the faces above, those sharing a grid
 // point with another (the encoder finds base vertices in the decoded base
 // by their grid point), and one vertex on each side of the grid's box (the
@@ -194,7 +240,7 @@ bool Collapser::ring(uint32_t v, std::vector<uint32_t>& out) const {
   const std::vector<uint32_t>& faces = vf_[v];
   const size_t d = faces.size();
   out.clear();
-  if (d < 3) return false;
+  if (d == 0) return false;
   std::vector<std::pair<uint32_t, uint32_t>> edge(d);
   for (size_t i = 0; i < d; ++i) {
     const auto& c = tri_[faces[i]];
@@ -220,10 +266,20 @@ void Collapser::cross(const uint32_t t[3], uint32_t from, uint32_t to, int64_t n
 
 // u merged into v keeps both fans manifold, the link condition, and turns
 // no triangle over or flat.
+// w, a neighbour of both u and v, keeps a fan after losing their shared
+// face: 3 faces inside the surface, 1 on a border.
+bool Collapser::keeps_fan(uint32_t w) {
+  if (w == kGhost) return true;
+  if (dup_[w] || vf_[w].size() < 2) return false;
+  return vf_[w].size() >= 4 || (ring(w, ring_w_) && ring_w_.back() == kGhost);
+}
+
 bool Collapser::valid(uint32_t u, uint32_t v, CollapseRecord& rec) {
   if (!ring(u, ring_u_) || !ring(v, ring_v_)) return false;
   const size_t du = ring_u_.size(), dv = ring_v_.size();
   if (du + dv < 7) return false;
+  // A border vertex merges only along its border.
+  if (ring_u_.back() == kGhost && v != ring_u_.front() && v != ring_u_[du - 2]) return false;
   const size_t j = static_cast<size_t>(std::find(ring_v_.begin(), ring_v_.end(), u) - ring_v_.begin());
   if (j == dv) return false;
   rec = {u, v, ring_v_[(j + dv - 1) % dv], ring_v_[(j + 1) % dv]};
@@ -234,7 +290,7 @@ bool Collapser::valid(uint32_t u, uint32_t v, CollapseRecord& rec) {
   std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
   if (common.size() != 2) return false;
   for (uint32_t w : {rec.x, rec.y})
-    if (vf_[w].size() < 4 || dup_[w]) return false;
+    if (!keeps_fan(w)) return false;
   for (uint32_t t : vf_[u]) {
     const auto& c = tri_[t];
     if (c[0] == v || c[1] == v || c[2] == v) continue;
@@ -285,6 +341,9 @@ std::vector<Candidate> Collapser::candidates() {
     // How far u lies from the centroid of its ring: the decoder predicts
     // the new vertex there (FORMAT.md §4.8), so collapses of vertices it
     // predicts well go first.
+    // On a border: from the midpoint of its border neighbours.
+    const bool border = r.back() == kGhost;
+    if (border) r = {r.front(), r[r.size() - 2]};
     double lap2 = 0;
     for (int a = 0; a < 3; ++a) {
       double c = 0;
@@ -298,9 +357,14 @@ std::vector<Candidate> Collapser::candidates() {
       for (int k = 0; k < 10; ++k) q[k] += quadric_[v][k];
       const double p[3] = {static_cast<double>(q_[3 * size_t{v}]), static_cast<double>(q_[3 * size_t{v} + 1]),
                            static_cast<double>(q_[3 * size_t{v} + 2])};
-      // The quadric error, plus the squared distance above weighted by the
+      double len2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = p[a] - static_cast<double>(q_[3 * size_t{u} + a]);
+        len2 += d * d;
+      }
+      // The quadric error, plus the squared distances above weighted by the
       // faces' area (the quadric's weight, q[0] + q[4] + q[7]).
-      const double cost = quadric_at(q, p) + kRegularity * lap2 * (q[0] + q[4] + q[7]);
+      const double cost = quadric_at(q, p) + (kRegularity * lap2 + kLength * len2) * (q[0] + q[4] + q[7]);
       out.push_back({cost, rank_[u], rank_[v], u, v});
     }
   }
@@ -375,6 +439,7 @@ double Collapser::level_error() const {
 void Collapser::run(CollapsePlan& plan) {
   rank_vertices();
   build();
+  add_border_planes();
   lock_special();
   plan.batches.clear();
   plan.errors.clear();

@@ -95,8 +95,8 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
     for (const CollapseRecord& r : plan.batches[b]) {
       VertexSplit s;
       s.v = id[r.v];
-      s.y = id[r.y];
-      s.x = id[r.x];
+      s.y = r.y == kGhost ? kGhost : id[r.y];
+      s.x = r.x == kGhost ? kGhost : id[r.x];
       if (s.v == kNotInBase || s.y == kNotInBase || s.x == kNotInBase)
         return Status(ErrorCode::internal, "progressive: a split around a vertex the base does not identify");
       for (int a = 0; a < 3; ++a) s.q[a] = q[3 * size_t{r.u} + a];
@@ -104,9 +104,9 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
     }
     std::string stream;
     std::vector<uint32_t> new_ids;
-    TSM_RETURN_IF_ERROR(encode_batch(level, splits, stream, new_ids));
-    for (size_t k = 0; k < splits.size(); ++k) id[plan.batches[b][k].u] = new_ids[k];
     BatchHeader bh;
+    TSM_RETURN_IF_ERROR(encode_batch(level, splits, stream, new_ids, bh.border));
+    for (size_t k = 0; k < splits.size(); ++k) id[plan.batches[b][k].u] = new_ids[k];
     bh.error_before = before;
     bh.error_after = b == 0 ? 0.0f : error_of(b - 1);
     bh.splits = splits.size();

@@ -17,15 +17,16 @@
 
 namespace tsm {
 
-constexpr int kFlagContexts = 8;
+constexpr int kFlagContexts = 16;
 constexpr int kScaleContexts = 24;
-constexpr int kRingContexts = 16;
+constexpr int kRingContexts = 32;
 
 struct BatchModels {
-  Prob flag[kFlagContexts];
-  UIntModelT<2> start[kRingContexts];  // by ring size
-  UIntModelT<2> dist[kRingContexts];   // by ring size
+  Prob flag[kFlagContexts];            // by ring size, closed then open
+  UIntModelT<2> start[kRingContexts];  // by ring size, closed then open
+  UIntModelT<2> dist[kRingContexts];   // by ring size, closed then open
   SIntModelT<3> residual[kScaleContexts][3];
+  SIntModelT<3> border[kScaleContexts][3];  // the new vertex on v's border
 };
 
 namespace {
@@ -37,7 +38,9 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist) {
   int64_t span = 0;
   for (uint32_t k = 0; k <= dist; ++k) {
-    const uint32_t* p = level.q(ring[(ia + k) % ring.size()]);
+    const uint32_t r = ring[(ia + k) % ring.size()];
+    if (r == kGhost) continue;
+    const uint32_t* p = level.q(r);
     for (int a = 0; a < 3; ++a) span = std::max<int64_t>(span, std::abs(int64_t{p[a]} - int64_t{level.q(v)[a]}));
   }
   return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
@@ -50,6 +53,7 @@ uint32_t farthest(const LevelMesh& level, uint32_t v, const std::vector<uint32_t
   uint32_t best = 0;
   uint64_t most = 0;
   for (uint32_t i = 0; i < ring.size(); ++i) {
+    if (ring[i] == kGhost) continue;
     uint64_t d2 = 0;
     for (int a = 0; a < 3; ++a) {
       const int64_t x = int64_t{level.q(ring[i])[a]} - int64_t{level.q(v)[a]};
@@ -60,19 +64,44 @@ uint32_t farthest(const LevelMesh& level, uint32_t v, const std::vector<uint32_t
   return best;
 }
 
-int flag_context(size_t degree) { return static_cast<int>(std::min<size_t>(degree, kFlagContexts + 2) - 3); }
+bool open_ring(const std::vector<uint32_t>& ring) { return ring.back() == kGhost; }
+
+int flag_context(const std::vector<uint32_t>& ring) {
+  return static_cast<int>(std::min<size_t>(ring.size(), 10) - 3) + (open_ring(ring) ? kFlagContexts / 2 : 0);
+}
+
+uint32_t ring_context(const std::vector<uint32_t>& ring) {
+  const uint32_t d = static_cast<uint32_t>(ring.size());
+  return std::min<uint32_t>(d, kRingContexts / 2 - 1) + (open_ring(ring) ? kRingContexts / 2 : 0);
+}
+
+// The arc's end next to the ghost when the arc starts or ends at it (the
+// new vertex then lies on v's border, between v and that neighbour);
+// kGhost otherwise.
+uint32_t border_neighbour(const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist) {
+  const size_t d = ring.size();
+  if (ring[ia] == kGhost) return ring[(ia + 1) % d];
+  if (ring[(ia + dist) % d] == kGhost) return ring[(ia + dist + d - 1) % d];
+  return kGhost;
+}
 
 // The grid position the decoder predicts for the new vertex: the centroid
-// of v and the ring neighbours r_ia .. r_{ia+dist} (the new vertex's ring).
+// of v and the ring neighbours r_ia .. r_{ia+dist} (the new vertex's ring;
+// the ghost left out); on v's border, the midpoint of v and the border
+// neighbour.
 void predict(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
              int64_t out[3]) {
   int64_t sum[3] = {level.q(v)[0], level.q(v)[1], level.q(v)[2]};
   const size_t d = ring.size();
+  int64_t n = 1;
+  const uint32_t b = border_neighbour(ring, ia, dist);
   for (uint32_t k = 0; k <= dist; ++k) {
-    const uint32_t* p = level.q(ring[(ia + k) % d]);
+    const uint32_t r = ring[(ia + k) % d];
+    if (r == kGhost || (b != kGhost && r != b)) continue;
+    const uint32_t* p = level.q(r);
     for (int a = 0; a < 3; ++a) sum[a] += p[a];
+    ++n;
   }
-  const int64_t n = dist + 2;
   for (int a = 0; a < 3; ++a) out[a] = (sum[a] + n / 2) / n;
 }
 
@@ -83,6 +112,7 @@ void ring_normal(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>
   const uint32_t* c = level.q(v);
   const size_t d = ring.size();
   for (size_t i = 0; i < d; ++i) {
+    if (ring[i] == kGhost || ring[(i + 1) % d] == kGhost) continue;
     const uint32_t* a = level.q(ring[i]);
     const uint32_t* b = level.q(ring[(i + 1) % d]);
     double e1[3], e2[3];
@@ -126,11 +156,12 @@ int64_t plane_offset(const LevelMesh& level, uint32_t v, const std::vector<uint3
   std::frexp(top, &exp);
   int64_t N[3];
   for (int a = 0; a < 3; ++a) N[a] = static_cast<int64_t>(std::floor(std::ldexp(n[a], 15 - exp) + 0.5));
-  const uint64_t d = ring.size();
+  const uint64_t d = ring.size() - (open_ring(ring) ? 1 : 0);
   int64_t height = 0;  // N . (q(v) - centroid of the ring)
   for (int a = 0; a < 3; ++a) {
     uint64_t sum = 0;
-    for (uint32_t r : ring) sum += level.q(r)[a];
+    for (uint32_t r : ring)
+      if (r != kGhost) sum += level.q(r)[a];
     const int64_t c = static_cast<int64_t>((sum + d / 2) / d);
     height += N[a] * (int64_t{level.q(v)[a]} - c);
   }
@@ -172,7 +203,7 @@ bool LevelMesh::ring(uint32_t v, std::vector<uint32_t>& ring) const {
   const std::vector<uint32_t>& faces = vf_[v];
   const size_t d = faces.size();
   ring.clear();
-  if (d < 3) return false;
+  if (d == 0) return false;
   // next[i]: the corner after v in face i, to the one after that.
   std::vector<std::pair<uint32_t, uint32_t>> edge(d);
   for (size_t i = 0; i < d; ++i) {
@@ -188,23 +219,34 @@ bool LevelMesh::ring(uint32_t v, std::vector<uint32_t>& ring) const {
 bool ring_from_edges(uint32_t v, std::vector<std::pair<uint32_t, uint32_t>>& edge, std::vector<uint32_t>& ring) {
   ring.clear();
   const size_t d = edge.size();
-  if (d < 3) return false;
+  if (d == 0) return false;
   for (const auto& e : edge)
     if (e.first == v || e.second == v || e.first == e.second) return false;
   std::sort(edge.begin(), edge.end());
   for (size_t i = 1; i < d; ++i)
     if (edge[i].first == edge[i - 1].first) return false;
+  // An open fan starts at the one first corner no edge ends at.
+  std::vector<uint32_t> ends(d);
+  for (size_t i = 0; i < d; ++i) ends[i] = edge[i].second;
+  std::sort(ends.begin(), ends.end());
   uint32_t at = edge[0].first;
+  size_t starts = 0;
+  for (const auto& e : edge)
+    if (!std::binary_search(ends.begin(), ends.end(), e.first) && starts++ == 0) at = e.first;
+  if (starts > 1 || (starts == 0 && d < 3)) return false;
   for (size_t i = 0; i < d; ++i) {
     ring.push_back(at);
     auto it = std::lower_bound(edge.begin(), edge.end(), std::make_pair(at, uint32_t{0}));
     if (it == edge.end() || it->first != at) return false;
     at = it->second;
   }
-  if (at != ring[0]) return false;
+  if (starts == 0 && at != ring[0]) return false;
+  if (starts == 1) ring.push_back(at);
   std::vector<uint32_t> sorted = ring;
   std::sort(sorted.begin(), sorted.end());
-  return std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end();
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
+  if (starts == 1) ring.push_back(kGhost);
+  return true;
 }
 
 bool LevelMesh::adjacent_to_marked(uint32_t v, const std::vector<uint8_t>& marked) const {
@@ -243,17 +285,24 @@ uint32_t LevelMesh::split(uint32_t v, const std::vector<uint32_t>& ring, uint32_
     }
   }
   vf_[v] = std::move(keep);
+  // The two faces around the new edge (v, u), but for the ghost's.
   const uint32_t y = ring[ia], x = ring[(ia + dist) % d];
-  const uint32_t f1 = static_cast<uint32_t>(mesh_->face_count());
-  mesh_->add_triangle(v, u, x);
-  mesh_->add_triangle(v, y, u);
-  for (uint32_t w : {v, u, x}) vf_[w].push_back(f1);
-  for (uint32_t w : {v, y, u}) vf_[w].push_back(f1 + 1);
+  if (x != kGhost) {
+    const uint32_t f = static_cast<uint32_t>(mesh_->face_count());
+    mesh_->add_triangle(v, u, x);
+    for (uint32_t w : {v, u, x}) vf_[w].push_back(f);
+  }
+  if (y != kGhost) {
+    const uint32_t f = static_cast<uint32_t>(mesh_->face_count());
+    mesh_->add_triangle(v, y, u);
+    for (uint32_t w : {v, y, u}) vf_[w].push_back(f);
+  }
   return u;
 }
 
 Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, std::string& stream,
-                    std::vector<uint32_t>& new_ids) {
+                    std::vector<uint32_t>& new_ids, uint64_t& border_splits) {
+  border_splits = 0;
   const size_t n = level.vertex_count();
   std::vector<uint8_t> marked(n, 0);
   std::vector<const VertexSplit*> by_vertex(n, nullptr);
@@ -270,7 +319,7 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
       continue;
     }
     const int b = by_vertex[i] != nullptr;
-    e.bit(m->flag[flag_context(ring.size())], b);
+    e.bit(m->flag[flag_context(ring)], b);
     marked[i] = static_cast<uint8_t>(b);
     ones += static_cast<size_t>(b);
   }
@@ -283,7 +332,7 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     const uint32_t ia = position_in(ring, s.y), ix = position_in(ring, s.x);
     const uint32_t dist = (ix + d - ia) % d;
     if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
-    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    const uint32_t ctx = ring_context(ring);
     m->dist[ctx].encode(e, dist - 1);
     m->start[ctx].encode(e, (ia + dist / 2 + d - farthest(level, v, ring)) % d);
     int64_t p[3];
@@ -293,11 +342,14 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     int order[3];
     ring_normal(level, v, ring, nrm);
     axis_order(nrm, order);
+    const bool border = border_neighbour(ring, ia, dist) != kGhost;
+    SIntModelT<3>* r = border ? m->border[sc] : m->residual[sc];
     const int64_t e1 = int64_t{s.q[order[1]]} - p[order[1]], e2 = int64_t{s.q[order[2]]} - p[order[2]];
-    const int64_t o = plane_offset(level, v, ring, nrm, order, e1, e2, qmax);
-    m->residual[sc][1].encode(e, static_cast<int32_t>(e1));
-    m->residual[sc][2].encode(e, static_cast<int32_t>(e2));
-    m->residual[sc][0].encode(e, static_cast<int32_t>(int64_t{s.q[order[0]]} - p[order[0]] - o));
+    const int64_t o = border ? 0 : plane_offset(level, v, ring, nrm, order, e1, e2, qmax);
+    r[1].encode(e, static_cast<int32_t>(e1));
+    r[2].encode(e, static_cast<int32_t>(e2));
+    r[0].encode(e, static_cast<int32_t>(int64_t{s.q[order[0]]} - p[order[0]] - o));
+    border_splits += border ? 1 : 0;
     ids[v] = level.split(v, ring, ia, dist, s.q);
   }
   for (const VertexSplit& s : splits) new_ids.push_back(ids[s.v]);
@@ -311,13 +363,16 @@ std::string write_batch(const BatchHeader& h, std::string_view stream) {
   w.f32(h.error_before);
   w.f32(h.error_after);
   w.varint(h.splits);
+  w.varint(h.border);
   w.bytes(stream);
   return out;
 }
 
 Status read_batch(std::string_view payload, BatchHeader& h, std::string_view& stream) {
   ByteReader r(payload);
-  if (!r.f32(h.error_before) || !r.f32(h.error_after) || !r.varint(h.splits)) return corrupt("truncated");
+  if (!r.f32(h.error_before) || !r.f32(h.error_after) || !r.varint(h.splits) || !r.varint(h.border))
+    return corrupt("truncated");
+  if (h.border > h.splits) return corrupt("more border splits than splits");
   for (float e : {h.error_before, h.error_after})
     if (!(e >= 0) || !std::isfinite(e)) return corrupt("an error that is not a finite non-negative number");
   r.bytes(r.remaining(), stream);
@@ -336,7 +391,7 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     return corrupt("split count " + std::to_string(splits) + " out of range");
   Mesh& mesh = level.mesh();
   if ((limits.max_vertices && n + splits > limits.max_vertices) ||
-      (limits.max_faces && mesh.face_count() + 2 * splits > limits.max_faces))
+      (limits.max_faces && mesh.face_count() + 2 * splits - bh.border > limits.max_faces))
     return Status(ErrorCode::limit_exceeded, "refinement batch: the mesh would exceed the decoder's limits");
   std::vector<uint8_t> marked(n, 0);
   if (!level.models()) level.models() = std::make_shared<BatchModels>();
@@ -346,18 +401,19 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
   uint64_t ones = 0;
   for (uint32_t i = 0; i < n && ones < splits; ++i) {
     if (level.adjacent_to_marked(i, marked) || !level.ring(i, ring)) continue;
-    const int b = dec.bit(m->flag[flag_context(ring.size())]);
+    const int b = dec.bit(m->flag[flag_context(ring)]);
     marked[i] = static_cast<uint8_t>(b);
     ones += static_cast<uint64_t>(b);
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the split flags");
   }
   if (ones != splits) return corrupt("fewer split flags than the split count");
   const int64_t qmax = (int64_t{1} << level.bits()) - 1;
+  uint64_t border_splits = 0;
   for (uint32_t v = 0; v < n; ++v) {
     if (!marked[v]) continue;
     level.ring(v, ring);
     const uint32_t d = static_cast<uint32_t>(ring.size());
-    const uint32_t ctx = std::min<uint32_t>(d, kRingContexts - 1);
+    const uint32_t ctx = ring_context(ring);
     const uint32_t dist = m->dist[ctx].decode(dec) + 1;
     if (dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
     const uint32_t middle = m->start[ctx].decode(dec);
@@ -370,18 +426,22 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     int order[3];
     ring_normal(level, v, ring, nrm);
     axis_order(nrm, order);
+    const bool border = border_neighbour(ring, ia, dist) != kGhost;
+    SIntModelT<3>* r = border ? m->border[sc] : m->residual[sc];
     uint32_t q[3];
     int64_t e[3] = {0, 0, 0};
     for (int k : {1, 2, 0}) {
-      e[k] = m->residual[sc][k].decode(dec);
-      const int64_t off = k == 0 ? plane_offset(level, v, ring, nrm, order, e[1], e[2], qmax) : 0;
+      e[k] = r[k].decode(dec);
+      const int64_t off = k == 0 && !border ? plane_offset(level, v, ring, nrm, order, e[1], e[2], qmax) : 0;
       const int64_t x = p[order[k]] + off + e[k];
       if (x < 0 || x > qmax) return corrupt("a new vertex off the grid");
       q[order[k]] = static_cast<uint32_t>(x);
     }
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the stream ends inside the splits");
     level.split(v, ring, ia, dist, q);
+    border_splits += border ? 1 : 0;
   }
+  if (border_splits != bh.border) return corrupt("a border split count that differs from the splits'");
   return Status::Ok();
 }
 

@@ -63,22 +63,36 @@ Status ProgressiveHierarchy::build(std::string_view bytes, const DecodeOptions& 
 // with the splits that made the vertices around it then.
 Status ProgressiveHierarchy::add_level(const Mesh& before, const Mesh& after, uint32_t batch, double error_before) {
   const size_t n0 = before.vertex_count(), n1 = after.vertex_count(), f0 = before.face_count();
-  if (n1 <= n0 || after.face_count() != f0 + 2 * (n1 - n0))
+  if (n1 <= n0 || after.face_count() < f0 + (n1 - n0))
     return Status(ErrorCode::internal, "batch " + std::to_string(batch) + ": unexpected vertex or face counts");
   std::vector<uint32_t> split_at(n0, kNone);  // vertex v of `before` -> its split in this batch
   const uint32_t first = split_count();
+  // Each split appended (v, u, x) then (v, y, u), either left out when the
+  // new vertex u lies on v's border (FORMAT.md §4.8).
+  std::vector<size_t> faces_end(n1 - n0);
+  size_t next = f0;
+  auto is_split_face = [&](size_t g, uint32_t v, uint32_t u) {
+    if (g >= after.face_count() || after.face_size(g) != 3) return false;
+    const uint32_t* a = after.face(g);
+    return a[0] == v && (a[1] == u || a[2] == u);
+  };
   for (size_t j = 0; j < n1 - n0; ++j) {
     const uint32_t u = static_cast<uint32_t>(n0 + j);
-    const uint32_t* a = after.face(f0 + 2 * j);
     Split s;
-    s.vertex = a[0];
+    s.vertex = next < after.face_count() ? after.face(next)[0] : kNone;
     s.child = u;
     s.batch = batch;
-    if (after.face_size(f0 + 2 * j) != 3 || a[1] != u || s.vertex >= n0 || split_at[s.vertex] != kNone)
+    if (s.vertex >= n0 || !is_split_face(next, s.vertex, u) || split_at[s.vertex] != kNone)
       return Status(ErrorCode::internal, "batch " + std::to_string(batch) + ": unexpected split faces");
+    const bool first_is_x = after.face(next)[1] == u;
+    ++next;
+    if (first_is_x && is_split_face(next, s.vertex, u) && after.face(next)[2] == u) ++next;
+    faces_end[j] = next;
     split_at[s.vertex] = first + static_cast<uint32_t>(j);
     splits_.push_back(std::move(s));
   }
+  if (next != after.face_count())
+    return Status(ErrorCode::internal, "batch " + std::to_string(batch) + ": unexpected vertex or face counts");
   // The vertices around each split vertex in `before`, as the splits that made them.
   for (size_t f = 0; f < f0; ++f) {
     const uint32_t* c = before.face(f);
@@ -98,7 +112,7 @@ Status ProgressiveHierarchy::add_level(const Mesh& before, const Mesh& after, ui
     deps.erase(std::unique(deps.begin(), deps.end()), deps.end());
     made_by_[splits_[s].child] = s;
     const size_t j = s - first;
-    face_made_by_[f0 + 2 * j] = face_made_by_[f0 + 2 * j + 1] = s;
+    for (size_t g = j == 0 ? f0 : faces_end[j - 1]; g < faces_end[j]; ++g) face_made_by_[g] = s;
   }
   batch_error_.push_back(error_before);
   return Status::Ok();
