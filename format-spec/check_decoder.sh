@@ -209,6 +209,9 @@ fi
 acheck uv_vertex "$work/uv_vertex.ply" 12 6
 acheck uv_vertex_segments "$work/uv_vertex.ply" 12 6 150
 acheck uv_corner "$work/uv_corner.obj" 12 6
+# the same through the points-out route at 10 bits: seams crossed by the
+# walk, predicted across them (§8.12 "Across a seam"), mirrored charts too
+acheck uv_seam_transfer "$work/uv_corner.obj" 10 6
 acheck uv_corner_segments "$work/uv_corner.obj" 12 6 60
 # the fast level: table-coded attribute residuals (§8.12.1) for predictor 2
 # in both domains, and in segments with values shared across borders

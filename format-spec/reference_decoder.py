@@ -1994,6 +1994,7 @@ class AttrModels:
         self.recent_index = UIntModel(2)
         self.sibling_hit = [[UIntModel(2), UIntModel(2)] for _ in range(2)]   # [previous was a hit][> 1 value]
         self.sibling_index = UIntModel(2)
+        self.transfer = UIntModel(2)                     # predictor 2 across a seam: the edge's turn
         self.last_zero = [1, 1, 1, 1]
         self.table = None                                # §8.12.1: (tables, bit reader, first context)
 
@@ -2168,7 +2169,7 @@ def predict_value(walk, item):
                 count += n
             if count > 0:
                 return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
-            return list(walk.prev), 0
+            return seam_transfer(walk, r, v)
         return list(walk.prev), 0
     if item[0] == 'corner' and h.quant == 2:
         r = walk.rank[item[2]]
@@ -2196,12 +2197,54 @@ def predict_value(walk, item):
     return list(walk.prev), 0
 
 
+def first_known_corner(walk, v, r, at=None):
+    """§8.12 "Across a seam": the own rank of the first corner of v's faces
+    (faces-around order, positions in order) decoded before rank r and, with
+    `at`, at that grid position; NONE if none."""
+    for f, _ in walk.around[v]:
+        for c in walk.faces[f]:
+            rc = walk.rank[c]
+            if rc != NONE and rc < r and (at is None or tuple(walk.q[rc]) == at):
+                return rc
+    return NONE
+
+
+def seam_transfer(walk, r, v):
+    """§8.12 "Across a seam": predictor 2 without a placement in the vertex
+    domain. Sets walk.transfer to (base, edge) when a transfer is found."""
+    ra = first_known_corner(walk, v, r)
+    if ra == NONE:
+        return list(walk.prev), 0
+    base = walk.values[ra]
+    s, seen = walk.earlier[r], 0
+    while s != NONE and seen < 32:
+        rb = first_known_corner(walk, walk.own_vertex[s], r, tuple(walk.q[ra]))
+        if rb != NONE:
+            walk.transfer = (base, [walk.values[s][c] - walk.values[rb][c] for c in range(2)])
+            return list(base), 1
+        s, seen = walk.earlier[s], seen + 1
+    return list(base), 0
+
+
+def turned(edge, k):
+    x, y = edge
+    return [(x, y), (-x, y), (x, -y), (-x, -y), (-y, x), (y, -x), (y, x), (-y, -x)][k]
+
+
 def decode_value(d, m, walk, item, segmented=False):
     """One value: per integer c a residual from res[cls][c][previous residual of c
     was 0]. A new corner value of a segment first says whether it stands for an
     earlier segment's value (and which)."""
     h = walk.h
+    walk.transfer = None
     pred, cls = predict_value(walk, item)
+    if walk.transfer is not None:                            # across a seam: the edge's turn
+        k = m.transfer.decode(d)
+        if k >= 8:
+            reject('attributes: vertex values of %r out of range' % h.name)
+        base, edge = walk.transfer
+        top = (1 << h.bits) - 1
+        pred = [min(max(base[c] + e, 0), top) for c, e in enumerate(turned(edge, k))]
     if segmented:
         g = m.imported[1 if walk.rank[item[2]] == NONE else 0].decode(d)
         if g > 1:
@@ -2342,6 +2385,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                 key = tuple(q[r])
                 earlier[r] = last_at.get(key, NONE)
                 last_at[key] = r
+            walk.earlier, walk.own_vertex = earlier, own_vertex
             for r in range(own):
                 if h.siblings and earlier[r] != NONE:        # one of the siblings' values
                     distinct, s, seen = [], earlier[r], 0

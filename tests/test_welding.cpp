@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 
 #include "mesh_gen.hpp"
@@ -493,4 +494,84 @@ TEST(IndexedCorners, ThroughPlyTheSameBytes) {
     ASSERT_TRUE(encode(read, EncodeOptions(), again).ok());
     EXPECT_TRUE(again == bytes) << name << ": " << again.size() << " vs " << bytes.size();
   }
+}
+
+namespace {
+
+// icosphere(3) in small texture charts, `sectors` by longitude times
+// `bands` by height (each face in its centroid's chart), as an OBJ with a vt
+// list: a vertex on a chart border has one value per chart. Chart (s, b)
+// maps a point to its centre plus (0.06 t, 0.4 z) turned by `turn`
+// (radians), t the point's coordinate along the sector's tangent; on the
+// odd charts (s + b odd) t changes sign with `mirror_odd` (each chart the
+// mirror image of its neighbours, as a texture atlas lays out a model's
+// halves) and the chart turns by `turn_odd` more.
+Mesh sector_charts_sphere(int sectors, int bands, double turn, bool mirror_odd, double turn_odd) {
+  Mesh m = icosphere(3);
+  Attribute t;
+  t.name = "texcoord";
+  t.kind = AttributeKind::texcoord;
+  t.domain = AttributeDomain::corner;
+  t.type = AttributeType::f32;
+  t.components = 2;
+  std::map<std::pair<uint32_t, int>, uint32_t> id;
+  const double pi = 3.14159265358979;
+  for (uint32_t f = 0; f < m.face_count(); ++f) {
+    double c[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) c[a] += m.positions[3 * size_t{m.face(f)[k]} + a];
+    const int s = static_cast<int>(std::floor((std::atan2(c[1], c[0]) + pi) / (2 * pi) * sectors)) % sectors;
+    const int band = std::min(bands - 1, static_cast<int>(std::floor((c[2] / 3 + 1) / 2 * bands)));
+    const int chart = s * bands + band;
+    const bool odd = (s + band) % 2 != 0;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = m.face(f)[k];
+      auto it = id.emplace(std::make_pair(v, chart), static_cast<uint32_t>(t.value_count()));
+      if (it.second) {
+        const double phi = (s + 0.5) / sectors * 2 * pi - pi;
+        const float* p = &m.positions[3 * size_t{v}];
+        const double x = (odd && mirror_odd ? -0.06 : 0.06) * (-std::sin(phi) * p[0] + std::cos(phi) * p[1]);
+        const double y = 0.4 * p[2], a = turn + (odd ? turn_odd : 0.0);
+        const double du = std::cos(a) * x - std::sin(a) * y, dv = std::sin(a) * x + std::cos(a) * y;
+        t.values.push_back(static_cast<float>(0.1 + 0.8 * s / sectors + du));
+        t.values.push_back(static_cast<float>(0.5 + 0.2 * band + dv));
+      }
+      t.indices.push_back(it.first->second);
+    }
+  }
+  m.attributes = {t};
+  return m;
+}
+
+}  // namespace
+
+// FORMAT.md §8.12 "Across a seam": where the walk crosses into another
+// texture chart, the first new vertex of a face is placed by the other
+// side's edge, turned or mirrored as one of eight turns says. Many small
+// charts, mirror images of their neighbours or turned by 60 degrees against
+// them (the edge's turns then miss): exact by the oracle, canonical; every
+// byte flipped in turn is refused or gives a valid mesh.
+TEST(IndexedCorners, SeamsCrossedByTheEdgeOfTheOtherSide) {
+  const double degree = 3.14159265358979 / 180;
+  const Mesh mirrored = sector_charts_sphere(16, 6, 15 * degree, true, 0.0);
+  const Mesh turned = sector_charts_sphere(16, 6, 15 * degree, false, 60 * degree);
+  ASSERT_TRUE(mirrored.valid());
+  ASSERT_GT(mirrored.attributes[0].value_count(), mirrored.vertex_count() + 200) << "the charts have seams";
+  const std::string bytes = expect_exact(mirrored, "mirrored charts");
+  EXPECT_GT(coded_vertices(bytes), mirrored.vertex_count()) << "coded as split vertices";
+  expect_exact(turned, "turned charts");
+  int refused = 0;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    std::string bad = bytes;
+    bad[i] = static_cast<char>(bad[i] ^ 0x5A);
+    Mesh out;
+    const Status s = decode(bad, out);
+    if (!s.ok()) {
+      EXPECT_FALSE(s.message().empty());
+      ++refused;
+    } else {
+      EXPECT_TRUE(out.valid());
+    }
+  }
+  EXPECT_GT(refused, 0);
 }

@@ -163,6 +163,7 @@ struct Models {
   UIntModel recent_index;   // which, most recent first
   UIntModel sibling_hit[2][2];  // [the previous was a hit][more than one wedge value]: an earlier sibling's value
   UIntModel sibling_index;      // which of the siblings' distinct values, latest first
+  UIntModel transfer;           // predictor 2, across a seam: which turn or mirror of the edge
 };
 
 // Residual coding of one value against a prediction; contexts: the
@@ -537,6 +538,35 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
 
 // The walk shared by the encoder (Coder = Enc, values known) and the decoder
 // (Coder = Dec): vertex, face and corner values of one attribute.
+// Predictor 2 without a placement (FORMAT.md §8.12, "Across a seam"): the
+// value of a known corner of the vertex's faces (`base`) and, when an
+// earlier vertex at the same position has a neighbour at that corner's
+// position, the texture edge between those two (`edge`): the same edge on
+// the other side of the seam, turned or mirrored as a chart of a texture
+// atlas is (kTurns of them, named by the `transfer` model).
+struct SeamTransfer {
+  bool have = false;
+  int32_t base[2] = {0, 0};
+  int32_t edge[2] = {0, 0};
+};
+constexpr uint32_t kTurns = 8;
+
+// The edge turned or mirrored as turn `k` says: identity, mirror in u, in
+// v, half turn, quarter turns, the diagonals' mirrors.
+void turned_edge(const int32_t* e, uint32_t k, int64_t* out) {
+  const int64_t x = e[0], y = e[1];
+  const int64_t t[kTurns][2] = {{x, y}, {-x, y}, {x, -y}, {-x, -y}, {-y, x}, {y, -x}, {y, x}, {-y, -x}};
+  out[0] = t[k][0];
+  out[1] = t[k][1];
+}
+
+void transfer_prediction(const SeamTransfer& t, uint32_t k, int bits, int32_t* pred) {
+  int64_t e[2];
+  turned_edge(t.edge, k, e);
+  const int64_t top = (int64_t{1} << bits) - 1;
+  for (int c = 0; c < 2; ++c) pred[c] = static_cast<int32_t>(std::clamp<int64_t>(t.base[c] + e[c], 0, top));
+}
+
 template <class Coder>
 struct AttributeWalk {
   const AttributeHeader& h;
@@ -624,7 +654,10 @@ struct AttributeWalk {
     std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
     uint32_t hit_before = 0, sibling_before = 0;
     std::vector<uint32_t> earlier;  // per own rank: the previous own vertex at its grid position, or kNone
-    if (siblings) earlier_at_same_position(earlier);
+    if (siblings || predictor == 2) earlier_at_same_position(earlier);
+    std::vector<uint32_t> vertex_of;  // per own rank: its part vertex
+    for (uint32_t v = 0; v < rank.size(); ++v)
+      if (rank[v] != kNone) vertex_of.push_back(v);
     for (size_t v = 0; v < rank.size(); ++v) {
       const uint32_t r = rank[v];
       if (r == kNone) continue;
@@ -666,16 +699,84 @@ struct AttributeWalk {
         }
         cls = placed(sum, count, pred);
       }
+      SeamTransfer transfer;
+      if (predictor == 2 && cls == 0) {
+        seam_transfer(v, r, earlier, vertex_of, x, pred, transfer);
+        if (transfer.have) cls = 1;
+      }
       int32_t* xv = &x[n * static_cast<size_t>(r)];
       if (!recent) {
-        if (!vc.value(h, pred, xv, cls)) return false;
-      } else if (!recent_value(list, hit_before, pred, cls, xv)) {
+        if (!transferred_value(transfer, pred, cls, xv)) return false;
+      } else if (!recent_value(list, hit_before, pred, cls, transfer, xv)) {
         return false;
       }
       std::copy(xv, xv + n, prev);
       if (predictor == 2) update_sigma(v, r, sigma, uv, x);
     }
     return true;
+  }
+  // Predictor 2 where no triangle places vertex v (own rank r): the value
+  // of the first corner of its faces (faces-around order, positions in
+  // order) decoded before it becomes the prediction, and the transfer's
+  // edge is looked for: along the chain of earlier vertices at v's position
+  // (latest first, at most kSiblingVertices), the first corner decoded
+  // before v of their faces (same order) at that corner's position.
+  void seam_transfer(size_t v, uint32_t r, const std::vector<uint32_t>& earlier,
+                     const std::vector<uint32_t>& vertex_of, const std::vector<int32_t>& x, int32_t* pred,
+                     SeamTransfer& t) const {
+    const uint32_t ra = first_known_corner(v, r, nullptr);
+    if (ra == kNone) return;
+    std::copy_n(&x[2 * size_t{ra}], 2, pred);
+    std::copy_n(&x[2 * size_t{ra}], 2, t.base);
+    if (earlier.empty()) return;
+    uint32_t seen = 0;
+    for (uint32_t s = earlier[r]; s != kNone && seen < kSiblingVertices; s = earlier[s], ++seen) {
+      const uint32_t rb = first_known_corner(vertex_of[s], r, &(*q)[3 * size_t{ra}]);
+      if (rb == kNone) continue;
+      t.have = true;
+      for (int c = 0; c < 2; ++c) t.edge[c] = x[2 * size_t{s} + c] - x[2 * size_t{rb} + c];
+      return;
+    }
+  }
+  // The own rank of the first corner of vertex v's faces (faces-around
+  // order, positions in order) decoded before rank r and, with `at`, at
+  // that grid position; kNone if none.
+  uint32_t first_known_corner(size_t v, uint32_t r, const uint32_t* at) const {
+    for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f);
+      const uint32_t* c = faces.face(f);
+      for (uint32_t i = 0; i < k; ++i) {
+        const uint32_t rc = rank[c[i]];
+        if (rc == kNone || rc >= r) continue;
+        if (!at || std::equal(at, at + 3, &(*q)[3 * size_t{rc}])) return rc;
+      }
+    }
+    return kNone;
+  }
+  // A value coded against `pred`, or with a seam transfer first the turn
+  // (the encoder's: the smallest larger residual, then the smallest sum,
+  // then the first) that makes the prediction.
+  bool transferred_value(const SeamTransfer& t, int32_t* pred, int cls, int32_t* xv) {
+    if (t.have) {
+      uint32_t k = 0;
+      if constexpr (Coder::kEncoder) {
+        int64_t best[2] = {INT64_MAX, INT64_MAX};
+        for (uint32_t j = 0; j < kTurns; ++j) {
+          int32_t p[2];
+          transfer_prediction(t, j, h.bits, p);
+          const int64_t d0 = std::abs(int64_t{xv[0]} - p[0]), d1 = std::abs(int64_t{xv[1]} - p[1]);
+          const int64_t cost[2] = {std::max(d0, d1), d0 + d1};
+          if (std::lexicographical_compare(cost, cost + 2, best, best + 2)) {
+            std::copy_n(cost, 2, best);
+            k = j;
+          }
+        }
+      }
+      k = io.uint(vc.m.transfer, k);
+      if (k >= kTurns) return false;
+      transfer_prediction(t, k, h.bits, pred);
+    }
+    return vc.value(h, pred, xv, cls);
   }
   // Faces completed by vertex v (own rank r) give the chart's orientation.
   void update_sigma(size_t v, uint32_t r, int& sigma, std::vector<const int32_t*>& uv,
@@ -765,8 +866,8 @@ struct AttributeWalk {
   }
   // One vertex value with the recent values: a hit (and which) or the value
   // coded against `pred`; then the value moves to the front of `list`.
-  bool recent_value(std::vector<std::array<int32_t, 4>>& list, uint32_t& hit_before, const int32_t* pred, int cls,
-                    int32_t* xv) {
+  bool recent_value(std::vector<std::array<int32_t, 4>>& list, uint32_t& hit_before, int32_t* pred, int cls,
+                    const SeamTransfer& transfer, int32_t* xv) {
     const uint32_t n = int_components(h);
     size_t at = list.size();  // the value's place in the list, if there
     uint32_t hit = 0, j = 0;
@@ -785,7 +886,7 @@ struct AttributeWalk {
       std::copy(list[j].begin(), list[j].begin() + n, xv);
       at = j;
     } else {
-      if (!vc.value(h, pred, xv, cls)) return false;
+      if (!transferred_value(transfer, pred, cls, xv)) return false;
       if constexpr (!Coder::kEncoder) at = find_recent(list, xv, n);
     }
     hit_before = hit;

@@ -1135,6 +1135,77 @@ std::string rank_stream(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
   return any ? e.finish() : std::string();
 }
 
+// The mesh in an order of its own, the same for any ordering of it (a
+// decoded file's included, up to vertices and values equal on the grid):
+// vertices by grid position, each face turned to start at its smallest
+// corner, faces by their corners' positions and corner values. The split
+// route is kept or not by its size, and a decoded file must make the same
+// choice as its input (canonical re-encoding). `perm`: per vertex of the
+// result its input vertex.
+Mesh in_own_order(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<AttributeHeader>& headers,
+                  std::vector<uint32_t>& perm) {
+  const uint32_t V = static_cast<uint32_t>(mesh.vertex_count());
+  perm.resize(V);
+  std::iota(perm.begin(), perm.end(), 0u);
+  auto grid = [&](uint32_t v) {
+    return std::array<uint32_t, 3>{qin[3 * size_t{v}], qin[3 * size_t{v} + 1], qin[3 * size_t{v} + 2]};
+  };
+  std::stable_sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) { return grid(a) < grid(b); });
+  std::vector<uint32_t> at(V);
+  for (uint32_t i = 0; i < V; ++i) at[perm[i]] = i;
+  // Per corner: its vertex's new id and its values' grid integers.
+  const size_t K = mesh.indices.size();
+  std::vector<std::vector<int32_t>> key(K);
+  for (size_t k = 0; k < K; ++k) {
+    key[k].push_back(static_cast<int32_t>(at[mesh.indices[k]]));
+    for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+      const Attribute& a = mesh.attributes[i];
+      if (a.domain != AttributeDomain::corner) continue;
+      std::vector<int32_t> x(attribute_key_size(headers[i]));
+      attribute_key(headers[i], &a.values[size_t{a.components} * a.indices[k]], x.data());
+      key[k].insert(key[k].end(), x.begin(), x.end());
+    }
+  }
+  const uint32_t F = static_cast<uint32_t>(mesh.face_count());
+  std::vector<uint32_t> first(F), order(F);
+  for (uint32_t f = 0; f < F; ++f) {
+    const uint32_t o = mesh.face_offsets[f], n = mesh.face_size(f);
+    for (uint32_t j = 1; j < n; ++j)
+      if (key[o + j] < key[o + first[f]]) first[f] = j;
+  }
+  auto corners = [&](uint32_t f) {
+    std::vector<std::vector<int32_t>> c;
+    const uint32_t o = mesh.face_offsets[f], n = mesh.face_size(f);
+    for (uint32_t j = 0; j < n; ++j) c.push_back(key[o + (first[f] + j) % n]);
+    return c;
+  };
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return corners(a) < corners(b); });
+  Mesh out = mesh;
+  for (uint32_t i = 0; i < V; ++i) std::copy_n(&mesh.positions[3 * size_t{perm[i]}], 3, &out.positions[3 * size_t{i}]);
+  std::vector<uint32_t> from(K);  // per new corner, its input corner
+  out.face_offsets.assign(1, 0);
+  for (uint32_t f : order) {
+    const uint32_t o = mesh.face_offsets[f], n = mesh.face_size(f);
+    for (uint32_t j = 0; j < n; ++j) from[out.face_offsets.back() + j] = o + (first[f] + j) % n;
+    out.face_offsets.push_back(out.face_offsets.back() + n);
+  }
+  for (size_t k = 0; k < K; ++k) out.indices[k] = at[mesh.indices[from[k]]];
+  for (size_t i = 0; i < mesh.attributes.size(); ++i) {
+    const Attribute& a = mesh.attributes[i];
+    Attribute& b = out.attributes[i];
+    const size_t c = a.components;
+    if (a.domain == AttributeDomain::vertex) {
+      for (uint32_t v = 0; v < V; ++v) std::copy_n(&a.values[c * perm[v]], c, &b.values[c * v]);
+    } else if (a.domain == AttributeDomain::face) {
+      for (uint32_t f = 0; f < F; ++f) std::copy_n(&a.values[c * order[f]], c, &b.values[c * f]);
+    } else {
+      for (size_t k = 0; k < K; ++k) b.indices[k] = a.indices[from[k]];
+    }
+  }
+  return out;
+}
+
 // FORMAT.md §8.13, points out: a mesh whose corner attributes are index
 // lists (OBJ vt/vn, PLY per-corner lists) coded as the split vertices a
 // glTF exporter would make, through the welded path, with the ranks that
@@ -1142,9 +1213,13 @@ std::string rank_stream(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
 // their grid; the decoder gives back one vertex per (point, rank) and the
 // value lists. `vertex_from`: per output vertex, its input vertex. `done`
 // is false when nothing was coded.
-Status encode_split_route(const Mesh& mesh, const std::vector<uint32_t>& qin, const EncodeOptions& options,
+Status encode_split_route(const Mesh& input, const std::vector<uint32_t>& qinput, const EncodeOptions& options,
                           EncodedPart& out, std::vector<uint32_t>& vertex_from, uint64_t& split_count, bool& done) {
   done = false;
+  std::vector<uint32_t> perm;
+  const Mesh mesh = in_own_order(input, qinput, attribute_headers(input, options.attribute_bits), perm);
+  std::vector<uint32_t> qin(qinput.size());
+  for (size_t v = 0; v < perm.size(); ++v) std::copy_n(&qinput[3 * size_t{perm[v]}], 3, &qin[3 * v]);
   std::vector<uint32_t> first;
   const Mesh s = split_vertices(mesh, first);
   if (s.vertex_count() == mesh.vertex_count()) return Status::Ok();
@@ -1160,6 +1235,7 @@ Status encode_split_route(const Mesh& mesh, const std::vector<uint32_t>& qin, co
   const std::vector<uint32_t> point_rank = point_ranks(mesh, qin, split_input, vertex_from);
   if (vertex_from.size() != mesh.vertex_count())
     return Status(ErrorCode::internal, "the split route's points do not map to the input's vertices");
+  for (uint32_t& v : vertex_from) v = perm[v];
   const std::string ranks =
       rank_stream(mesh, qin, out.vertex_from, first, point_rank, attribute_headers(mesh, options.attribute_bits),
                   per_vertex_corner_attributes(s));
