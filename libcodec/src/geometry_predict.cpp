@@ -1100,10 +1100,16 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   const std::vector<uint32_t>& vs = order->vertices;
   const uint32_t nv = static_cast<uint32_t>(vs.size());
   if (order != &own) sc.walks = &order->walks;  // the encoder's passes share them
-  for (uint32_t i = 0; i < nv; ++i) {
-    if (!sc.code(first_he[vs[i]], true)) return false;
-    if ((i & 4095) == 0 && s.truncated()) return false;
-  }
+  // (As code_march_order: without a lattice, tangent step, spread contexts
+  // or mixing, their branches compiled out.)
+  auto walk = [&](auto plain) {
+    for (uint32_t i = 0; i < nv; ++i) {
+      if (!sc.template code<decltype(plain)::value>(first_he[vs[i]], true)) return false;
+      if ((i & 4095) == 0 && s.truncated()) return false;
+    }
+    return true;
+  };
+  if (!(c.plain() ? walk(std::true_type{}) : walk(std::false_type{}))) return false;
   if (sc.walks) sc.walks->ready = true;
   return sc.isolated();
 }
