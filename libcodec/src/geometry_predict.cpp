@@ -1081,6 +1081,14 @@ struct GreedyOrder {
   std::vector<uint32_t> vertices;
   bool found = false;
   FanWalks walks;  // what the first pass's walks found (SurfaceCoder::code)
+  // The coordinates the encoder's passes code: each pass writes back the
+  // values it reads (prediction plus residual, or the plane coded), so
+  // one copy of q serves them all.
+  std::vector<uint32_t> coords;
+  std::vector<uint32_t>& work(const std::vector<uint32_t>& q) {
+    if (coords.empty()) coords = q;
+    return coords;
+  }
 };
 
 // Codes the vertices in greedy order (order: the encoder's, found on the
@@ -1099,7 +1107,10 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   }
   const std::vector<uint32_t>& vs = order->vertices;
   const uint32_t nv = static_cast<uint32_t>(vs.size());
-  if (order != &own) sc.walks = &order->walks;  // the encoder's passes share them
+  if (order != &own) {  // the encoder's passes share them
+    sc.walks = &order->walks;
+    if (!sc.walks->ready) sc.walks->fans.reserve(nv);
+  }
   // (As code_march_order: without a lattice, tangent step, spread contexts
   // or mixing, their branches compiled out.)
   auto walk = [&](auto plain) {
@@ -1332,7 +1343,8 @@ void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predi
                   GreedyOrder* order) {
   fit.collect = true;
   CollectSink cs;
-  std::vector<uint32_t> work = q;
+  std::vector<uint32_t> own;
+  std::vector<uint32_t>& work = order ? order->work(q) : (own = q);
   if (greedy_order(pred))
     code_greedy(g, fit, cs, work, order);
   else
@@ -1485,7 +1497,8 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
     c.planes_from_top = top;
     code_lattice(s, c);
     c.build_nearest();
-    std::vector<uint32_t> work = q;
+    std::vector<uint32_t> own;
+    std::vector<uint32_t>& work = order ? order->work(q) : (own = q);
     if (pred == Predictor::ancestors)
       code_ancestors(g, K, lambda, c, s, work);
     else if (greedy_order(pred))
