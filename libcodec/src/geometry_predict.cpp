@@ -385,9 +385,10 @@ struct Coder {
         size_t jx = 0;
         int on = 0;
         if constexpr (Sink::kEncoder) {
-          auto it = std::lower_bound(L.begin(), L.end(), x);
-          on = it != L.end() && *it == x;
-          jx = static_cast<size_t>(it - L.begin());
+          // A value on a plane is nearest that plane (the table, when built,
+          // saves the search).
+          jx = nearest_plane(a, x);
+          on = L[jx] == x;
         }
         LatticeModels& lm = lat();
         on = s.bit(lm.on[a][on_count], on);
