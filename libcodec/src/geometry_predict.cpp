@@ -39,7 +39,8 @@
 #include <memory>
 #include <new>
 #include <type_traits>
-#ifdef __SSE2__
+#if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
+#define TSM_FIT_SSE2 1
 #include <emmintrin.h>
 #endif
 
@@ -1244,10 +1245,10 @@ namespace {
 
 // fit_alpha's sums of log2(1 + |residual|), one per weight a16 = 0 ..
 // kLanes - 1 (the last 3 unused: 4 lanes a step), each added in sample
-// order. With SSE2, 4 residuals and 2 sums a step.
+// order. With SSE2 (x86 GCC or Clang), 4 residuals and 2 sums a step.
 struct AlphaCosts {
   static constexpr int kLanes = 28;
-#ifdef __SSE2__
+#ifdef TSM_FIT_SSE2
   __m128d acc[kLanes / 2];
   AlphaCosts() {
     for (__m128d& x : acc) x = _mm_setzero_pd();
@@ -1268,6 +1269,9 @@ struct AlphaCosts {
       _mm_store_si128(reinterpret_cast<__m128i*>(index + k), _mm_sub_epi32(_mm_xor_si128(r, sign), sign));
       t = _mm_add_epi32(t, step);
     }
+    // The indices are read back from memory (one load each) rather than
+    // taken out of the vector registers lane by lane (three instructions).
+    __asm__ volatile("" : : "r"(index) : "memory");
 #pragma GCC unroll 14
     for (int j = 0; j < kLanes / 2; ++j) {
       const __m128d v = _mm_loadh_pd(_mm_load_sd(table + index[2 * j]), table + index[2 * j + 1]);
@@ -1278,13 +1282,14 @@ struct AlphaCosts {
     for (int j = 0; j < kLanes / 2; ++j) _mm_storeu_pd(cost + 2 * j, acc[j]);
   }
 #else
+  static constexpr int kUsed = 25;  // without SIMD, only the weights fit_alpha reads
   double acc[kLanes] = {};
   void add(const double* term) {
-    for (int a = 0; a < kLanes; ++a) acc[a] += term[a];
+    for (int a = 0; a < kUsed; ++a) acc[a] += term[a];
   }
   void add_small(const double* table, int32_t d, int32_t y) {
     int32_t t = 8;
-    for (int a = 0; a < kLanes; ++a, t += d) {
+    for (int a = 0; a < kUsed; ++a, t += d) {
       const int32_t r = y - (t >> 4);
       acc[a] += table[r < 0 ? -r : r];
     }
