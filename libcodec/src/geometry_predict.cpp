@@ -39,6 +39,10 @@
 #include <memory>
 #include <new>
 #include <type_traits>
+#if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
+#define TSM_FIT_SSE2 1
+#include <emmintrin.h>
+#endif
 
 #include "byte_io.hpp"
 #include "connectivity.hpp"
@@ -382,9 +386,10 @@ struct Coder {
         size_t jx = 0;
         int on = 0;
         if constexpr (Sink::kEncoder) {
-          auto it = std::lower_bound(L.begin(), L.end(), x);
-          on = it != L.end() && *it == x;
-          jx = static_cast<size_t>(it - L.begin());
+          // A value on a plane is nearest that plane (the table, when built,
+          // saves the search).
+          jx = nearest_plane(a, x);
+          on = L[jx] == x;
         }
         LatticeModels& lm = lat();
         on = s.bit(lm.on[a][on_count], on);
@@ -1078,6 +1083,14 @@ struct GreedyOrder {
   std::vector<uint32_t> vertices;
   bool found = false;
   FanWalks walks;  // what the first pass's walks found (SurfaceCoder::code)
+  // The coordinates the encoder's passes code: each pass writes back the
+  // values it reads (prediction plus residual, or the plane coded), so
+  // one copy of q serves them all.
+  std::vector<uint32_t> coords;
+  std::vector<uint32_t>& work(const std::vector<uint32_t>& q) {
+    if (coords.empty()) coords = q;
+    return coords;
+  }
 };
 
 // Codes the vertices in greedy order (order: the encoder's, found on the
@@ -1096,11 +1109,20 @@ bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_
   }
   const std::vector<uint32_t>& vs = order->vertices;
   const uint32_t nv = static_cast<uint32_t>(vs.size());
-  if (order != &own) sc.walks = &order->walks;  // the encoder's passes share them
-  for (uint32_t i = 0; i < nv; ++i) {
-    if (!sc.code(first_he[vs[i]], true)) return false;
-    if ((i & 4095) == 0 && s.truncated()) return false;
+  if (order != &own) {  // the encoder's passes share them
+    sc.walks = &order->walks;
+    if (!sc.walks->ready) sc.walks->fans.reserve(nv);
   }
+  // (As code_march_order: without a lattice, tangent step, spread contexts
+  // or mixing, their branches compiled out.)
+  auto walk = [&](auto plain) {
+    for (uint32_t i = 0; i < nv; ++i) {
+      if (!sc.template code<decltype(plain)::value>(first_he[vs[i]], true)) return false;
+      if ((i & 4095) == 0 && s.truncated()) return false;
+    }
+    return true;
+  };
+  if (!(c.plain() ? walk(std::true_type{}) : walk(std::false_type{}))) return false;
   if (sc.walks) sc.walks->ready = true;
   return sc.isolated();
 }
@@ -1219,6 +1241,65 @@ bool top_pays(const Lattice& lattice, int bits, uint32_t vertex_count) {
 
 }  // namespace
 
+namespace {
+
+// fit_alpha's sums of log2(1 + |residual|), one per weight a16 = 0 ..
+// kLanes - 1 (the last 3 unused: 4 lanes a step), each added in sample
+// order. With SSE2 (x86 GCC or Clang), 4 residuals and 2 sums a step.
+struct AlphaCosts {
+  static constexpr int kLanes = 28;
+#ifdef TSM_FIT_SSE2
+  __m128d acc[kLanes / 2];
+  AlphaCosts() {
+    for (__m128d& x : acc) x = _mm_setzero_pd();
+  }
+  void add(const double* term) {
+    for (int j = 0; j < kLanes / 2; ++j) acc[j] = _mm_add_pd(acc[j], _mm_loadu_pd(term + 2 * j));
+  }
+  // A sample whose residuals |y - floor((a16 d + 8) / 16)| are all below
+  // the table's end (so |d| < 2^13: 32 bits hold a16 d).
+  void add_small(const double* table, int32_t d, int32_t y) {
+    alignas(16) int32_t index[kLanes];
+    __m128i t = _mm_setr_epi32(8, 8 + d, 8 + 2 * d, 8 + 3 * d);
+    const __m128i step = _mm_set1_epi32(4 * d), yv = _mm_set1_epi32(y);
+#pragma GCC unroll 7
+    for (int k = 0; k < kLanes; k += 4) {
+      const __m128i r = _mm_sub_epi32(yv, _mm_srai_epi32(t, 4));
+      const __m128i sign = _mm_srai_epi32(r, 31);
+      _mm_store_si128(reinterpret_cast<__m128i*>(index + k), _mm_sub_epi32(_mm_xor_si128(r, sign), sign));
+      t = _mm_add_epi32(t, step);
+    }
+    // The indices are read back from memory (one load each) rather than
+    // taken out of the vector registers lane by lane (three instructions).
+    __asm__ volatile("" : : "r"(index) : "memory");
+#pragma GCC unroll 14
+    for (int j = 0; j < kLanes / 2; ++j) {
+      const __m128d v = _mm_loadh_pd(_mm_load_sd(table + index[2 * j]), table + index[2 * j + 1]);
+      acc[j] = _mm_add_pd(acc[j], v);
+    }
+  }
+  void get(double* cost) const {
+    for (int j = 0; j < kLanes / 2; ++j) _mm_storeu_pd(cost + 2 * j, acc[j]);
+  }
+#else
+  static constexpr int kUsed = 25;  // without SIMD, only the weights fit_alpha reads
+  double acc[kLanes] = {};
+  void add(const double* term) {
+    for (int a = 0; a < kUsed; ++a) acc[a] += term[a];
+  }
+  void add_small(const double* table, int32_t d, int32_t y) {
+    int32_t t = 8;
+    for (int a = 0; a < kUsed; ++a, t += d) {
+      const int32_t r = y - (t >> 4);
+      acc[a] += table[r < 0 ? -r : r];
+    }
+  }
+  void get(double* cost) const { std::copy(acc, acc + kLanes, cost); }
+#endif
+};
+
+}  // namespace
+
 // The weight (of 16ths, 0 .. 1.5) that minimizes an estimate of the coded
 // size, sum log2(1 + |residual|), over a sample of the coordinates.
 int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
@@ -1232,17 +1313,30 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
   const size_t stride = std::max<size_t>(1, samples.size() / 200000);
   // Every weight's cost in one pass over the samples (each sum still adds
   // its terms in sample order, so the costs are those of a pass per weight).
+  // The weight's residual y - floor((a16 d + 8) / 16) (alpha d rounded at
+  // 4.12, alpha = a16 / 16) is monotone in a16: when it is inside the
+  // table at a16 = 0 and at the last lane it is at every lane, and those
+  // samples (nearly all) go through fast_terms.
   constexpr int kWeights = 25;  // a16 = 0 .. 24
-  double cost[kWeights] = {};
+  constexpr int64_t kTable = 4096;
+  AlphaCosts costs;
   for (size_t i = 0; i < samples.size(); i += stride) {
     const int64_t d = samples[i].first, y = samples[i].second;
-    for (int a16 = 0; a16 < kWeights; ++a16) {
-      const int64_t alpha = int64_t{a16} << (kAlphaShift - 4);
-      const int64_t r = y - floor_shift(alpha * d + (int64_t{1} << (kAlphaShift - 1)), kAlphaShift);
-      const int64_t m = r < 0 ? -r : r;
-      cost[a16] += m < 4096 ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
+    const int64_t r_last = y - floor_shift((AlphaCosts::kLanes - 1) * d + 8, 4);
+    if (y > -kTable && y < kTable && r_last > -kTable && r_last < kTable) {
+      costs.add_small(small_log.data(), static_cast<int32_t>(d), static_cast<int32_t>(y));
+      continue;
     }
+    double term[AlphaCosts::kLanes];
+    for (int a16 = 0; a16 < AlphaCosts::kLanes; ++a16) {
+      const int64_t r = y - floor_shift(a16 * d + 8, 4);
+      const int64_t m = r < 0 ? -r : r;
+      term[a16] = m < kTable ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
+    }
+    costs.add(term);
   }
+  double cost[AlphaCosts::kLanes];
+  costs.get(cost);
   int best = 0;
   for (int a16 = 1; a16 < kWeights; ++a16)
     if (cost[a16] < cost[best]) best = a16;
@@ -1255,7 +1349,8 @@ void collect_pass(const GeometryLayout& g, const std::vector<uint32_t>& q, Predi
                   GreedyOrder* order) {
   fit.collect = true;
   CollectSink cs;
-  std::vector<uint32_t> work = q;
+  std::vector<uint32_t> own;
+  std::vector<uint32_t>& work = order ? order->work(q) : (own = q);
   if (greedy_order(pred))
     code_greedy(g, fit, cs, work, order);
   else
@@ -1408,7 +1503,8 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
     c.planes_from_top = top;
     code_lattice(s, c);
     c.build_nearest();
-    std::vector<uint32_t> work = q;
+    std::vector<uint32_t> own;
+    std::vector<uint32_t>& work = order ? order->work(q) : (own = q);
     if (pred == Predictor::ancestors)
       code_ancestors(g, K, lambda, c, s, work);
     else if (greedy_order(pred))

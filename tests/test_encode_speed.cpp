@@ -1,0 +1,92 @@
+// The encoder's faster steps keep its choices: fit_alpha (geometry_predict.cpp),
+// whose SSE2 fast path must pick the weight that one sum per weight over
+// the samples in order picks, whatever the samples (inside the log table,
+// across its end, far outside it, more than its sampling stride).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <utility>
+#include <vector>
+
+namespace tsm {
+int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples);
+}
+
+namespace {
+
+using Samples = std::vector<std::pair<int64_t, int64_t>>;
+
+// fit_alpha as it was written first: per weight a16 = 0 .. 24 (of 16ths),
+// the sum of log2(1 + |y - round(alpha d)|) over every stride-th sample,
+// in sample order; the first smallest wins (4.12 fixed point).
+int32_t plain_fit_alpha(const Samples& samples) {
+  if (samples.empty()) return 1 << 12;
+  const size_t stride = std::max<size_t>(1, samples.size() / 200000);
+  double cost[25] = {};
+  for (size_t i = 0; i < samples.size(); i += stride) {
+    const int64_t d = samples[i].first, y = samples[i].second;
+    for (int a16 = 0; a16 < 25; ++a16) {
+      const int64_t alpha = int64_t{a16} << 8;
+      const int64_t r = y - ((alpha * d + 2048) >> 12);
+      cost[a16] += std::log2(1.0 + static_cast<double>(r < 0 ? -r : r));
+    }
+  }
+  int best = 0;
+  for (int a16 = 1; a16 < 25; ++a16)
+    if (cost[a16] < cost[best]) best = a16;
+  return best << 8;
+}
+
+// y near alpha * d for a random alpha in 0 .. 1.5, plus noise of the
+// given size: the weights' costs are close, as on a scan.
+Samples make_samples(std::mt19937_64& rng, size_t n, int64_t dmax, int64_t noise) {
+  std::uniform_int_distribution<int64_t> dd(-dmax, dmax), nn(-noise, noise);
+  std::uniform_real_distribution<double> aa(0.0, 1.5);
+  const double alpha = aa(rng);
+  Samples s(n);
+  for (auto& [d, y] : s) {
+    d = dd(rng);
+    y = static_cast<int64_t>(std::llround(alpha * static_cast<double>(d))) + nn(rng);
+  }
+  return s;
+}
+
+TEST(EncoderSpeed, FitAlphaPicksThePlainSumsWeight) {
+  std::mt19937_64 rng(37);
+  int cases = 0;
+  // Small residuals (the table), residuals across the table's end (4096),
+  // far beyond it (the slow path), and each mixed in one sample set.
+  const std::pair<int64_t, int64_t> regimes[] = {{40, 3},      {300, 40},          {3000, 200},    {6000, 3000},
+                                                 {4000, 4100}, {1 << 20, 1 << 12}, {1 << 28, 100}, {5461, 0}};
+  for (auto [dmax, noise] : regimes)
+    for (size_t n : {size_t{1}, size_t{7}, size_t{100}, size_t{5000}}) {
+      const Samples s = make_samples(rng, n, dmax, noise);
+      EXPECT_EQ(tsm::fit_alpha(s), plain_fit_alpha(s)) << "dmax " << dmax << " noise " << noise << " n " << n;
+      ++cases;
+    }
+  Samples mixed;
+  for (auto [dmax, noise] : regimes) {
+    const Samples s = make_samples(rng, 3000, dmax, noise);
+    mixed.insert(mixed.end(), s.begin(), s.end());
+  }
+  EXPECT_EQ(tsm::fit_alpha(mixed), plain_fit_alpha(mixed));
+  // More samples than the stride's 200,000: every second one is summed.
+  const Samples many = make_samples(rng, 450001, 500, 60);
+  EXPECT_EQ(tsm::fit_alpha(many), plain_fit_alpha(many));
+  EXPECT_EQ(cases, 32);
+}
+
+// A set where two weights cost exactly the same: the first (smaller)
+// weight wins, as in the plain sums.
+TEST(EncoderSpeed, FitAlphaTieKeepsTheSmallerWeight) {
+  const Samples zero_d(50, {0, 5});  // every weight predicts 0: all costs equal
+  EXPECT_EQ(tsm::fit_alpha(zero_d), 0);
+  EXPECT_EQ(plain_fit_alpha(zero_d), 0);
+  const Samples exact = {{16, 16}, {-32, -32}, {160, 160}};  // alpha 1.0 exactly
+  EXPECT_EQ(tsm::fit_alpha(exact), 1 << 12);
+  EXPECT_EQ(plain_fit_alpha(exact), 1 << 12);
+}
+
+}  // namespace
