@@ -36,6 +36,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -338,11 +339,12 @@ struct Coder {
   // kPlain: the caller knows there is no lattice, no tangent step (normal
   // null), no spread context and no mixing (plain() below), so those
   // branches are compiled out (the fast levels' gate predictor).
+  // kLattice false: the caller knows no axis has lattice planes.
   bool plain() const {
     return !tangent && !mix && !spread_ctx && lattice.values[0].empty() && lattice.values[1].empty() &&
            lattice.values[2].empty();
   }
-  template <bool kPlain = false, class Sink>
+  template <bool kPlain = false, bool kLattice = true, class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
               const int64_t* spread = nullptr, const int64_t* normal = nullptr, int tan_set = 0) {
     uint64_t sum = 0, top = 0;
@@ -377,7 +379,7 @@ struct Coder {
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
       const std::vector<uint32_t>& L = lattice.values[a];
       bool coded = false;
-      if (!kPlain && !L.empty()) {
+      if (!kPlain && kLattice && !L.empty()) {
         const size_t j = nearest_plane(a, static_cast<uint32_t>(p));
         size_t jx = 0;
         int on = 0;
@@ -784,49 +786,48 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
 
 // The greedy order's state (greedy_vertices below): per vertex kDone once
 // ordered, else its priority 4 min(parallelograms, 3) + min(neighbours, 3);
-// bucket b (1..15) lists the vertices of priority b in the order they
-// reached it (doubly linked: a vertex leaves its bucket when its priority
-// rises), the next vertex is the first of the highest non-empty bucket.
+// bucket b (1..15) lists the vertices in the order they reached priority b,
+// the next vertex is the first of the highest bucket still at that
+// priority. A vertex whose priority rises is appended to its new bucket and
+// left in the old one, where it is skipped (priorities only rise, so a
+// vertex enters a bucket at most once): no unlinking. A drained bucket is
+// emptied, so its storage stays the size of the front.
 struct GreedyQueue {
   static constexpr uint8_t kDone = 0xFF;
-  explicit GreedyQueue(uint32_t n) : prio(n, 0), next(new uint32_t[n]), prev(new uint32_t[n]) {
-    std::fill(head, head + 16, kNone);
-    std::fill(tail, tail + 16, kNone);
-  }
+  explicit GreedyQueue(uint32_t n) : prio(n, 0) {}
   std::vector<uint8_t> prio;
-  std::unique_ptr<uint32_t[]> next, prev;  // set when a vertex joins a bucket
-  uint32_t head[16], tail[16];
-  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
+  std::vector<uint32_t> bucket[16];
+  size_t taken[16] = {};   // per bucket: entries already taken or skipped
+  uint32_t nonempty = 0;  // bit b: bucket b may hold a vertex still at priority b
 
   bool done(uint32_t x) const { return x != kNone && prio[x] == kDone; }
-  void unlink(uint32_t x, int b) {
-    const uint32_t p = prev[x], nx = next[x];
-    (p == kNone ? head[b] : next[p]) = nx;
-    (nx == kNone ? tail[b] : prev[nx]) = p;
-    if (head[b] == kNone) nonempty &= ~(1u << b);
-  }
   // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
   // vertex x (not ordered yet).
   void raise(uint32_t x, int dp, int dn) {
     const int p = prio[x];
     const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
     if (np == p) return;
-    if (p) unlink(x, p);
     prio[x] = static_cast<uint8_t>(np);
-    prev[x] = tail[np];
-    next[x] = kNone;
-    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
-    tail[np] = x;
+    bucket[np].push_back(x);
     nonempty |= 1u << np;
   }
   // The next vertex (marked done), or kNone when every bucket is empty.
   uint32_t pop() {
-    if (!nonempty) return kNone;
-    const int b = 31 - __builtin_clz(nonempty);
-    const uint32_t v = head[b];
-    unlink(v, b);
-    prio[v] = kDone;
-    return v;
+    while (nonempty) {
+      const int b = 31 - __builtin_clz(nonempty);
+      std::vector<uint32_t>& list = bucket[b];
+      while (taken[b] < list.size()) {
+        const uint32_t v = list[taken[b]++];
+        if (prio[v] == b) {
+          prio[v] = kDone;
+          return v;
+        }
+      }
+      list.clear();
+      taken[b] = 0;
+      nonempty &= ~(1u << b);
+    }
+    return kNone;
   }
   // After vertex v (done) at the origin of half-edge h: the counts that
   // its triangle (v, u, w) completes (u at hn = he_next(h), w at hp).
@@ -867,6 +868,7 @@ struct FanTableDecoder {
   std::vector<uint32_t>& q;
   int64_t* last;
   int& last_act;
+  bool lattice;  // some axis has lattice planes
 
   FanTableDecoder(const GeometryLayout& g, Coder& coder, TableDecodeSink& sink, std::vector<uint32_t>& qs,
                   int64_t* last_, int& last_act_)
@@ -878,7 +880,8 @@ struct FanTableDecoder {
         s(sink),
         q(qs),
         last(last_),
-        last_act(last_act_) {}
+        last_act(last_act_),
+        lattice(!(c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty())) {}
   uint32_t known(uint32_t h) const {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
@@ -890,7 +893,8 @@ struct FanTableDecoder {
   __attribute__((always_inline)) bool vertex(uint32_t h0, GreedyQueue* greedy) {
     constexpr int kPairs = 16;
     const uint32_t v = cv[h0];
-    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, pred[3];
+    constexpr int64_t kMax = std::numeric_limits<int64_t>::max(), kMin = std::numeric_limits<int64_t>::min();
+    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {kMax, kMax, kMax}, hi[3] = {kMin, kMin, kMin}, pred[3];
     int npara = 0, nnb = 0, actsum = 0, npair = 0;
     uint32_t pu[kPairs], pw[kPairs];
     uint32_t h = h0;
@@ -914,8 +918,8 @@ struct FanTableDecoder {
             for (int a = 0; a < 3; ++a) {
               const int64_t x = int64_t{U[a]} + W[a] - O[a];
               para[a] += x;
-              lo[a] = npara ? std::min(lo[a], x) : x;
-              hi[a] = npara ? std::max(hi[a], x) : x;
+              lo[a] = std::min(lo[a], x);
+              hi[a] = std::max(hi[a], x);
             }
             ++npara;
           }
@@ -927,8 +931,9 @@ struct FanTableDecoder {
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
     const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
-    int64_t spread[3];
-    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+    int64_t spread[3] = {0, 0, 0};
+    if (npara >= 2)
+      for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
     NormalSum ns;
     if (c.tangent && npara > 0) {
@@ -946,7 +951,9 @@ struct FanTableDecoder {
       normal = ns.finish();
     }
     const int activity = nnb ? (actsum + nnb / 2) / nnb : last_act;
-    if (!c.vertex<false>(s, q, v, pred, cls, activity, c.spread_ctx && npara >= 2 ? spread : nullptr, normal))
+    const int64_t* sp = c.spread_ctx && npara >= 2 ? spread : nullptr;
+    if (!(lattice ? c.vertex<false, true>(s, q, v, pred, cls, activity, sp, normal)
+                  : c.vertex<false, false>(s, q, v, pred, cls, activity, sp, normal)))
       return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = act[v];
