@@ -449,6 +449,27 @@ struct NormalSum {
       if (std::abs(d1[a]) >= kMaxDiff || std::abs(d2[a]) >= kMaxDiff) ok = false;
     }
     if (!ok) return;
+    cross(d1, d2);
+  }
+  // add() when every coordinate difference from c is known to be below
+  // kMaxDiff (near() for corners on the grid of qmax).
+  void add_near(const uint32_t* u, const uint32_t* w, const int64_t c[3]) {
+    if (!ok || ++count > kMaxTriangles) {
+      ok = false;
+      return;
+    }
+    const int64_t d1[3] = {u[0] - c[0], u[1] - c[1], u[2] - c[2]};
+    const int64_t d2[3] = {w[0] - c[0], w[1] - c[1], w[2] - c[2]};
+    cross(d1, d2);
+  }
+  // Whether every point of the grid 0..qmax per axis lies within kMaxDiff
+  // of c on each axis (then add_near() equals add() for decoded corners).
+  static bool near(int64_t qmax, const int64_t c[3]) {
+    for (int a = 0; a < 3; ++a)
+      if (c[a] <= qmax - kMaxDiff || c[a] >= kMaxDiff) return false;
+    return true;
+  }
+  void cross(const int64_t d1[3], const int64_t d2[3]) {
     n[0] += d1[1] * d2[2] - d1[2] * d2[1];
     n[1] += d1[2] * d2[0] - d1[0] * d2[2];
     n[2] += d1[0] * d2[1] - d1[1] * d2[0];
@@ -938,7 +959,12 @@ struct FanTableDecoder {
     NormalSum ns;
     if (c.tangent && npara > 0) {
       if (npair <= kPairs) {
-        for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
+        // Without lattice planes every decoded coordinate is within 0..qmax.
+        if (!lattice && NormalSum::near(c.qmax, pred)) {
+          for (int j = 0; j < npair; ++j) ns.add_near(at(pu[j]), at(pw[j]), pred);
+        } else {
+          for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
+        }
       } else {  // a wide fan: walk it again
         uint32_t hh = h0;
         size_t gg = 0;
