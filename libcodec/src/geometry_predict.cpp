@@ -959,8 +959,9 @@ struct FanTableDecoder {
     NormalSum ns;
     if (c.tangent && npara > 0) {
       if (npair <= kPairs) {
-        // Without lattice planes every decoded coordinate is within 0..qmax.
-        if (!lattice && NormalSum::near(c.qmax, pred)) {
+        // Every decoded coordinate is within 0..qmax (residuals are checked,
+        // lattice planes too: code_lattice).
+        if (NormalSum::near(c.qmax, pred)) {
           for (int j = 0; j < npair; ++j) ns.add_near(at(pu[j]), at(pw[j]), pred);
         } else {
           for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
