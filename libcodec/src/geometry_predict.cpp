@@ -248,7 +248,7 @@ struct TableDecodeSink : DecodeSink {
   RansDecoder tables;
   BitReader bits;
   bool bad_code = false;  // a context without a table
-  int32_t residual(SurfaceModels*, int ctx, int64_t) {
+  __attribute__((always_inline)) int32_t residual(SurfaceModels*, int ctx, int64_t) {
     int32_t r = 0;
     if (!tables.decode(bits, ctx, r)) bad_code = true;  // also a context without a table
     return r;
