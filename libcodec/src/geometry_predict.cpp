@@ -999,21 +999,44 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
   return true;
 }
 
+// Per vertex its smallest half-edge (first_he, kNone for a vertex on no
+// triangle), and the vertices in the order of their smallest half-edges
+// (march order), in one pass over the corners.
+void first_half_edges_in_order(const std::vector<uint32_t>& cv, uint32_t vertex_count, std::vector<uint32_t>& first_he,
+                               std::vector<uint32_t>& march) {
+  first_he.assign(vertex_count, kNone);
+  march.resize(vertex_count);
+  uint32_t* f = first_he.data();
+  uint32_t* out = march.data();
+  size_t n = 0;
+  for (uint32_t h = 0, H = static_cast<uint32_t>(cv.size()); h < H; ++h) {
+    const uint32_t x = cv[h];
+    if (x != kNone && f[x] == kNone) {
+      f[x] = h;
+      out[n++] = x;
+    }
+  }
+  march.resize(n);
+}
+
 // Greedy order (greedy_vertices below), found as the vertices are decoded:
 // the walk that predicts a vertex also counts what it completes.
-// first_he: per vertex, its smallest half-edge.
+// first_he, march: as first_half_edges_in_order gives them.
 bool decode_greedy_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
-                          const std::vector<uint32_t>& first_he, int64_t last[3], int& last_act) {
+                          const std::vector<uint32_t>& first_he, const std::vector<uint32_t>& march, int64_t last[3],
+                          int& last_act) {
   FanTableDecoder fd(g, c, s, q, last, last_act);
   GreedyQueue greedy(g.vertex_count);
-  const uint32_t H = static_cast<uint32_t>(fd.H);
-  uint32_t scan = 0;
+  const size_t M = march.size();
+  size_t scan = 0;
   for (uint32_t i = 0;; ++i) {
     uint32_t v = greedy.pop();
-    if (v == kNone) {  // a new component: the first undecoded corner in march order
-      while (scan < H && (fd.cv[scan] == kNone || greedy.prio[fd.cv[scan]] == GreedyQueue::kDone)) ++scan;
-      if (scan == H) return true;
-      v = fd.cv[scan];
+    if (v == kNone) {
+      // A new component: the first undecoded corner in march order, which
+      // is the first half-edge of the first undecoded vertex in `march`.
+      while (scan < M && greedy.prio[march[scan]] == GreedyQueue::kDone) ++scan;
+      if (scan == M) return true;
+      v = march[scan];
       greedy.prio[v] = GreedyQueue::kDone;
     }
     if (!fd.vertex(first_he[v], &greedy)) return false;
@@ -1119,9 +1142,14 @@ struct GreedyOrder {
 template <class Sink>
 bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
   SurfaceCoder<Sink> sc(g, c, s, q);
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
+    if (!c.mix) {
+      std::vector<uint32_t> march;
+      first_half_edges_in_order(sc.cv, g.vertex_count, sc.first_he, march);  // (isolated() reuses first_he)
+      return decode_greedy_tables(g, c, s, q, sc.first_he, march, sc.last, sc.last_act) && sc.isolated();
+    }
+  }
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
-  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
-    if (!c.mix) return decode_greedy_tables(g, c, s, q, first_he, sc.last, sc.last_act) && sc.isolated();
   GreedyOrder own;
   if (!order) order = &own;
   if (!order->found) {
