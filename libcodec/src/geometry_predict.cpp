@@ -855,20 +855,19 @@ struct GreedyQueue {
   __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
                                             uint32_t hp) {
     const uint32_t xu = cv[hn], xw = cv[hp];
-    count(cv, twin, h, hn, hp, xu, xw, done(xu), done(xw));
+    const bool u = done(xu), w = done(xw);
+    count(cv, twin, h, hp, xu, xw, u, w, u && w ? cv[he_prev(twin[hn])] : kNone);
   }
-  // The same with u = cv[hn] and w = cv[hp] given, and whether each is done.
-  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
-                                            uint32_t hp, uint32_t xu, uint32_t xw, bool u, bool w) {
+  // The same with u = cv[hn] and w = cv[hp] given, whether each is done,
+  // and (when both are) x, the corner across u-w.
+  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hp,
+                                            uint32_t xu, uint32_t xw, bool u, bool w, uint32_t x) {
     // v as a neighbour of u, and the parallelogram of u across w-v.
     if (!u && xu != kNone) raise(xu, w && done(cv[he_prev(twin[hp])]), 1);
     // The parallelogram of w across v-u.
     if (!w && xw != kNone && u && done(cv[he_prev(twin[h])])) raise(xw, 1, 0);
     // v as the far corner of the vertex across u-w.
-    if (u && w) {
-      const uint32_t x = cv[he_prev(twin[hn])];
-      if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
-    }
+    if (u && w && x != kNone && prio[x] != kDone) raise(x, 1, 0);
   }
 };
 
@@ -924,6 +923,8 @@ struct FanTableDecoder {
       const uint32_t hn = he_next(h), hp = he_prev(h), xu = cv[hn], xw = cv[hp];
       auto decoded = [&](uint32_t x) { return x != kNone && act[x] != kUnknown; };
       const uint32_t u = decoded(xu) ? xu : kNone;
+      uint32_t xo = kNone;  // the corner across u-w, once looked up
+      bool have_xo = false;
       if (u != kNone) {
         const uint32_t* U = at(u);
         for (int a = 0; a < 3; ++a) nb[a] += U[a];
@@ -933,9 +934,10 @@ struct FanTableDecoder {
         if (w != kNone) {
           if (npair < kPairs) pu[npair] = u, pw[npair] = w;
           ++npair;
-          const uint32_t o = known(he_prev(twin[hn]));
-          if (o != kNone) {
-            const uint32_t *W = at(w), *O = at(o);
+          xo = cv[he_prev(twin[hn])];
+          have_xo = true;
+          if (decoded(xo)) {
+            const uint32_t *W = at(w), *O = at(xo);
             for (int a = 0; a < 3; ++a) {
               const int64_t x = int64_t{U[a]} + W[a] - O[a];
               para[a] += x;
@@ -947,7 +949,11 @@ struct FanTableDecoder {
         }
       }
       // (v counts as done there: decoded before the next vertex is chosen)
-      if (greedy) greedy->count(cv, twin, h, hn, hp, xu, xw, u != kNone || xu == v, decoded(xw) || xw == v);
+      if (greedy) {
+        const bool ud = u != kNone || xu == v, wd = decoded(xw) || xw == v;
+        if (ud && wd && !have_xo) xo = cv[he_prev(twin[hn])];
+        greedy->count(cv, twin, h, hp, xu, xw, ud, wd, xo);
+      }
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
