@@ -414,13 +414,10 @@ Status collect_parts(const Header& h, const std::vector<Section>& sections, std:
   return Status::Ok();
 }
 
-}  // namespace
-
-// A grid index as a coordinate (FORMAT.md §5).
-float grid_value(const Header& h, double step, int axis, uint32_t q) {
-  if (h.flags & kHeaderExactGrid) return exact_value(h.exact_step, h.exact_base[axis], q);  // §5.1
+// A grid index as a coordinate on the Draco grid: origin o, step, the
+// header's extent (grid_value below; append_part's loop calls it inline).
+inline float draco_grid_value(double o, double step, double extent, uint32_t q) {
   constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
-  const double o = static_cast<double>(h.origin[axis]);
   double x = o + static_cast<double>(q) * step;
   // A grid point may lie up to half a step past the largest input
   // coordinate; near the float limit, clamp (the input was within range).
@@ -430,8 +427,16 @@ float grid_value(const Header& h, double step, int axis, uint32_t q) {
   // lie just past origin + extent; then the float below it, so that the
   // decoded mesh has the extent it was coded with and coding it again
   // takes the same grid (canonical re-encoding).
-  while (static_cast<double>(c) - o > h.extent) c = std::nextafter(c, -std::numeric_limits<float>::infinity());
+  while (static_cast<double>(c) - o > extent) c = std::nextafter(c, -std::numeric_limits<float>::infinity());
   return c;
+}
+
+}  // namespace
+
+// A grid index as a coordinate (FORMAT.md §5).
+float grid_value(const Header& h, double step, int axis, uint32_t q) {
+  if (h.flags & kHeaderExactGrid) return exact_value(h.exact_step, h.exact_base[axis], q);  // §5.1
+  return draco_grid_value(static_cast<double>(h.origin[axis]), step, h.extent, q);
 }
 
 namespace {
@@ -490,8 +495,15 @@ Status append_part(const Header& h, DecodedPart& part, Mesh& out, bool first) {
   out.positions.resize(out.positions.size() + part.q.size());
   float* pos = out.positions.data() + 3 * static_cast<size_t>(base);
   const uint32_t* q = part.q.data();
-  for (size_t v = 0, nv = part.q.size() / 3; v < nv; ++v, q += 3, pos += 3)
-    for (int axis = 0; axis < 3; ++axis) pos[axis] = grid_value(h, step, axis, q[axis]);
+  const size_t nv = part.q.size() / 3;
+  if (h.flags & kHeaderExactGrid) {
+    for (size_t v = 0; v < nv; ++v, q += 3, pos += 3)
+      for (int axis = 0; axis < 3; ++axis) pos[axis] = grid_value(h, step, axis, q[axis]);
+  } else {
+    const double o[3] = {h.origin[0], h.origin[1], h.origin[2]};
+    for (size_t v = 0; v < nv; ++v, q += 3, pos += 3)
+      for (int axis = 0; axis < 3; ++axis) pos[axis] = draco_grid_value(o[axis], step, h.extent, q[axis]);
+  }
   if (first) {  // the first part has no references: its faces as they are, no copy
     out.face_offsets = std::move(part.faces.face_offsets);
     out.indices = std::move(part.faces.indices);

@@ -36,6 +36,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -251,7 +252,7 @@ struct TableDecodeSink : DecodeSink {
   RansDecoder tables;
   BitReader bits;
   bool bad_code = false;  // a context without a table
-  int32_t residual(SurfaceModels*, int ctx, int64_t) {
+  __attribute__((always_inline)) int32_t residual(SurfaceModels*, int ctx, int64_t) {
     int32_t r = 0;
     if (!tables.decode(bits, ctx, r)) bad_code = true;  // also a context without a table
     return r;
@@ -342,11 +343,12 @@ struct Coder {
   // kPlain: the caller knows there is no lattice, no tangent step (normal
   // null), no spread context and no mixing (plain() below), so those
   // branches are compiled out (the fast levels' gate predictor).
+  // kLattice false: the caller knows no axis has lattice planes.
   bool plain() const {
     return !tangent && !mix && !spread_ctx && lattice.values[0].empty() && lattice.values[1].empty() &&
            lattice.values[2].empty();
   }
-  template <bool kPlain = false, class Sink>
+  template <bool kPlain = false, bool kLattice = true, class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
               const int64_t* spread = nullptr, const int64_t* normal = nullptr, int tan_set = 0) {
     uint64_t sum = 0, top = 0;
@@ -381,7 +383,7 @@ struct Coder {
       uint32_t& x = q[3 * static_cast<size_t>(v) + a];
       const std::vector<uint32_t>& L = lattice.values[a];
       bool coded = false;
-      if (!kPlain && !L.empty()) {
+      if (!kPlain && kLattice && !L.empty()) {
         const size_t j = nearest_plane(a, static_cast<uint32_t>(p));
         size_t jx = 0;
         int on = 0;
@@ -452,6 +454,27 @@ struct NormalSum {
       if (std::abs(d1[a]) >= kMaxDiff || std::abs(d2[a]) >= kMaxDiff) ok = false;
     }
     if (!ok) return;
+    cross(d1, d2);
+  }
+  // add() when every coordinate difference from c is known to be below
+  // kMaxDiff (near() for corners on the grid of qmax).
+  void add_near(const uint32_t* u, const uint32_t* w, const int64_t c[3]) {
+    if (!ok || ++count > kMaxTriangles) {
+      ok = false;
+      return;
+    }
+    const int64_t d1[3] = {u[0] - c[0], u[1] - c[1], u[2] - c[2]};
+    const int64_t d2[3] = {w[0] - c[0], w[1] - c[1], w[2] - c[2]};
+    cross(d1, d2);
+  }
+  // Whether every point of the grid 0..qmax per axis lies within kMaxDiff
+  // of c on each axis (then add_near() equals add() for decoded corners).
+  static bool near(int64_t qmax, const int64_t c[3]) {
+    for (int a = 0; a < 3; ++a)
+      if (c[a] <= qmax - kMaxDiff || c[a] >= kMaxDiff) return false;
+    return true;
+  }
+  void cross(const int64_t d1[3], const int64_t d2[3]) {
     n[0] += d1[1] * d2[2] - d1[2] * d2[1];
     n[1] += d1[2] * d2[0] - d1[0] * d2[2];
     n[2] += d1[0] * d2[1] - d1[1] * d2[0];
@@ -789,69 +812,67 @@ bool decode_gate_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, s
 
 // The greedy order's state (greedy_vertices below): per vertex kDone once
 // ordered, else its priority 4 min(parallelograms, 3) + min(neighbours, 3);
-// bucket b (1..15) lists the vertices of priority b in the order they
-// reached it (doubly linked: a vertex leaves its bucket when its priority
-// rises), the next vertex is the first of the highest non-empty bucket.
+// bucket b (1..15) lists the vertices in the order they reached priority b,
+// the next vertex is the first of the highest bucket still at that
+// priority. A vertex whose priority rises is appended to its new bucket and
+// left in the old one, where it is skipped (priorities only rise, so a
+// vertex enters a bucket at most once): no unlinking. A drained bucket is
+// emptied, so its storage stays the size of the front.
 struct GreedyQueue {
   static constexpr uint8_t kDone = 0xFF;
-  explicit GreedyQueue(uint32_t n) : prio(n, 0), next(new uint32_t[n]), prev(new uint32_t[n]) {
-    std::fill(head, head + 16, kNone);
-    std::fill(tail, tail + 16, kNone);
-  }
+  explicit GreedyQueue(uint32_t n) : prio(n, 0) {}
   std::vector<uint8_t> prio;
-  std::unique_ptr<uint32_t[]> next, prev;  // set when a vertex joins a bucket
-  uint32_t head[16], tail[16];
-  uint32_t nonempty = 0;  // bit b: bucket b holds a vertex
+  std::vector<uint32_t> bucket[16];
+  size_t taken[16] = {};   // per bucket: entries already taken or skipped
+  uint32_t nonempty = 0;  // bit b: bucket b may hold a vertex still at priority b
 
   bool done(uint32_t x) const { return x != kNone && prio[x] == kDone; }
-  void unlink(uint32_t x, int b) {
-    const uint32_t p = prev[x], nx = next[x];
-    (p == kNone ? head[b] : next[p]) = nx;
-    (nx == kNone ? tail[b] : prev[nx]) = p;
-    if (head[b] == kNone) nonempty &= ~(1u << b);
-  }
   // Adds a parallelogram (dp = 1) and/or a neighbour (dn = 1) to the
   // vertex x (not ordered yet).
   void raise(uint32_t x, int dp, int dn) {
     const int p = prio[x];
     const int np = std::min((p >> 2) + dp, 3) * 4 + std::min((p & 3) + dn, 3);
     if (np == p) return;
-    if (p) unlink(x, p);
     prio[x] = static_cast<uint8_t>(np);
-    prev[x] = tail[np];
-    next[x] = kNone;
-    (tail[np] == kNone ? head[np] : next[tail[np]]) = x;
-    tail[np] = x;
+    bucket[np].push_back(x);
     nonempty |= 1u << np;
   }
   // The next vertex (marked done), or kNone when every bucket is empty.
   uint32_t pop() {
-    if (!nonempty) return kNone;
-    const int b = 31 - __builtin_clz(nonempty);
-    const uint32_t v = head[b];
-    unlink(v, b);
-    prio[v] = kDone;
-    return v;
+    while (nonempty) {
+      const int b = 31 - __builtin_clz(nonempty);
+      std::vector<uint32_t>& list = bucket[b];
+      while (taken[b] < list.size()) {
+        const uint32_t v = list[taken[b]++];
+        if (prio[v] == b) {
+          prio[v] = kDone;
+          return v;
+        }
+      }
+      list.clear();
+      taken[b] = 0;
+      nonempty &= ~(1u << b);
+    }
+    return kNone;
   }
   // After vertex v (done) at the origin of half-edge h: the counts that
   // its triangle (v, u, w) completes (u at hn = he_next(h), w at hp).
   __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
                                             uint32_t hp) {
     const uint32_t xu = cv[hn], xw = cv[hp];
-    count(cv, twin, h, hn, hp, xu, xw, done(xu), done(xw));
+    const bool u = done(xu), w = done(xw);
+    count(cv, twin, h, hp, xu, xw, u, w, u && w ? cv[he_prev(twin[hn])] : kNone);
   }
-  // The same with u = cv[hn] and w = cv[hp] given, and whether each is done.
-  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hn,
-                                            uint32_t hp, uint32_t xu, uint32_t xw, bool u, bool w) {
+  // The same with u = cv[hn] and w = cv[hp] given, whether each is done,
+  // and (when both are) x, the corner across u-w.
+  __attribute__((always_inline)) void count(const uint32_t* cv, const uint32_t* twin, uint32_t h, uint32_t hp,
+                                            uint32_t xu, uint32_t xw, bool u, bool w, uint32_t x) {
     // v as a neighbour of u, and the parallelogram of u across w-v.
     if (!u && xu != kNone) raise(xu, w && done(cv[he_prev(twin[hp])]), 1);
     // The parallelogram of w across v-u.
     if (!w && xw != kNone && u && done(cv[he_prev(twin[h])])) raise(xw, 1, 0);
     // v as the far corner of the vertex across u-w.
-    if (u && w) {
-      const uint32_t x = cv[he_prev(twin[hn])];
-      if (x != kNone && prio[x] != kDone) raise(x, 1, 0);
-    }
+    if (u && w && x != kNone && prio[x] != kDone) raise(x, 1, 0);
   }
 };
 
@@ -872,6 +893,7 @@ struct FanTableDecoder {
   std::vector<uint32_t>& q;
   int64_t* last;
   int& last_act;
+  bool lattice;  // some axis has lattice planes
 
   FanTableDecoder(const GeometryLayout& g, Coder& coder, TableDecodeSink& sink, std::vector<uint32_t>& qs,
                   int64_t* last_, int& last_act_)
@@ -883,7 +905,8 @@ struct FanTableDecoder {
         s(sink),
         q(qs),
         last(last_),
-        last_act(last_act_) {}
+        last_act(last_act_),
+        lattice(!(c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty())) {}
   uint32_t known(uint32_t h) const {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
@@ -895,7 +918,8 @@ struct FanTableDecoder {
   __attribute__((always_inline)) bool vertex(uint32_t h0, GreedyQueue* greedy) {
     constexpr int kPairs = 16;
     const uint32_t v = cv[h0];
-    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, pred[3];
+    constexpr int64_t kMax = std::numeric_limits<int64_t>::max(), kMin = std::numeric_limits<int64_t>::min();
+    int64_t para[3] = {0, 0, 0}, nb[3] = {0, 0, 0}, lo[3] = {kMax, kMax, kMax}, hi[3] = {kMin, kMin, kMin}, pred[3];
     int npara = 0, nnb = 0, actsum = 0, npair = 0;
     uint32_t pu[kPairs], pw[kPairs];
     uint32_t h = h0;
@@ -904,6 +928,8 @@ struct FanTableDecoder {
       const uint32_t hn = he_next(h), hp = he_prev(h), xu = cv[hn], xw = cv[hp];
       auto decoded = [&](uint32_t x) { return x != kNone && act[x] != kUnknown; };
       const uint32_t u = decoded(xu) ? xu : kNone;
+      uint32_t xo = kNone;  // the corner across u-w, once looked up
+      bool have_xo = false;
       if (u != kNone) {
         const uint32_t* U = at(u);
         for (int a = 0; a < 3; ++a) nb[a] += U[a];
@@ -913,32 +939,44 @@ struct FanTableDecoder {
         if (w != kNone) {
           if (npair < kPairs) pu[npair] = u, pw[npair] = w;
           ++npair;
-          const uint32_t o = known(he_prev(twin[hn]));
-          if (o != kNone) {
-            const uint32_t *W = at(w), *O = at(o);
+          xo = cv[he_prev(twin[hn])];
+          have_xo = true;
+          if (decoded(xo)) {
+            const uint32_t *W = at(w), *O = at(xo);
             for (int a = 0; a < 3; ++a) {
               const int64_t x = int64_t{U[a]} + W[a] - O[a];
               para[a] += x;
-              lo[a] = npara ? std::min(lo[a], x) : x;
-              hi[a] = npara ? std::max(hi[a], x) : x;
+              lo[a] = std::min(lo[a], x);
+              hi[a] = std::max(hi[a], x);
             }
             ++npara;
           }
         }
       }
       // (v counts as done there: decoded before the next vertex is chosen)
-      if (greedy) greedy->count(cv, twin, h, hn, hp, xu, xw, u != kNone || xu == v, decoded(xw) || xw == v);
+      if (greedy) {
+        const bool ud = u != kNone || xu == v, wd = decoded(xw) || xw == v;
+        if (ud && wd && !have_xo) xo = cv[he_prev(twin[hn])];
+        greedy->count(cv, twin, h, hp, xu, xw, ud, wd, xo);
+      }
       h = he_next(twin[h]);
     } while (h != h0 && ++guard < H);
     int64_t d[3], n[3];
     const int cls = blend_prediction(c.alpha, para, npara, nb, nnb, last, pred, d, n);
-    int64_t spread[3];
-    for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
+    int64_t spread[3] = {0, 0, 0};
+    if (npara >= 2)
+      for (int a = 0; a < 3; ++a) spread[a] = hi[a] - lo[a];
     const int64_t* normal = nullptr;
     NormalSum ns;
     if (c.tangent && npara > 0) {
       if (npair <= kPairs) {
-        for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
+        // Every decoded coordinate is within 0..qmax (residuals are checked,
+        // lattice planes too: code_lattice).
+        if (NormalSum::near(c.qmax, pred)) {
+          for (int j = 0; j < npair; ++j) ns.add_near(at(pu[j]), at(pw[j]), pred);
+        } else {
+          for (int j = 0; j < npair; ++j) ns.add(at(pu[j]), at(pw[j]), pred);
+        }
       } else {  // a wide fan: walk it again
         uint32_t hh = h0;
         size_t gg = 0;
@@ -951,7 +989,9 @@ struct FanTableDecoder {
       normal = ns.finish();
     }
     const int activity = nnb ? (actsum + nnb / 2) / nnb : last_act;
-    if (!c.vertex<false>(s, q, v, pred, cls, activity, c.spread_ctx && npara >= 2 ? spread : nullptr, normal))
+    const int64_t* sp = c.spread_ctx && npara >= 2 ? spread : nullptr;
+    if (!(lattice ? c.vertex<false, true>(s, q, v, pred, cls, activity, sp, normal)
+                  : c.vertex<false, false>(s, q, v, pred, cls, activity, sp, normal)))
       return false;
     for (int a = 0; a < 3; ++a) last[a] = at(v)[a];
     last_act = act[v];
@@ -970,21 +1010,44 @@ bool decode_fan_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, st
   return true;
 }
 
+// Per vertex its smallest half-edge (first_he, kNone for a vertex on no
+// triangle), and the vertices in the order of their smallest half-edges
+// (march order), in one pass over the corners.
+void first_half_edges_in_order(const std::vector<uint32_t>& cv, uint32_t vertex_count, std::vector<uint32_t>& first_he,
+                               std::vector<uint32_t>& march) {
+  first_he.assign(vertex_count, kNone);
+  march.resize(vertex_count);
+  uint32_t* f = first_he.data();
+  uint32_t* out = march.data();
+  size_t n = 0;
+  for (uint32_t h = 0, H = static_cast<uint32_t>(cv.size()); h < H; ++h) {
+    const uint32_t x = cv[h];
+    if (x != kNone && f[x] == kNone) {
+      f[x] = h;
+      out[n++] = x;
+    }
+  }
+  march.resize(n);
+}
+
 // Greedy order (greedy_vertices below), found as the vertices are decoded:
 // the walk that predicts a vertex also counts what it completes.
-// first_he: per vertex, its smallest half-edge.
+// first_he, march: as first_half_edges_in_order gives them.
 bool decode_greedy_tables(const GeometryLayout& g, Coder& c, TableDecodeSink& s, std::vector<uint32_t>& q,
-                          const std::vector<uint32_t>& first_he, int64_t last[3], int& last_act) {
+                          const std::vector<uint32_t>& first_he, const std::vector<uint32_t>& march, int64_t last[3],
+                          int& last_act) {
   FanTableDecoder fd(g, c, s, q, last, last_act);
   GreedyQueue greedy(g.vertex_count);
-  const uint32_t H = static_cast<uint32_t>(fd.H);
-  uint32_t scan = 0;
+  const size_t M = march.size();
+  size_t scan = 0;
   for (uint32_t i = 0;; ++i) {
     uint32_t v = greedy.pop();
-    if (v == kNone) {  // a new component: the first undecoded corner in march order
-      while (scan < H && (fd.cv[scan] == kNone || greedy.prio[fd.cv[scan]] == GreedyQueue::kDone)) ++scan;
-      if (scan == H) return true;
-      v = fd.cv[scan];
+    if (v == kNone) {
+      // A new component: the first undecoded corner in march order, which
+      // is the first half-edge of the first undecoded vertex in `march`.
+      while (scan < M && greedy.prio[march[scan]] == GreedyQueue::kDone) ++scan;
+      if (scan == M) return true;
+      v = march[scan];
       greedy.prio[v] = GreedyQueue::kDone;
     }
     if (!fd.vertex(first_he[v], &greedy)) return false;
@@ -1098,9 +1161,14 @@ struct GreedyOrder {
 template <class Sink>
 bool code_greedy(const GeometryLayout& g, Coder& c, Sink& s, std::vector<uint32_t>& q, GreedyOrder* order = nullptr) {
   SurfaceCoder<Sink> sc(g, c, s, q);
+  if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
+    if (!c.mix) {
+      std::vector<uint32_t> march;
+      first_half_edges_in_order(sc.cv, g.vertex_count, sc.first_he, march);  // (isolated() reuses first_he)
+      return decode_greedy_tables(g, c, s, q, sc.first_he, march, sc.last, sc.last_act) && sc.isolated();
+    }
+  }
   const std::vector<uint32_t>& first_he = sc.first_half_edges();
-  if constexpr (std::is_same_v<Sink, TableDecodeSink>)
-    if (!c.mix) return decode_greedy_tables(g, c, s, q, first_he, sc.last, sc.last_act) && sc.isolated();
   GreedyOrder own;
   if (!order) order = &own;
   if (!order->found) {

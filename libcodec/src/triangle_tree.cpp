@@ -123,6 +123,11 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
     if (loop[p] >= n) return corrupt("loop vertex out of range");
     if (visits[loop[p]] < 3) ++visits[loop[p]];
   }
+  // Raw pointers: the walk's stores could otherwise make the compiler
+  // reload each vector's data (and the run's march count) every step.
+  const uint32_t* const lp = loop.data();
+  uint32_t* const val = valence.data();
+  const uint8_t* const vis = visits.data();
   uint32_t* const corner = out.corner;
   uint32_t* const twin = out.twin;
   uint32_t* const loop_he = out.loop_he;
@@ -131,10 +136,10 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   // Triangle (a, b, x) entered through the parent's edge `slot` (inlined at
   // its four uses: the walk's inner loop).
   auto emit = [&](uint32_t a, uint32_t b, uint32_t x, uint32_t par, uint8_t slot) __attribute__((always_inline)) {
-    const uint32_t va = loop[a], vbb = loop[b], vx = loop[x];
-    ++valence[va];
-    ++valence[vbb];
-    ++valence[vx];
+    const uint32_t va = lp[a], vbb = lp[b], vx = lp[x];
+    ++val[va];
+    ++val[vbb];
+    ++val[vx];
     uint32_t* c = corner + 3 * size_t{k};
     c[0] = vb + va;
     c[1] = vb + vbb;
@@ -169,12 +174,13 @@ Status decode_triangle_tree(uint32_t L, const TriangleRuns& runs, const std::vec
   for (size_t ri = 0; ri < nr; ++ri) {
     // Edges in this polygon besides the gate: (a - b) mod L.
     int prev = 2;
-    for (uint32_t i = 0; i < runs.march[ri]; ++i) {
+    const uint32_t march = runs.march[ri];
+    for (uint32_t i = 0; i < march; ++i) {
       if (span_of(cur.a, cur.b) < 3) return corrupt("a march step leaves no room for the rest of the run");
       const uint32_t right = fwd(cur.b, 1), left = bwd(cur.a, 1);
-      const int ctx = ((static_cast<int>(std::min<uint32_t>(valence[loop[cur.a]], 7)) * 8 +
-                        static_cast<int>(std::min<uint32_t>(valence[loop[cur.b]], 7))) * 3 + prev) * 9 +
-                      (visits[loop[right]] - 1) * 3 + (visits[loop[left]] - 1);
+      const int ctx = ((static_cast<int>(std::min<uint32_t>(val[lp[cur.a]], 7)) * 8 +
+                        static_cast<int>(std::min<uint32_t>(val[lp[cur.b]], 7))) * 3 + prev) * 9 +
+                      (vis[lp[right]] - 1) * 3 + (vis[lp[left]] - 1);
       prev = bits.bit(ctx);
       ++bit_count;
       if (prev == 0) {
