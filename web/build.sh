@@ -31,14 +31,22 @@ command -v emcc >/dev/null || { echo "web/build.sh: emcc not found (apt-get inst
 VERSION="$(sed -n 's/^project(tsm VERSION \([0-9.]*\).*/\1/p' "$ROOT/CMakeLists.txt")"
 OPT=(-O3 -DNDEBUG)
 LOPT=(-O3)
-# Cold code, optimized for size (after OPT, so its -Oz wins): the container,
-# the C API, error messages, the segment table and zstd (small side-data
-# sections); the decoding stages keep -O3.
+# Speed or size, per file. The stages a decode spends its time in keep -O3:
+# connectivity (vertex and triangle trees, bounding loops), geometry
+# prediction and its coders, attributes, the split layout of glTF meshes,
+# part assembly (decode.cpp: dequantization, copies). Everything else is
+# compiled -Oz (after OPT, so it wins): the container, the C API, keep-order,
+# progressive batches, exact grids, segments, messages and zstd; a source
+# file added to the decoder is -Oz until it is named here. -Oz on
+# attributes.cpp or geometry_predict.cpp slows the bunny or dragon res2 by
+# 10-15%, on decode.cpp by 3%.
 COLD=(-Oz)
 if [ "${TSM_WEB_DEBUG:-0}" = 1 ]; then OPT=(-O1 -g); LOPT=(-O1 -g -sASSERTIONS=1); COLD=(); fi
+HOT_FILES="attributes.cpp bounding_loop.cpp connectivity_decode.cpp decode.cpp geometry_predict.cpp range_coder.cpp
+           rans_coder.cpp split_layout.cpp table_coder.cpp triangle_tree.cpp"
 is_cold() {
-  case "$(basename "$1")" in c_api.cpp | container_read.cpp | mesh.cpp | parallel.cpp | segments.cpp | status.cpp) return 0 ;; esac
-  return 1
+  case " $(echo $HOT_FILES) " in *" $(basename "$1") "*) return 1 ;; esac
+  return 0
 }
 # TSM_WEB_FLAGS: extra compile and link flags, for trying variants (e.g. "-flto", "-msimd128")
 read -r -a EXTRA <<<"${TSM_WEB_FLAGS:-}"
@@ -80,7 +88,8 @@ ZSTD_MODE=debian
 if [ "${TSM_WEB_ZSTD:-debian}" = debian ] && zstd_from_debian; then
   echo "web/build.sh: zstd decompressor from Debian's source package ($ZSTD_SRC)"
   ZSTD_CFLAGS=(-I"$ZSTD_SRC" -DZSTD_DISABLE_ASM -DZSTD_NO_TRACE -DXXH_NAMESPACE=ZSTD_ -DZSTD_LEGACY_SUPPORT=0
-               -DZSTD_STRIP_ERROR_STRINGS -DHUF_FORCE_DECOMPRESS_X1 -DZSTD_FORCE_DECOMPRESS_SEQUENCES_SHORT)
+               -DZSTD_STRIP_ERROR_STRINGS -DHUF_FORCE_DECOMPRESS_X1 -DZSTD_FORCE_DECOMPRESS_SEQUENCES_SHORT
+               -DZSTD_NO_INLINE -DZSTD_NO_UNUSED_FUNCTIONS -DDYNAMIC_BMI2=0)
   ZSTD_FILES=("$ZSTD_SRC"/common/{entropy_common,error_private,fse_decompress,xxhash,zstd_common}.c
               "$ZSTD_SRC"/decompress/{huf_decompress,zstd_ddict,zstd_decompress,zstd_decompress_block}.c)
   ZSTD_INC=(-I"$ZSTD_SRC")
@@ -130,7 +139,7 @@ compile() {  # src obj flags...
     emcc "$@" -c "$src" -o "$obj"
   fi
 }
-FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}" "${COLD[@]}")"
+FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}" "${COLD[@]}" "$HOT_FILES")"
 if [ ! -f "$OUT/.flags" ] || [ "$(cat "$OUT/.flags")" != "$FLAGSIG" ]; then printf '%s\n' "$FLAGSIG" > "$OUT/.flags"; fi
 # headers: rebuild everything when any library header is newer than the last link
 if [ -f "$OUT/tsm_decoder.wasm" ]; then

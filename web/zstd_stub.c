@@ -1,7 +1,9 @@
 /* Stand-in for zstd's decompressor in the WebAssembly build, used only when
  * web/build.sh cannot get zstd's sources from Debian's source package. The
- * tsm encoder never writes zstd-coded sections; a file that has one is refused
- * (container_read.cpp reports the section as not decodable). */
+ * tsm encoder zstd-codes the metadata section (a glTF or OBJ source's side
+ * data) and a lossless file's exceptions when that is smaller: such a file is
+ * refused by a build with this stub (container_read.cpp reports the section
+ * as not decodable). */
 #include <stddef.h>
 
 #define TSM_ZSTD_STUB_ERROR ((size_t)-1)
