@@ -238,6 +238,35 @@ TEST(Simplify, PolygonsAndFaceAttributes) {
   ASSERT_EQ(out.attributes[0].values.size(), 36u);
 }
 
+// Every result triangle carries a bound of its distance to the input,
+// proven through the triangles it replaced (their distance plus their own
+// bound) or through the input itself; after thousands of collapses on top
+// of each other the largest must still be at least the distance sampled
+// from the result to the input (a smaller one would be a broken proof), and
+// within the limit.
+TEST(Simplify, ChainedBoundsDominateTheSampledDistance) {
+  for (const Mesh& in : {tsm_test::jittered(tsm_test::icosphere(4), 0.002f, 3), tsm_test::torus(64, 32),
+                         tsm_test::irregular_grid(40, 7)}) {
+    for (double fraction : {0.003, 0.02}) {
+      const double e = fraction * tsm::bounding_box(in).diagonal();
+      tsm::SimplifyOptions o;
+      o.max_error = e;
+      Mesh out;
+      tsm::SimplifyReport r;
+      ASSERT_TRUE(tsm::simplify(in, o, out, &r).ok());
+      EXPECT_GT(r.collapses, 300u);
+      tsm::DistanceOptions d;
+      d.target_samples = 100000;
+      tsm::DistanceReport dr;
+      ASSERT_TRUE(tsm::measure_distance(out, in, d, dr).ok());
+      EXPECT_GT(dr.a_to_b.max, 0.0);
+      EXPECT_GE(r.result_error, dr.a_to_b.max * (1 - 1e-9)) << fraction << " faces " << out.face_count();
+      EXPECT_LE(r.result_error, e);
+      EXPECT_LE(dr.b_to_a.max, e * (1 + 1e-9));
+    }
+  }
+}
+
 TEST(Simplify, RefusesBadOptions) {
   Mesh out;
   EXPECT_FALSE(tsm::simplify(tsm_test::icosphere(1), {}, out).ok());

@@ -4,19 +4,25 @@
 // original mesh and the result stays within the limit (after Wendt's
 // guaranteed-deviation reduction).
 //
-// The bound rests on one fact: the distance from a point to ONE triangle is
-// a convex function, so a (sub-)triangle whose three corners are within E
-// of a triangle t lies wholly within E of t.
+// The bound rests on two facts: the distance from a point to ONE triangle
+// is a convex function, so a (sub-)triangle whose three corners are within
+// E of a triangle t lies wholly within E of t; and the triangle inequality,
+// d(p, X) <= d(p, t) + (the farthest any point of t is from X).
 //  - original -> result: every original triangle is cut into pieces (at
-//    first one piece, itself), each assigned to a result triangle within E
-//    of its three corners. A collapse re-assigns the pieces of the triangles
-//    it changes to the new triangles around the kept vertex (or the
-//    unchanged ones next to them), cutting a piece in four where no single
-//    triangle takes it.
-//  - result -> original: every new triangle is checked against the original
-//    through the BVH, cut in four recursively until each part is within E
-//    of one original triangle (convexity) or its corners' distances plus
-//    its covering radius are (the distance to a mesh is 1-Lipschitz).
+//    first one piece, itself), each held by a result triangle with a proven
+//    bound of its distance to it. A collapse hands the pieces of the
+//    triangles it changes to the new triangles around the kept vertex (or
+//    the unchanged ones next to them): through the triangle inequality
+//    (the piece's bound plus the farthest corner of its old triangle from
+//    the new one) when that is within E, else by its corners, cutting it in
+//    four where no single triangle takes it.
+//  - result -> original: every result triangle carries a proven bound of
+//    its distance to the original (0 at first). A new triangle is checked
+//    first through the triangles it replaces (the distance to one of them
+//    plus its bound), then through the BVH over the original, cut in four
+//    recursively until each part is within E of one triangle (convexity)
+//    or its corners' bounds plus its covering radius are (the distance to
+//    a mesh is 1-Lipschitz).
 // A collapse that fails either, flips or degenerates a triangle, or changes
 // the topology is refused. Vertices of non-manifold edges and fans may move
 // but never go; vertices on attribute seams and degenerate input triangles
@@ -80,6 +86,7 @@ struct Piece {
   Vec3 p[3];
   uint32_t depth = 0;
   uint32_t orig = 0;  // the original triangle it is part of
+  double delta = 0;   // proven: no point of the piece is farther from the triangle holding it
 };
 
 constexpr uint32_t kMaxPieceDepth = 4;  // a piece is cut at most this many times (4^4 parts)
@@ -106,7 +113,8 @@ class Simplifier {
   void find_locked();
   void find_components();
   void init_quadrics();
-  void push_edges_of(uint32_t v);
+  void push_edges_of(uint32_t v, bool higher_only = false);
+  std::vector<uint32_t> ends_;  // push_edges_of's scratch
   bool candidate_for(uint32_t u, uint32_t v, Candidate& c);
 
   // ---- one collapse
@@ -131,9 +139,29 @@ class Simplifier {
   // ---- the bound
   bool assign_pieces(const std::vector<uint32_t>& changed);
   bool assign_piece(const Piece& pc);
-  bool within_original(uint32_t t);
-  bool nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint);
-  bool within_original_rec(const Vec3 p[3], const double d[3], const int64_t t[3], uint32_t depth);
+  // A triangle that may take pieces: its corners (new ones for a changed
+  // triangle) and box.
+  struct Taker {
+    Vec3 p[3], lo, hi;
+    uint32_t t;
+  };
+  double fit2(const Piece& pc, const Taker& k, double limit2) const;
+  std::vector<Taker> takers_;
+  size_t last_taker_ = 0;
+  // A bound of a point's distance to the original: b >= d(p, original),
+  // proven through `ref` (>= 0: that original triangle, with no error of its
+  // own; < 0: ring_[-1 - ref], a current triangle within tri_err_ of it).
+  struct Near {
+    double b;
+    int64_t ref;
+  };
+  bool within_original(uint32_t t, double& err);
+  Near ring_bound(Vec3 p);
+  Near exact_bound(Vec3 p, int64_t hint);
+  struct NearEntry;
+  NearEntry& near_entry(Vec3 p);
+  double leaf_bound(const Vec3 p[3], const Near n[3]) const;
+  bool within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth, double& err);
   Vec3 new_corner(uint32_t t, int k) const;
 
   // ---- output
@@ -180,25 +208,41 @@ class Simplifier {
   // Scratch of one attempt: the collapse u -> v at x.
   uint32_t cu_ = 0, cv_ = 0;
   Vec3 cx_;
-  std::vector<uint32_t> changed_;                   // triangles whose corners move or that go
-  std::vector<uint32_t> new_tris_;                  // changed triangles that stay (with u or v replaced by the moved v)
-  std::vector<uint32_t> near_tris_;                 // unchanged live triangles around, also able to take pieces
-  std::vector<std::pair<uint32_t, Piece>> placed_;  // triangle, piece (an attempt's assignments)
-  // Nearest original triangles of the points met in one try_collapse
-  // (corners and cut points are shared between neighbouring triangles and
-  // between placements): open addressing, emptied by a new generation.
+  std::vector<uint32_t> changed_;    // triangles whose corners move or that go
+  std::vector<uint32_t> new_tris_;   // changed triangles that stay (with u or v replaced by the moved v)
+  std::vector<uint32_t> near_tris_;  // unchanged live triangles around, also able to take pieces
+  // An attempt's assignments: pieces that stay whole (triangle, piece, its
+  // new bound), parts of cut ones (triangle, part), the cut ones.
+  struct Placed {
+    uint32_t t, piece;
+    double delta;
+  };
+  std::vector<Placed> placed_;
+  std::vector<std::pair<uint32_t, Piece>> placed_new_;
+  std::vector<uint32_t> cut_;
+  std::vector<double> new_err_;  // per new_tris_ entry: the bound its check proved
+  // Per current triangle: a proven bound of the distance from any of its
+  // points to the original (0 for an original triangle). By the triangle
+  // inequality a point p is within d(p, T) + tri_err_[T] of the original.
+  std::vector<double> tri_err_;
+  std::vector<uint32_t> ring_;        // the triangles around the edge tried, before the collapse
+  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
+  std::vector<uint32_t> orig_mark_;   // per original triangle: orig_mark_gen_ when in local_orig_
+  uint32_t orig_mark_gen_ = 0;
+  bool near_local_original(uint32_t t, double& err);
+  // Bounds of the points met in one try_collapse (corners and cut points
+  // are shared between neighbouring triangles and between placements),
+  // each computed when first asked: through the ring, through the BVH.
+  // Open addressing, emptied by a new generation.
   struct NearEntry {
     Vec3 p;
-    double d;
-    int64_t t;
+    Near ring, exact;
     uint32_t gen = 0;
+    bool has_ring = false, has_exact = false;
   };
   std::vector<NearEntry> near_cache_ = std::vector<NearEntry>(1u << 12);
   uint32_t near_gen_ = 1, near_used_ = 0;
   void clear_near_cache() { ++near_gen_, near_used_ = 0; }
-  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
-  std::vector<uint32_t> orig_mark_;   // per original triangle: orig_mark_gen_ when in local_orig_
-  uint32_t orig_mark_gen_ = 0;
 
   uint64_t collapses_ = 0, rejected_ = 0, locked_count_ = 0;
 };
@@ -253,6 +297,7 @@ void Simplifier::build() {
   for (uint32_t v = 0; v < nv; ++v) had_faces_[v] = !vtris_[v].empty();
   live_ = tri_.size();
   pieces_.resize(tri_.size());
+  tri_err_.assign(tri_.size(), 0.0);
   orig_mark_.assign(tri_.size(), 0);
   tri_pieces_.assign(tri_.size(), {});
   for (uint32_t t = 0; t < tri_.size(); ++t) {
@@ -410,16 +455,19 @@ bool Simplifier::candidate_for(uint32_t u, uint32_t v, Candidate& c) {
   return any;
 }
 
-void Simplifier::push_edges_of(uint32_t v) {
+// The edges of v, each once (with `higher_only`, those to a higher index:
+// the first pass over all vertices queues every edge once).
+void Simplifier::push_edges_of(uint32_t v, bool higher_only) {
+  ends_.clear();
   for (uint32_t t : vtris_[v])
     for (uint32_t w : tri_[t])
-      if (w != v && v < w) {
-        Candidate c;
-        if (candidate_for(v, w, c)) heap_.push(c);
-      } else if (w != v) {
-        Candidate c;
-        if (candidate_for(w, v, c)) heap_.push(c);
-      }
+      if (w != v && (!higher_only || w > v)) ends_.push_back(w);
+  std::sort(ends_.begin(), ends_.end());
+  ends_.erase(std::unique(ends_.begin(), ends_.end()), ends_.end());
+  for (uint32_t w : ends_) {
+    Candidate c;
+    if (candidate_for(std::min(v, w), std::max(v, w), c)) heap_.push(c);
+  }
 }
 
 // Link condition, boundary and component rules; `edge_tris` gets the
@@ -492,31 +540,107 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
 }
 
 // Pieces of the changed triangles onto the new triangles (or the unchanged
-// ones around); the assignments go to placed_.
+// ones around); the assignments go to placed_ (whole pieces) and
+// placed_new_ (the parts of cut ones). A piece of T within delta of T is
+// within delta + h of T's new shape, h = the largest distance of T's
+// corners to it (the distance to a triangle is convex, so no point of T is
+// farther; only the moved corner counts): most pieces stay by that sum
+// alone; the others are checked corner by corner.
 bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
   placed_.clear();
-  for (uint32_t t : changed)
-    for (uint32_t pi : tri_pieces_[t])
-      if (!assign_piece(pieces_[pi])) return false;
+  placed_new_.clear();
+  cut_.clear();
+  takers_.clear();
+  auto add = [&](uint32_t t, Vec3 a, Vec3 b, Vec3 c) {
+    Taker k{{a, b, c},
+            {std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})},
+            {std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})},
+            t};
+    takers_.push_back(k);
+  };
+  for (uint32_t t : new_tris_) add(t, new_corner(t, 0), new_corner(t, 1), new_corner(t, 2));
+  // The unchanged triangles around the new ring may take pieces too: added
+  // when a piece fits no new triangle.
+  bool near_added = false;
+  auto add_near = [&]() {
+    near_added = true;
+    near_tris_.clear();
+    for (uint32_t t : new_tris_)
+      for (uint32_t w : tri_[t])
+        if (w != cu_ && w != cv_)
+          for (uint32_t s : vtris_[w])
+            if (std::find(changed.begin(), changed.end(), s) == changed.end() &&
+                std::find(near_tris_.begin(), near_tris_.end(), s) == near_tris_.end())
+              near_tris_.push_back(s);
+    for (uint32_t t : near_tris_) add(t, pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]]);
+  };
+  last_taker_ = 0;
+  const double e = std::sqrt(e2_);
+  for (uint32_t t : changed) {
+    // h: the farthest corner of t from its own new shape (none when t goes).
+    size_t self = takers_.size();
+    for (size_t k = 0; k < new_tris_.size(); ++k)
+      if (new_tris_[k] == t) self = k;
+    double h = std::numeric_limits<double>::infinity();
+    if (self < takers_.size()) {
+      const Piece whole{{pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]]}, 0, 0, 0};
+      h = std::sqrt(fit2(whole, takers_[self], e2_));
+    }
+    for (uint32_t pi : tri_pieces_[t]) {
+      const Piece& pc = pieces_[pi];
+      if (pc.delta + h <= e) {
+        placed_.push_back({t, pi, pc.delta + h});
+        continue;
+      }
+      if (!near_added) add_near();
+      const size_t before = placed_new_.size();
+      if (!assign_piece(pc)) return false;
+      if (placed_new_.size() == before + 1 && placed_new_.back().second.depth == pc.depth) {
+        // Taken whole: the piece stays (with its new bound).
+        placed_.push_back({placed_new_.back().first, pi, placed_new_.back().second.delta});
+        placed_new_.pop_back();
+      } else {
+        cut_.push_back(pi);
+      }
+    }
+  }
   return true;
 }
 
+// The largest squared distance of the piece's corners to the taker, or
+// more than `limit2` as soon as one is (a box test first: most takers are
+// far from most pieces).
+double Simplifier::fit2(const Piece& pc, const Taker& k, double limit2) const {
+  for (const Vec3& p : pc.p) {
+    const double dx = std::max({k.lo.x - p.x, p.x - k.hi.x, 0.0}), dy = std::max({k.lo.y - p.y, p.y - k.hi.y, 0.0}),
+                 dz = std::max({k.lo.z - p.z, p.z - k.hi.z, 0.0});
+    if (dx * dx + dy * dy + dz * dz > limit2) return std::numeric_limits<double>::infinity();
+  }
+  double worst = 0;
+  for (const Vec3& p : pc.p) {
+    worst = std::max(worst, geom::point_triangle_dist2(p, k.p[0], k.p[1], k.p[2]));
+    if (worst > limit2) return std::numeric_limits<double>::infinity();
+  }
+  return worst;
+}
+
+// The piece to the first taker (new triangles, then unchanged ones) within
+// E of its corners, trying the last one that took a piece first (the
+// pieces of one triangle come in order, neighbours mostly go together);
+// else cut in four.
 bool Simplifier::assign_piece(const Piece& pc) {
-  auto fits = [&](Vec3 a, Vec3 b, Vec3 c) {
-    for (const Vec3& p : pc.p)
-      if (geom::point_triangle_dist2(p, a, b, c) > e2_) return false;
-    return true;
-  };
-  for (uint32_t t : new_tris_)
-    if (fits(new_corner(t, 0), new_corner(t, 1), new_corner(t, 2))) {
-      placed_.push_back({t, pc});
+  for (size_t j = 0; j <= takers_.size(); ++j) {
+    const size_t i = j == 0 ? last_taker_ : j - 1;
+    if (i >= takers_.size() || (j > 0 && i == last_taker_)) continue;
+    const double d2 = fit2(pc, takers_[i], e2_);
+    if (d2 <= e2_) {
+      Piece taken = pc;
+      taken.delta = std::sqrt(d2);
+      placed_new_.push_back({takers_[i].t, taken});
+      last_taker_ = i;
       return true;
     }
-  for (uint32_t t : near_tris_)
-    if (fits(pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]])) {
-      placed_.push_back({t, pc});
-      return true;
-    }
+  }
   if (pc.depth >= kMaxPieceDepth) return false;
   const Vec3 m01 = (pc.p[0] + pc.p[1]) * 0.5, m12 = (pc.p[1] + pc.p[2]) * 0.5, m20 = (pc.p[2] + pc.p[0]) * 0.5;
   const Vec3 parts[4][3] = {{pc.p[0], m01, m20}, {m01, pc.p[1], m12}, {m20, m12, pc.p[2]}, {m01, m12, m20}};
@@ -530,11 +654,9 @@ bool Simplifier::assign_piece(const Piece& pc) {
   return true;
 }
 
-// The nearest original triangle to p and its distance (not squared); false
-// when it is beyond the bound. Points met before in this collapse attempt
-// (corners and edge midpoints shared by the new triangles, the ring's
-// vertices for every placement tried) come from a small cache.
-bool Simplifier::nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint) {
+// The cache entry of p in this try_collapse (its bounds computed when first
+// asked).
+Simplifier::NearEntry& Simplifier::near_entry(Vec3 p) {
   if (2 * (near_used_ + 1) > near_cache_.size()) {
     // Full: start again twice as large (the entries are only a cache).
     near_cache_.assign(2 * near_cache_.size(), {});
@@ -542,64 +664,150 @@ bool Simplifier::nearest_original(Vec3 p, double& d, int64_t& t, int64_t hint) {
   }
   uint64_t bits[3];
   std::memcpy(&bits[0], &p.x, 8), std::memcpy(&bits[1], &p.y, 8), std::memcpy(&bits[2], &p.z, 8);
-  uint64_t h = (bits[0] * 0x9E3779B97F4A7C15ull) ^ (bits[1] * 0xC2B2AE3D27D4EB4Full) ^ (bits[2] * 0x165667B19E3779F9ull);
+  uint64_t h =
+      (bits[0] * 0x9E3779B97F4A7C15ull) ^ (bits[1] * 0xC2B2AE3D27D4EB4Full) ^ (bits[2] * 0x165667B19E3779F9ull);
   const size_t mask = near_cache_.size() - 1;
   size_t i = static_cast<size_t>(h ^ (h >> 29)) & mask;
   for (; near_cache_[i].gen == near_gen_; i = (i + 1) & mask) {
-    const NearEntry& c = near_cache_[i];
-    if (c.p.x == p.x && c.p.y == p.y && c.p.z == p.z) {
-      d = c.d, t = c.t;
-      return d * d <= e2_;
-    }
+    NearEntry& c = near_cache_[i];
+    if (c.p.x == p.x && c.p.y == p.y && c.p.z == p.z) return c;
   }
-  double d2;
-  t = bvh_.nearest(p, d2, hint);
-  d = std::sqrt(d2);
-  near_cache_[i] = {p, d, t, near_gen_};
+  NearEntry& c = near_cache_[i];
+  c.p = p, c.gen = near_gen_, c.has_ring = false, c.has_exact = false;
   ++near_used_;
-  return d2 <= e2_;
+  return c;
 }
 
-bool Simplifier::within_original(uint32_t tri) {
+// Through the ring: min over its triangles T of d(p, T) + tri_err_[T].
+Simplifier::Near Simplifier::ring_bound(Vec3 p) {
+  NearEntry& c = near_entry(p);
+  if (c.has_ring) return c.ring;
+  c.has_ring = true;
+  c.ring = {std::numeric_limits<double>::infinity(), -1};
+  for (size_t k = 0; k < ring_.size(); ++k) {
+    const uint32_t t = ring_[k];
+    const double e = tri_err_[t];
+    if (e >= c.ring.b) continue;
+    const double d2 = geom::point_triangle_dist2(p, pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]]);
+    const double r = c.ring.b - e;
+    if (d2 >= r * r) continue;
+    c.ring = {std::sqrt(d2) + e, -1 - static_cast<int64_t>(k)};
+  }
+  return c.ring;
+}
+
+// The distance to the original itself (its nearest triangle, through the
+// BVH).
+Simplifier::Near Simplifier::exact_bound(Vec3 p, int64_t hint) {
+  NearEntry& c = near_entry(p);
+  if (!c.has_exact) {
+    double d2;
+    const int64_t t = bvh_.nearest(p, d2, hint);
+    c.exact = {std::sqrt(d2), t};
+    c.has_exact = true;
+  }
+  return c.exact;
+}
+
+// The smallest bound of d(x, original) over the points x of the triangle p
+// that one test proves (+inf when none): convexity of the distance to one
+// triangle (a corner's reference triangle, plus its own error), or the
+// corners' bounds plus the covering radius (the distance is 1-Lipschitz).
+double Simplifier::leaf_bound(const Vec3 p[3], const Near n[3]) const {
+  double best = std::max({n[0].b, n[1].b, n[2].b}) + longest_edge(p[0], p[1], p[2]) / std::sqrt(3.0);
+  const double e = std::sqrt(e2_);
+  for (int k = 0; k < 3; ++k) {
+    const int64_t ref = n[k].ref;
+    if ((k > 0 && ref == n[0].ref) || (k > 1 && ref == n[1].ref)) continue;
+    Vec3 a, b, c;
+    double own = 0;
+    if (ref >= 0) {
+      a = orig_.corner(static_cast<size_t>(ref), 0), b = orig_.corner(static_cast<size_t>(ref), 1),
+      c = orig_.corner(static_cast<size_t>(ref), 2);
+    } else {
+      const uint32_t t = ring_[static_cast<size_t>(-1 - ref)];
+      a = pos_[tri_[t][0]], b = pos_[tri_[t][1]], c = pos_[tri_[t][2]], own = tri_err_[t];
+    }
+    const double limit = std::min(best, e) - own;  // only a better bound within E is of use
+    if (!(limit >= 0)) continue;
+    double worst2 = 0;
+    for (int j = 0; j < 3 && worst2 <= limit * limit; ++j)
+      worst2 = std::max(worst2, geom::point_triangle_dist2(p[j], a, b, c));
+    if (worst2 <= limit * limit) best = std::min(best, std::sqrt(worst2) + own);
+  }
+  return best;
+}
+
+// The new triangle t within E of one original triangle of local_orig_;
+// err gets its largest corner distance.
+bool Simplifier::near_local_original(uint32_t t, double& err) {
+  const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
+  for (uint32_t o : local_orig_) {
+    const Vec3 oa = orig_.corner(o, 0), ob = orig_.corner(o, 1), oc = orig_.corner(o, 2);
+    double worst = geom::point_triangle_dist2(a, oa, ob, oc);
+    if (worst > e2_) continue;
+    worst = std::max(worst, geom::point_triangle_dist2(b, oa, ob, oc));
+    if (worst > e2_) continue;
+    worst = std::max(worst, geom::point_triangle_dist2(c, oa, ob, oc));
+    if (worst > e2_) continue;
+    err = std::sqrt(worst);
+    return true;
+  }
+  return false;
+}
+
+// The new triangle t within E of the original; err gets the bound proved.
+bool Simplifier::within_original(uint32_t tri, double& err) {
   Vec3 p[3];
-  double d[3];
-  int64_t t[3];
-  int64_t hint = -1;
+  Near n[3];
   for (int k = 0; k < 3; ++k) {
     p[k] = new_corner(tri, k);
-    if (!nearest_original(p[k], d[k], t[k], hint)) return false;
-    hint = t[k];
+    n[k] = ring_bound(p[k]);
   }
-  return within_original_rec(p, d, t, 0);
+  err = 0;
+  return within_original_rec(p, n, 0, err);
 }
 
-// p: corners, d: their distances to the original, t: their nearest triangles.
-bool Simplifier::within_original_rec(const Vec3 p[3], const double d[3], const int64_t t[3], uint32_t depth) {
+// p: corners, n: their bounds (the new triangle's corners through the
+// ring, cut points through the BVH). A part the bounds do not prove is
+// tried with the distances to the original at its corners, then cut in
+// four; err gets the largest bound of the parts proved.
+bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth, double& err) {
   const double e = std::sqrt(e2_);
-  if (std::max({d[0], d[1], d[2]}) + longest_edge(p[0], p[1], p[2]) / std::sqrt(3.0) <= e) return true;
+  double b = leaf_bound(p, n);
+  if (b <= e) {
+    err = std::max(err, b);
+    return true;
+  }
+  // Corners bounded through the ring: their distances to the original.
+  int64_t hint = -1;
+  bool ring = false;
   for (int k = 0; k < 3; ++k) {
-    const Vec3 a = orig_.corner(t[k], 0), b = orig_.corner(t[k], 1), c = orig_.corner(t[k], 2);
-    if (geom::point_triangle_dist2(p[0], a, b, c) <= e2_ && geom::point_triangle_dist2(p[1], a, b, c) <= e2_ &&
-        geom::point_triangle_dist2(p[2], a, b, c) <= e2_)
+    if (n[k].ref >= 0) hint = n[k].ref;
+    ring = ring || n[k].ref < 0;
+  }
+  if (ring) {
+    for (int k = 0; k < 3; ++k) {
+      if (n[k].ref < 0) n[k] = exact_bound(p[k], hint);
+      if (!(n[k].b <= e)) return false;
+      hint = n[k].ref;
+    }
+    b = leaf_bound(p, n);
+    if (b <= e) {
+      err = std::max(err, b);
       return true;
+    }
   }
   if (depth >= kMaxCheckDepth) return false;
   const Vec3 m[3] = {(p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5, (p[2] + p[0]) * 0.5};
-  double dm[3];
-  int64_t tm[3];
-  for (int k = 0; k < 3; ++k) {
-    // Cut points are shared with the neighbouring part (and at the first
-    // cut with the neighbouring new triangle).
-    if (!nearest_original(m[k], dm[k], tm[k], t[k])) return false;
-  }
+  Near nm[3];
+  for (int k = 0; k < 3; ++k) nm[k] = exact_bound(m[k], n[k].ref);
   const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
              c3[3] = {m[0], m[1], m[2]};
-  const double d0[3] = {d[0], dm[0], dm[2]}, d1[3] = {dm[0], d[1], dm[1]}, d2[3] = {dm[2], dm[1], d[2]},
-               d3[3] = {dm[0], dm[1], dm[2]};
-  const int64_t t0[3] = {t[0], tm[0], tm[2]}, t1[3] = {tm[0], t[1], tm[1]}, t2[3] = {tm[2], tm[1], t[2]},
-                t3[3] = {tm[0], tm[1], tm[2]};
-  return within_original_rec(c3, d3, t3, depth + 1) && within_original_rec(c0, d0, t0, depth + 1) &&
-         within_original_rec(c1, d1, t1, depth + 1) && within_original_rec(c2, d2, t2, depth + 1);
+  Near n0[3] = {n[0], nm[0], nm[2]}, n1[3] = {nm[0], n[1], nm[1]}, n2[3] = {nm[2], nm[1], n[2]},
+       n3[3] = {nm[0], nm[1], nm[2]};
+  return within_original_rec(c3, n3, depth + 1, err) && within_original_rec(c0, n0, depth + 1, err) &&
+         within_original_rec(c1, n1, depth + 1, err) && within_original_rec(c2, n2, depth + 1, err);
 }
 
 // Collapse u into v placed at x: flips, degeneracy and the bound.
@@ -623,15 +831,6 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
     if (!(geom::dot(n_old, n_new) > 0)) return false;         // flipped (90 degrees or more)
   }
   if (!bounded_) return true;
-  // Unchanged triangles around the new ring may take pieces too.
-  near_tris_.clear();
-  for (uint32_t t : new_tris_)
-    for (uint32_t w : tri_[t])
-      if (w != u && w != v)
-        for (uint32_t s : vtris_[w])
-          if (std::find(changed_.begin(), changed_.end(), s) == changed_.end() &&
-              std::find(near_tris_.begin(), near_tris_.end(), s) == near_tris_.end())
-            near_tris_.push_back(s);
   // First the original triangles whose pieces the changed triangles hold:
   // a new triangle within E of one of them needs no search.
   local_orig_.clear();
@@ -643,17 +842,9 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
       orig_mark_[o] = orig_mark_gen_;
       local_orig_.push_back(o);
     }
-  for (uint32_t t : new_tris_) {
-    const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
-    bool near = false;
-    for (size_t i = 0; i < local_orig_.size() && !near; ++i) {
-      const Vec3 oa = orig_.corner(local_orig_[i], 0), ob = orig_.corner(local_orig_[i], 1),
-                 oc = orig_.corner(local_orig_[i], 2);
-      near = geom::point_triangle_dist2(a, oa, ob, oc) <= e2_ && geom::point_triangle_dist2(b, oa, ob, oc) <= e2_ &&
-             geom::point_triangle_dist2(c, oa, ob, oc) <= e2_;
-    }
-    if (!near && !within_original(t)) return false;
-  }
+  new_err_.resize(new_tris_.size());
+  for (size_t i = 0; i < new_tris_.size(); ++i)
+    if (!near_local_original(new_tris_[i], new_err_[i]) && !within_original(new_tris_[i], new_err_[i])) return false;
   return assign_pieces(changed_);
 }
 
@@ -727,11 +918,14 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   quad_[v].add(quad_[u]);
   // The pieces: the changed triangles' lists are rebuilt from placed_.
   if (bounded_) {
-    for (uint32_t t : changed_) {
-      for (uint32_t pi : tri_pieces_[t]) free_pieces_.push_back(pi);
-      tri_pieces_[t].clear();
+    for (size_t i = 0; i < new_tris_.size(); ++i) tri_err_[new_tris_[i]] = new_err_[i];
+    for (uint32_t t : changed_) tri_pieces_[t].clear();
+    for (const Placed& pl : placed_) {
+      pieces_[pl.piece].delta = pl.delta;
+      tri_pieces_[pl.t].push_back(pl.piece);
     }
-    for (const auto& [t, pc] : placed_) {
+    for (uint32_t pi : cut_) free_pieces_.push_back(pi);
+    for (const auto& [t, pc] : placed_new_) {
       uint32_t pi;
       if (!free_pieces_.empty()) {
         pi = free_pieces_.back();
@@ -796,6 +990,9 @@ bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
   std::vector<uint32_t> edge_tris;
   if (!topology_ok(a, b, edge_tris)) return false;
   clear_near_cache();
+  ring_ = vtris_[a];
+  for (uint32_t t : vtris_[b])
+    if (std::find(edge_tris.begin(), edge_tris.end(), t) == edge_tris.end()) ring_.push_back(t);
   Quadric q = quad_[a];
   q.add(quad_[b]);
   for (const Place& p : placements(a, b, q))
@@ -870,7 +1067,7 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
   init_quadrics();
   report.faces_in = tri_.size();
   report.vertices_in = pos_.size();
-  for (uint32_t v = 0; v < pos_.size(); ++v) push_edges_of(v);
+  for (uint32_t v = 0; v < pos_.size(); ++v) push_edges_of(v, true);
   uint64_t since = 0;
   while (!heap_.empty() && live_faces() > o_.target_faces) {
     const Candidate c = heap_.top();
@@ -893,6 +1090,8 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
   report.collapses = collapses_;
   report.rejected = rejected_;
   report.locked_vertices = locked_count_;
+  for (uint32_t t = 0; t < tri_.size(); ++t)
+    if (tri_alive_[t]) report.result_error = std::max(report.result_error, tri_err_[t]);
   return Status::Ok();
 }
 
