@@ -13,7 +13,7 @@ bool meshopt_available();
 struct MeshoptRun {
   bool ok = false;
   Mesh mesh;              // positions as given, the kept triangles
-  double ms = 0;          // the one meshopt_simplify call that made `mesh`
+  double ms = 0;          // the one meshopt_simplify call that made `mesh` (thread CPU time)
   double own_error = 0;   // meshoptimizer's own error estimate, model units
   double measured = 0;    // by `measure`, model units
 };
