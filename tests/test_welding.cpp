@@ -451,6 +451,30 @@ TEST(IndexedCorners, RanksKeepCoincidingValuesAndPointsApart) {
   expect_exact(both, "both", 8);
 }
 
+namespace {
+
+// Decodes `bytes` with every `stride`-th byte XORed with `mask`, one at a
+// time: each decode must fail with a message or give a valid mesh. Returns
+// how many were refused.
+int refused_flips(const std::string& bytes, size_t stride, int mask) {
+  int refused = 0;
+  for (size_t i = 0; i < bytes.size(); i += stride) {
+    std::string bad = bytes;
+    bad[i] = static_cast<char>(bad[i] ^ mask);
+    Mesh out;
+    const Status s = decode(bad, out);
+    if (!s.ok()) {
+      EXPECT_FALSE(s.message().empty());
+      ++refused;
+    } else {
+      EXPECT_TRUE(out.valid());
+    }
+  }
+  return refused;
+}
+
+}  // namespace
+
 // A file with ranks (FORMAT.md §8.13 points out), each byte flipped in turn:
 // refused with a message, or a valid mesh; never a crash.
 TEST(IndexedCorners, DamagedRanksRefusedOrValid) {
@@ -462,20 +486,7 @@ TEST(IndexedCorners, DamagedRanksRefusedOrValid) {
   ASSERT_TRUE(encode(m, EncodeOptions(), bytes).ok());
   ASSERT_GT(coded_vertices(bytes), m.vertex_count());
   // Flip every byte once: each decode fails cleanly or gives a valid mesh.
-  int refused = 0;
-  for (size_t i = 0; i < bytes.size(); ++i) {
-    std::string bad = bytes;
-    bad[i] = static_cast<char>(bad[i] ^ 0xFF);
-    Mesh out;
-    const Status s = decode(bad, out);
-    if (!s.ok()) {
-      EXPECT_FALSE(s.message().empty());
-      ++refused;
-    } else {
-      EXPECT_TRUE(out.valid());
-    }
-  }
-  EXPECT_GT(refused, 0);
+  EXPECT_GT(refused_flips(bytes, 1, 0xFF), 0);
 }
 
 // A PLY holds corner values one per corner; its reader shares equal ones
@@ -560,18 +571,5 @@ TEST(IndexedCorners, SeamsCrossedByTheEdgeOfTheOtherSide) {
   const std::string bytes = expect_exact(mirrored, "mirrored charts");
   EXPECT_GT(coded_vertices(bytes), mirrored.vertex_count()) << "coded as split vertices";
   expect_exact(turned, "turned charts");
-  int refused = 0;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    std::string bad = bytes;
-    bad[i] = static_cast<char>(bad[i] ^ 0x5A);
-    Mesh out;
-    const Status s = decode(bad, out);
-    if (!s.ok()) {
-      EXPECT_FALSE(s.message().empty());
-      ++refused;
-    } else {
-      EXPECT_TRUE(out.valid());
-    }
-  }
-  EXPECT_GT(refused, 0);
+  EXPECT_GT(refused_flips(bytes, 3, 0x5A), 0);
 }
