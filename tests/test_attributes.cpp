@@ -1,4 +1,4 @@
-// Attributes (issue: normals, colours, texture coordinates): per vertex, per
+// Attributes (normals, colours, texture coordinates): per vertex, per
 // face and per corner (seams and creases), through encode and decode, exact
 // up to each attribute's quantization; in segments and streamed.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Welding (issue 36, FORMAT.md §8.13): a mesh with attributes whose faces
+// Welding (FORMAT.md §8.13): a mesh with attributes whose faces
 // use several vertices at one position (flat shading, texture seams, CAD
 // parts) is coded on one point per grid position and the split layout; the
 // decoder gives back the same split vertices with the same values. Exact by

@@ -234,7 +234,7 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
   return anchors ? anchor_step(mesh, qin, is_ref, options.quantization_bits, hints, ce, view) : Status::Ok();
 }
 
-// Canonical re-encoding (issue 3): a decoded mesh must encode to the bytes
+// Canonical re-encoding: a decoded mesh must encode to the bytes
 // it came from. The coder's choices follow vertex ids and face order, and
 // the decoder's order reproduces them, except where vertices were split and
 // stitched back: there the decoded order lets the cut find another copy of

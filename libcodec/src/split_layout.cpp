@@ -1,4 +1,4 @@
-// Welding, the split layout (FORMAT.md §8.13; issue 36): a mesh with
+// Welding, the split layout (FORMAT.md §8.13): a mesh with
 // attributes usually repeats a position wherever a normal, texture
 // coordinate or colour changes (a flat-shaded model three times per
 // triangle, a CAD part once per face normal). The encoder codes one point
