@@ -137,12 +137,6 @@ std::set<AttributeKind> kinds_of(const Mesh& m) {
   return kinds;
 }
 
-bool has_kind(const Mesh& m, AttributeKind k) {
-  for (const Attribute& a : m.attributes)
-    if (a.kind == k) return true;
-  return false;
-}
-
 std::string lower_extension(const std::string& path) {
   std::string e = fs::path(path).extension().string();
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -264,7 +258,7 @@ AttributeFileRow bench_attribute_file(const std::string& path, const Mesh& input
   if (ext == ".obj" || ext == ".ply") inputs.push_back({"the file", path});
   const std::string stem = (fs::path(work_dir) / ("attr_" + std::to_string(q) + "_" + fs::path(path).stem().string())).string();
   // Colours go through PLY (Draco's OBJ reader has none), the rest through OBJ.
-  const std::string split_ext = has_kind(m, AttributeKind::color) ? ".ply" : ".obj";
+  const std::string split_ext = want.count(AttributeKind::color) ? ".ply" : ".obj";
   WriteOptions wo;
   wo.ascii = true;
   if (write_mesh(stem + "_split" + split_ext, with_byte_colors(split_vertices(m)), wo).ok())

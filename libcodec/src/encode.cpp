@@ -1175,14 +1175,20 @@ Mesh in_own_order(const Mesh& mesh, const std::vector<uint32_t>& qin, const std:
     for (uint32_t j = 1; j < n; ++j)
       if (key[o + j] < key[o + first[f]]) first[f] = j;
   }
-  auto corners = [&](uint32_t f) {
-    std::vector<std::vector<int32_t>> c;
-    const uint32_t o = mesh.face_offsets[f], n = mesh.face_size(f);
-    for (uint32_t j = 0; j < n; ++j) c.push_back(key[o + (first[f] + j) % n]);
-    return c;
+  // Faces compared corner by corner from their first, the shorter first on a
+  // tie (without building each face's key list per comparison).
+  auto face_less = [&](uint32_t a, uint32_t b) {
+    const uint32_t oa = mesh.face_offsets[a], na = mesh.face_size(a);
+    const uint32_t ob = mesh.face_offsets[b], nb = mesh.face_size(b);
+    for (uint32_t j = 0; j < std::min(na, nb); ++j) {
+      const std::vector<int32_t>& ka = key[oa + (first[a] + j) % na];
+      const std::vector<int32_t>& kb = key[ob + (first[b] + j) % nb];
+      if (ka != kb) return ka < kb;
+    }
+    return na < nb;
   };
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return corners(a) < corners(b); });
+  std::stable_sort(order.begin(), order.end(), face_less);
   Mesh out = mesh;
   for (uint32_t i = 0; i < V; ++i) std::copy_n(&mesh.positions[3 * size_t{perm[i]}], 3, &out.positions[3 * size_t{i}]);
   std::vector<uint32_t> from(K);  // per new corner, its input corner
