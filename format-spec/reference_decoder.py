@@ -143,16 +143,18 @@ def read_container(data):
     h['corner_count'], p = read_varint(data, p, n)
     if n - p < 2 + 12 + 4:
         reject('header fields')                                     # step 5
-    grid = data[p]
+    grid, level = data[p], data[p + 1]
     h['bits'] = grid & 0x1F
     axis = grid >> 6
-    h['level'] = data[p + 1]
+    h['level'] = level & 0x0F
     p += 2
     h['origin'] = list(struct.unpack_from('<3f', data, p))
     p += 12
     top = struct.unpack_from('<f', data, p)[0]
     p += 4
-    h['segment_count'], p = read_varint(data, p, n)                 # step 6
+    h['segment_count'] = 1
+    if level & 0x10:                                                # step 6: several segments
+        h['segment_count'], p = read_varint(data, p, n)
     h['exact'] = None
     if grid & 0x20:                                                 # step 7, §5.1: the exact grid
         if n - p < 8:
@@ -168,8 +170,8 @@ def read_container(data):
         h['exact'] = (step, base)
     if axis > 2:
         reject('grid axis')                                         # step 8
-    if not 1 <= h['segment_count'] <= 0xFFFFFFFF:
-        reject('segment count')                                     # step 9
+    if level & 0xE0 or (level & 0x10 and not 2 <= h['segment_count'] <= 0xFFFFFFFF):
+        reject('level byte or segment count')                       # step 9
     if not all(math.isfinite(o) for o in h['origin']):
         reject('origin')                                            # step 10
     if not (math.isfinite(top) and top >= h['origin'][axis]):
@@ -1853,16 +1855,26 @@ def read_attribute_header(buf, p):
     h.origin = []
     h.extent = 0.0
     if h.quant == 1:
-        if end - p < 1 + 4 * h.components + 4:
-            reject('attributes: truncated grid')
-        axis = buf[p]
+        if end - p < 1:
+            reject('attributes: truncated attribute header')
+        grid = buf[p]
         p += 1
-        if axis >= h.components:
-            reject('attributes: bad grid axis')
-        h.origin = list(struct.unpack_from('<%df' % h.components, buf, p))
-        p += 4 * h.components
-        top = struct.unpack_from('<f', buf, p)[0]
-        p += 4
+        axis = grid & 3
+        if axis >= h.components or grid >> 7 or grid >> (2 + h.components) & ((1 << (4 - h.components)) - 1):
+            reject('attributes: bad grid byte')
+        values = []
+        for bit in [2 + c for c in range(h.components)] + [6]:
+            if grid >> bit & 1:                              # short: an i8, the value times 64
+                if end - p < 1:
+                    reject('attributes: truncated grid')
+                values.append(struct.unpack_from('<b', buf, p)[0] / 64.0)
+                p += 1
+            else:
+                if end - p < 4:
+                    reject('attributes: truncated grid')
+                values.append(struct.unpack_from('<f', buf, p)[0])
+                p += 4
+        h.origin, top = values[:-1], values[-1]
         if not all(math.isfinite(o) for o in h.origin):
             reject('attributes: bad grid origin')
         if not (math.isfinite(top) and top >= h.origin[axis]):

@@ -643,9 +643,10 @@ def split_container(data):
     _, p = read_varint(data, 4, n)
     for _ in range(3):
         _, p = read_varint(data, p, n)
-    grid = data[p]
+    grid, level = data[p], data[p + 1]
     p += 18
-    _, p = read_varint(data, p, n)
+    if level & 0x10:
+        _, p = read_varint(data, p, n)
     if grid & 0x20:
         p += 8
         for _ in range(3):

@@ -66,8 +66,8 @@ inline void set_u32(std::string& s, size_t at, uint32_t v) {
 
 // The end of the header (FORMAT.md §2-3): after the magic, the version
 // varint, the three counts, the grid and level bytes, origin and maximum
-// (16 bytes), the segment count and, with the grid byte's exact flag, the
-// exact grid's step and base. Sets `counts_end` to the end of the counts.
+// (16 bytes), with the level byte's bit 4 the segment count and, with the
+// grid byte's exact flag, the exact grid's step and base. Sets `counts_end` to the end of the counts.
 inline bool header_end(std::string_view file, size_t& p, size_t& counts_end) {
   uint64_t v = 0;
   p = 4;
@@ -77,8 +77,9 @@ inline bool header_end(std::string_view file, size_t& p, size_t& counts_end) {
   counts_end = p;
   if (file.size() - p < 18) return false;
   const bool exact = (static_cast<uint8_t>(file[p]) & 0x20) != 0;
+  const bool segmented = (static_cast<uint8_t>(file[p + 1]) & 0x10) != 0;
   p += 18;
-  if (!get_varint(file, p, v)) return false;
+  if (segmented && !get_varint(file, p, v)) return false;
   if (!exact) return true;
   if (file.size() - p < 8) return false;
   p += 8;

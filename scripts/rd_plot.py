@@ -49,8 +49,10 @@ def level_ends(path):
     pos = 4
     for _ in range(4):  # version, vertex, face and corner counts
         _, pos = varint(data, pos)
-    grid = data[pos]
-    _, pos = varint(data, pos + 18)  # grid, level, origin, top; segment count
+    grid, level = data[pos], data[pos + 1]
+    pos += 18  # grid, level, origin, top
+    if level & 0x10:  # several segments: their count
+        _, pos = varint(data, pos)
     if grid & 0x20:  # the exact grid's step and base
         pos += 8
         for _ in range(3):

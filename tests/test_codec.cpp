@@ -461,7 +461,7 @@ TEST(Codec, RandomSingleByteCorruptionNeverCrashes) {
 struct Parsed {
   uint64_t version = 0;
   uint64_t vertices = 0, faces = 0, corners = 0;
-  uint8_t grid = 0, level = 0;  // grid: quantization bits | 0x20 exact | axis << 6
+  uint8_t grid = 0, level = 0;  // grid: quantization bits | 0x20 exact | axis << 6; level | 0x10 segmented
   float origin[3] = {0, 0, 0};
   float top = 0;  // the bounding box's maximum on the grid byte's axis
   uint64_t segments = 0;
@@ -516,7 +516,7 @@ Parsed parse(const std::string& file) {
   h.level = static_cast<uint8_t>(file.at(p++));
   for (float& o : h.origin) o = get_f32(file, p);
   h.top = get_f32(file, p);
-  h.segments = get_varint(file, p);
+  h.segments = (h.level & 0x10) ? get_varint(file, p) : 1;
   const size_t first = p;
   const uint64_t tag = get_varint(file, p);
   const uint64_t stored = get_varint(file, p);
@@ -537,7 +537,7 @@ std::string build(const Parsed& h) {
   s.push_back(static_cast<char>(h.level));
   for (float o : h.origin) put_f32(s, o);
   put_f32(s, h.top);
-  put_varint(s, h.segments);
+  if (h.level & 0x10) put_varint(s, h.segments);
   s += h.first;
   put_le(s, XXH32(s.data(), s.size(), 0), 4);
   return s + h.rest;
@@ -630,10 +630,16 @@ TEST(Codec, ForgedHeaderFieldsRefused) {
     h.grid |= 0xc0;
     EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
   }
-  {
+  for (uint64_t segments : {0, 1}) {  // a segment count follows only for 2 or more
     Parsed h = good;
-    h.segments = 0;
-    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
+    h.level |= 0x10;
+    h.segments = segments;
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << segments;
+  }
+  for (int bit : {0x20, 0x40, 0x80}) {  // the level byte's bits 5-7
+    Parsed h = good;
+    h.level = static_cast<uint8_t>(h.level | bit);
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << bit;
   }
   {
     // The header is covered by the first section's checksum.
@@ -753,7 +759,7 @@ std::string spec_example_bytes() {
 // it).
 TEST(Codec, FormatSpecWorkedExampleIsCurrent) {
   const std::string example = spec_example_bytes();
-  ASSERT_EQ(example.size(), 58u) << "could not read the example from " << TSM_FORMAT_SPEC;
+  ASSERT_EQ(example.size(), 57u) << "could not read the example from " << TSM_FORMAT_SPEC;
   tsm::Mesh m;
   m.add_vertex(0, 0, 0);
   m.add_vertex(2, 0, 0);

@@ -796,6 +796,16 @@ TEST(Corruption, ForgedMetadataRefused) {
   EXPECT_EQ(guarded_decode(build(twice)).status.code(), ErrorCode::corrupt_data) << "two metadata sections";
 }
 
+// The bytes of an attribute grid (FORMAT.md §8.12) of `components` values
+// at `at`: its grid byte, then each origin and the top, one byte when the
+// grid byte marks it short, else four.
+size_t grid_bytes(const std::string& payload, size_t at, uint32_t components) {
+  const uint32_t grid = static_cast<uint8_t>(payload.at(at));
+  size_t n = 1;
+  for (uint32_t c = 0; c < components; ++c) n += (grid >> (2 + c) & 1) ? 1 : 4;
+  return n + ((grid >> 6 & 1) ? 1 : 4);
+}
+
 // An attribute's type and quantization pair one way only (FORMAT.md §8.12):
 // integer types are coded exactly, f32 on a grid or octahedrally. fuzz_decode
 // found a forged file whose u8 attribute said "octahedral" and decoded to
@@ -843,9 +853,9 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   grid_u8[c_at + 7] = 1 | 8 << 2;
   grid_u8.insert(c_at + 8, std::string(1 + 3 * 4 + 4, '\0'));
   cases.push_back({"u8 grid", grid_u8, "integer attribute not coded as exact"});
-  std::string exact_f32 = payload;  // f32 temp as exact integers: axis, origin and top dropped
+  std::string exact_f32 = payload;  // f32 temp as exact integers: the grid byte, origin and top dropped
   exact_f32[t_at + 6] = 0;
-  exact_f32.erase(t_at + 7, 1 + 4 + 4);
+  exact_f32.erase(t_at + 7, grid_bytes(payload, t_at + 7, 1));
   cases.push_back({"f32 exact", exact_f32, "f32 attribute coded as exact integers"});
   for (const Case& k : cases) {
     Container c = good;
@@ -877,11 +887,12 @@ TEST(Corruption, PerVertexCodingOfAVertexAttributeRefused) {
     if (good.sections[i].id == 10) at = i;
   ASSERT_LT(at, good.sections.size()) << "no mesh section";
   ASSERT_EQ(good.sections[at].codec, 0);
-  // Header: name (5 bytes), layout, coding, axis, origin (f32), top (f32); then the predictor byte.
+  // Header: name (5 bytes), layout, coding, the grid (byte, origin, top); then the predictor byte.
   const size_t t_at = good.sections[at].stored.find(std::string("\x0e" "temp\x00", 6));
   ASSERT_NE(t_at, std::string::npos) << "temp header not found";
   Container c = good;
-  c.sections[at].stored[t_at + 16] = static_cast<char>(c.sections[at].stored[t_at + 16] | 0x10);
+  const size_t predictor_at = t_at + 7 + grid_bytes(good.sections[at].stored, t_at + 7, 1);
+  c.sections[at].stored[predictor_at] = static_cast<char>(c.sections[at].stored[predictor_at] | 0x10);
   const DecodeResult r = guarded_decode(build(c));
   expect_clean(r, "per-vertex bit on a vertex attribute");
   EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << describe(r);

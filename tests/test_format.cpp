@@ -672,3 +672,32 @@ TEST(Format, EveryLevelRoundTripsCanonically) {
 }
 
 }  // namespace
+
+namespace {
+
+// FORMAT.md §8.12: a grid bound that is a multiple of 1/64 in -2 .. 2 (0,
+// 0.25, 1: texture coordinates in 0..1) takes one byte instead of four;
+// the same grid shifted off those values costs 3 bytes more per bound,
+// codes the same values, and both round trip and re-encode to their bytes.
+TEST(Format, GridBoundsOnSixtyFourthsTakeOneByte) {
+  std::string bytes[2];
+  for (int shifted = 0; shifted < 2; ++shifted) {
+    Mesh m = tsm_test::icosphere(0);
+    const float off = shifted ? 1.0f / 1024 : 0.0f;
+    tsm::Attribute uv;
+    uv.name = "texcoord";
+    uv.kind = tsm::AttributeKind::texcoord;
+    uv.components = 2;
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      uv.values.push_back(static_cast<float>(v % 5) / 4.0f + off);
+      uv.values.push_back(static_cast<float>(v % 3) / 2.0f + off);
+    }
+    m.attributes = {uv};
+    bytes[shifted] = encode(m, 12, 6);
+    expect_round_trip(m, bytes[shifted], 12, shifted ? "shifted" : "on sixty-fourths");
+    EXPECT_EQ(encode(decode_ok(bytes[shifted]), 12, 6), bytes[shifted]) << "canonical re-encoding";
+  }
+  EXPECT_EQ(bytes[0].size() + 3 * 3, bytes[1].size()) << "two origins and the top, 1 byte each instead of 4";
+}
+
+}  // namespace

@@ -60,6 +60,10 @@ constexpr uint16_t kHeaderExactGrid = 1;
 constexpr uint8_t kGridBitsMask = 0x1f;
 constexpr uint8_t kGridExact = 0x20;
 constexpr int kGridAxisShift = 6;
+// The header's level byte: the level (bits 0-3) and, in bit 4, that a
+// segment count (2 or more) follows the grid's top; without it, 1 segment.
+constexpr uint8_t kLevelMask = 0x0f;
+constexpr uint8_t kLevelSegmented = 0x10;
 
 struct Section {
   uint16_t id = 0;

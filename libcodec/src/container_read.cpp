@@ -82,13 +82,13 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
   header.version = kFormatVersion;
   // A read cut off by the end of the bytes leaves fewer than 8 of them
   // (the widest fixed field): with more, a varint is invalid.
-  uint8_t grid = 0;
+  uint8_t grid = 0, level = 0;
   float top = 0;
-  uint64_t segments = 0;
+  uint64_t segments = 1;
   bool ok = r.varint(header.vertex_count) && r.varint(header.face_count) && r.varint(header.corner_count) &&
-            r.u8(grid) && r.u8(header.level);
+            r.u8(grid) && r.u8(level);
   for (float& o : header.origin) ok = ok && r.f32(o);
-  ok = ok && r.f32(top) && r.varint(segments);
+  ok = ok && r.f32(top) && (!(level & kLevelSegmented) || r.varint(segments));
   header.flags = (grid & kGridExact) ? kHeaderExactGrid : 0;
   if (ok && (grid & kGridExact)) {
     ok = r.f64(header.exact_step);
@@ -104,6 +104,8 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
     return Status::Ok();
   }
   header.quantization_bits = grid & kGridBitsMask;
+  header.level = level & kLevelMask;
+  if (level & ~(kLevelMask | kLevelSegmented)) return corrupt("header level byte has bits 5-7 set");
   const int axis = grid >> kGridAxisShift;
   if (axis > 2) return corrupt("header grid byte names axis 3");
   if (header.quantization_bits < 1 || header.quantization_bits > 30)
@@ -117,7 +119,7 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
     return corrupt("the exact grid's step is not a finite positive number");
   for (int64_t b : header.exact_base)
     if (b > (int64_t{1} << 62) || b < -(int64_t{1} << 62)) return corrupt("the exact grid's base is out of range");
-  if (segments == 0 || segments > 0xffffffffu) return corrupt("bad segment count");
+  if ((level & kLevelSegmented) && (segments < 2 || segments > 0xffffffffu)) return corrupt("bad segment count");
   header.segment_count = static_cast<uint32_t>(segments);
   offset = r.offset();
   return Status::Ok();

@@ -23,10 +23,10 @@ void write_header_fields(ByteWriter& w, const Header& h) {
   const int axis = extent_axis(h.origin, 3, h.extent, top);
   const bool exact = (h.flags & kHeaderExactGrid) != 0;
   w.u8(static_cast<uint8_t>(h.quantization_bits | (exact ? kGridExact : 0) | axis << kGridAxisShift));
-  w.u8(h.level);
+  w.u8(static_cast<uint8_t>(h.level | (h.segment_count > 1 ? kLevelSegmented : 0)));
   for (float o : h.origin) w.f32(o);
   w.f32(top);
-  w.varint(h.segment_count);
+  if (h.segment_count > 1) w.varint(h.segment_count);
   if (exact) {
     w.f64(h.exact_step);
     for (int64_t b : h.exact_base) w.varint((static_cast<uint64_t>(b) << 1) ^ static_cast<uint64_t>(b >> 63));

@@ -38,12 +38,13 @@ const varint = () => { let v = 0, s = 1; for (;;) { const c = src[at++]; v += (c
 const putVarint = (v, out) => { while (v >= 0x80) { out.push((v % 128) | 0x80); v = Math.floor(v / 128); } out.push(v); };
 if (src.subarray(0, 4).toString('latin1') !== 'TSM\x1a') throw new Error('not a .tsm file');
 // The header (FORMAT.md §3): version, three counts, grid and level bytes,
-// origin and top (16 bytes), segment count, the exact grid's fields.
+// origin and top (16 bytes), the segment count (level bit 4), the exact
+// grid's fields (grid bit 5).
 at = 4;
 for (let i = 0; i < 4; i++) varint();
-const grid = src[at];
+const grid = src[at], level = src[at + 1];
 at += 18;
-varint();
+if (level & 0x10) varint();
 if (grid & 0x20) { at += 8; for (let i = 0; i < 3; i++) varint(); }
 const parts = [src.subarray(0, at)];
 let first = true, recoded = 0;
