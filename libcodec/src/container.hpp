@@ -92,7 +92,7 @@ class ContainerWriter {
 void append_raw_section(std::string& file, uint16_t id, std::string_view payload);
 // The end marker (FORMAT.md §4.4): one byte.
 constexpr size_t kEndMarkerBytes = 1;
-void append_end_marker(std::string& file);
+inline void append_end_marker(std::string& file) { file.push_back(static_cast<char>(kSectionEnd)); }
 // The bytes of a section's framing (id and codec, lengths, checksum).
 uint64_t section_framing_bytes(const Section& s);
 

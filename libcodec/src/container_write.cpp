@@ -75,8 +75,6 @@ void append_raw_section(std::string& file, uint16_t id, std::string_view payload
   put_section(file, file.size(), id, SectionCodec::raw, payload, payload.size());
 }
 
-void append_end_marker(std::string& file) { file.push_back(static_cast<char>(kSectionEnd)); }
-
 std::string ContainerWriter::finish() {
   append_end_marker(out_);
   return std::move(out_);
