@@ -260,10 +260,10 @@ for op in mode=2 mode=0 cut=1 cut=7 cut=40 cut=300; do
 done
 # Attribute headers (§8.12): an integer type on a grid, f32 as exact integers.
 forge="$PY $here/test_meshes.py --replace-in-mesh"
-forged forged_u16_grid $forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 056c6162656c000002010000 \
-  056c6162656c000002010108000000000000000000000000 && refused forged_u16_grid
+forged forged_u16_grid $forge "$work/attributes_ply_l0.tsm" "$work/forged_u16_grid.tsm" 0f6c6162656c2000 \
+  0f6c6162656c2021000000000000000000 && refused forged_u16_grid
 forged forged_f32_exact $forge "$work/attributes_ply_l0.tsm" "$work/forged_f32_exact.tsm" \
-  0b74656d70657261747572650000000101 0b74656d70657261747572650000000100 && refused forged_f32_exact
+  1574656d70657261747572650041 1574656d70657261747572650000 && refused forged_f32_exact
 
 if [ "$cases" -eq 0 ]; then
   echo "0 cases checked: FAILED"

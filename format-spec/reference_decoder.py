@@ -133,94 +133,79 @@ def read_container(data):
     n = len(data)
     if n < 4 or data[:4] != MAGIC:
         reject('not a .tsm file')                                   # step 1
-    if n < 8:
-        reject('truncated preamble')                                # step 2
-    version, flags = struct.unpack_from('<HH', data, 4)
+    version, p = read_varint(data, 4, n)                            # step 2
     if version != FORMAT_VERSION:
         raise Unsupported('format version %d (this decoder reads version %d only)'
                           % (version, FORMAT_VERSION))              # step 3
-    if flags & ~1:
-        reject('flags')                                             # step 4
-    hlen, pos = read_varint(data, 8, n)                             # step 5
-    if hlen > 1 << 20 or hlen > n - pos:
-        reject('header length')
-    hstart = pos
-    hend = pos + hlen
-    if n - hend < 4:
-        reject('header checksum missing')                           # step 6
-    if struct.unpack_from('<I', data, hend)[0] != xxh32(data[:hend]):
-        reject('header checksum')                                   # step 7
     h = {'version': version}
-    p = hstart                                                      # step 8
-    h['vertex_count'], p = read_varint(data, p, hend)
-    h['face_count'], p = read_varint(data, p, hend)
-    h['corner_count'], p = read_varint(data, p, hend)
-    if hend - p < 2 + 12 + 8:
-        reject('header fields')
-    h['bits'] = data[p]
-    h['level'] = data[p + 1]
+    h['vertex_count'], p = read_varint(data, p, n)                  # step 4
+    h['face_count'], p = read_varint(data, p, n)
+    h['corner_count'], p = read_varint(data, p, n)
+    if n - p < 2 + 12 + 4:
+        reject('header fields')                                     # step 5
+    grid, level = data[p], data[p + 1]
+    h['bits'] = grid & 0x1F
+    axis = grid >> 6
+    h['level'] = level & 0x0F
     p += 2
     h['origin'] = list(struct.unpack_from('<3f', data, p))
     p += 12
-    h['extent'] = struct.unpack_from('<d', data, p)[0]
-    p += 8
-    h['segment_count'], p = read_varint(data, p, hend)
+    top = struct.unpack_from('<f', data, p)[0]
+    p += 4
+    h['segment_count'] = 1
+    if level & 0x10:                                                # step 6: several segments
+        h['segment_count'], p = read_varint(data, p, n)
     h['exact'] = None
-    if flags & 1:                                                   # §3, §5.1: the exact grid
-        if hend - p < 8:
+    if grid & 0x20:                                                 # step 7, §5.1: the exact grid
+        if n - p < 8:
             reject('header fields')
         step = struct.unpack_from('<d', data, p)[0]
         p += 8
         base = []
         for _ in range(3):
-            z, p = read_varint(data, p, hend)
+            z, p = read_varint(data, p, n)
             base.append((z >> 1) ^ -(z & 1))
         if not (math.isfinite(step) and step > 0) or any(abs(b) > 1 << 62 for b in base):
-            reject('exact grid')                                    # step 4
+            reject('exact grid')
         h['exact'] = (step, base)
-    if not 1 <= h['segment_count'] <= 0xFFFFFFFF:
-        reject('segment count')                                     # step 9
+    if axis > 2:
+        reject('grid axis')                                         # step 8
+    if level & 0xE0 or (level & 0x10 and not 2 <= h['segment_count'] <= 0xFFFFFFFF):
+        reject('level byte or segment count')                       # step 9
     if not all(math.isfinite(o) for o in h['origin']):
         reject('origin')                                            # step 10
-    e = h['extent']
-    if not (math.isfinite(e) and e >= 0 and e <= 6.9e38):
-        reject('extent')                                            # step 11
+    if not (math.isfinite(top) and top >= h['origin'][axis]):
+        reject('bounding-box maximum')                              # step 11
+    h['extent'] = top - h['origin'][axis]
     if not 1 <= h['bits'] <= 30:
         reject('quantization bits')                                 # step 12
     sections = {}
     segments = []
     refinements = []
     order = []
-    pos = hend + 4
+    pos = p
+    covered = 0                          # §4.1: the first section's checksum covers the header too
     while True:
-        if n - pos < 2:
-            reject('no end marker')                                 # step 13
-        sid = struct.unpack_from('<H', data, pos)[0]
-        pos += 2
-        if sid == 0:                                                # step 14
+        tag, pos = read_varint(data, pos, n)                        # step 13
+        if tag == 0:                                                # step 14: the end marker
             break
-        if n - pos < 1:
-            reject('section header')                                # step 15
-        codec = data[pos]
-        pos += 1
-        stored, pos = read_varint(data, pos, n)
-        raw, pos = read_varint(data, pos, n)
-        if n - pos < 4:
-            reject('section checksum missing')
-        cks = struct.unpack_from('<I', data, pos)[0]
-        pos += 4
-        if codec > 1:
-            reject('codec')                                         # step 16
-        if stored > n - pos:
+        sid, codec = tag >> 1, tag & 1
+        if sid == 0 or sid > 0xFFFF:
+            reject('section id')                                    # step 15
+        stored, pos = read_varint(data, pos, n)                     # step 16
+        raw = stored
+        if codec == 1:
+            raw, pos = read_varint(data, pos, n)
+        if stored > n - pos or n - pos - stored < 4:
             reject('stored length')                                 # step 17
-        if codec == 0 and raw != stored:
-            reject('raw length')                                    # step 18
         if codec == 1 and raw > stored * 1024:
-            reject('expansion')
+            reject('expansion')                                     # step 18
         body = data[pos:pos + stored]
         pos += stored
-        if xxh32(body) != cks:
+        if struct.unpack_from('<I', data, pos)[0] != xxh32(data[covered:pos]):
             reject('section checksum')                              # step 19
+        pos += 4
+        covered = pos
         if sid == 7:                                                # step 20, §4.3
             if h['segment_count'] == 1 or len(segments) >= h['segment_count']:
                 reject('segment section')
@@ -1832,29 +1817,32 @@ class AttrHeader:
 
 
 COMMON_NAMES = (b'normal', b'texcoord', b'color', b'texcoord0', b'texcoord1', b'TANGENT', b'JOINTS_0',
-                b'WEIGHTS_0', b'_gltf_group', b'_gltf_primitive')     # §8.12: name lengths 1025 + index
+                b'WEIGHTS_0', b'_gltf_group', b'_gltf_primitive')     # §8.12: names 0 .. 9
 
 
 def read_attribute_header(buf, p):
     end = len(buf)
     h = AttrHeader()
     n, p = read_varint(buf, p, end)
-    if n > 1024:
-        if n - 1025 >= len(COMMON_NAMES):
-            reject('attributes: bad attribute name length')
-        h.name = COMMON_NAMES[n - 1025]
+    if n < len(COMMON_NAMES):
+        h.name = COMMON_NAMES[n]
     else:
+        n -= len(COMMON_NAMES)
+        if n > 1024:
+            reject('attributes: bad attribute name length')
         if n > end - p:
             reject('attributes: truncated attribute header')
         h.name = bytes(buf[p:p + n])
         p += n
-    if end - p < 6:
+    if end - p < 2:
         reject('attributes: truncated attribute header')
-    h.kind, h.domain, h.type, h.components, h.quant, h.bits = buf[p:p + 6]
-    p += 6
-    if h.kind > 3 or h.domain > 2 or h.type > 3 or not 1 <= h.components <= 4 or h.quant > 2:
+    layout, coding = buf[p], buf[p + 1]
+    p += 2
+    h.kind, h.domain, h.type, h.components = layout & 3, layout >> 2 & 3, layout >> 4 & 3, (layout >> 6) + 1
+    h.quant, h.bits = coding & 3, coding >> 2
+    if h.domain > 2 or h.quant > 2 or h.bits > 24:
         reject('attributes: bad attribute header')
-    if h.quant != 0 and not 1 <= h.bits <= 24:
+    if (h.quant == 0) != (h.bits == 0):
         reject('attributes: bad quantization bits')
     if (h.type == 0) == (h.quant == 0):
         reject('attributes: an f32 attribute coded as exact integers' if h.quant == 0 else
@@ -1867,16 +1855,31 @@ def read_attribute_header(buf, p):
     h.origin = []
     h.extent = 0.0
     if h.quant == 1:
-        if end - p < 4 * h.components + 8:
-            reject('attributes: truncated grid')
-        h.origin = list(struct.unpack_from('<%df' % h.components, buf, p))
-        p += 4 * h.components
-        h.extent = struct.unpack_from('<d', buf, p)[0]
-        p += 8
+        if end - p < 1:
+            reject('attributes: truncated attribute header')
+        grid = buf[p]
+        p += 1
+        axis = grid & 3
+        if axis >= h.components or grid >> 7 or grid >> (2 + h.components) & ((1 << (4 - h.components)) - 1):
+            reject('attributes: bad grid byte')
+        values = []
+        for bit in [2 + c for c in range(h.components)] + [6]:
+            if grid >> bit & 1:                              # short: an i8, the value times 64
+                if end - p < 1:
+                    reject('attributes: truncated grid')
+                values.append(struct.unpack_from('<b', buf, p)[0] / 64.0)
+                p += 1
+            else:
+                if end - p < 4:
+                    reject('attributes: truncated grid')
+                values.append(struct.unpack_from('<f', buf, p)[0])
+                p += 4
+        h.origin, top = values[:-1], values[-1]
         if not all(math.isfinite(o) for o in h.origin):
             reject('attributes: bad grid origin')
-        if not (math.isfinite(h.extent) and 0 <= h.extent <= 6.9e38):
-            reject('attributes: bad grid extent')
+        if not (math.isfinite(top) and top >= h.origin[axis]):
+            reject('attributes: bad grid maximum')
+        h.extent = top - h.origin[axis]
     return h, p
 
 

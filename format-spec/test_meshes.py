@@ -633,17 +633,57 @@ def varint(n):
         n >>= 7
 
 
+def split_container(data):
+    """A .tsm file's bytes as (head, sections): head = the preamble and header
+    (§2-3), sections = [id, codec, raw_length, stored bytes] in file order
+    (§4.1); checksums are not checked."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from reference_decoder import read_varint
+    n = len(data)
+    _, p = read_varint(data, 4, n)
+    for _ in range(3):
+        _, p = read_varint(data, p, n)
+    grid, level = data[p], data[p + 1]
+    p += 18
+    if level & 0x10:
+        _, p = read_varint(data, p, n)
+    if grid & 0x20:
+        p += 8
+        for _ in range(3):
+            _, p = read_varint(data, p, n)
+    head, sections = data[:p], []
+    while True:
+        tag, p = read_varint(data, p, n)
+        if tag == 0:
+            return head, sections
+        stored, p = read_varint(data, p, n)
+        raw = stored
+        if tag & 1:
+            raw, p = read_varint(data, p, n)
+        sections.append([tag >> 1, tag & 1, raw, data[p:p + stored]])
+        p += stored + 4
+
+
+def join_container(head, sections):
+    """The file of split_container's parts, every checksum computed (§4.1:
+    the first section's covers the head too)."""
+    from reference_decoder import xxh32
+    out = bytearray(head)
+    covered = 0
+    for sid, codec, raw, stored in sections:
+        out += varint(sid << 1 | codec) + varint(len(stored)) + (varint(raw) if codec else b'') + stored
+        out += struct.pack('<I', xxh32(bytes(out[covered:])))
+        covered = len(out)
+    return bytes(out) + b'\x00'
+
+
 def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
     """Copies the .tsm file src to dst with a metadata section (id 9, §4.6)
-    inserted after the header checksum, as the reference encoder places it.
+    inserted after the header, as the reference encoder places it.
     entries: (key, value) byte strings; raw_payload: the payload as given (for
     malformed sections); zstd: store it zstd-coded (codec 1, by the zstd
     command), else raw."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reference_decoder import xxh32, read_varint
-    data = open(src, 'rb').read()
-    hlen, p = read_varint(data, 8, len(data))
-    at = p + hlen + 4
+    head, sections = split_container(open(src, 'rb').read())
     if raw_payload is None:
         raw_payload = varint(len(entries)) + b''.join(
             bytes([len(k)]) + k + varint(len(v)) + v for k, v in entries)
@@ -652,37 +692,25 @@ def add_metadata(src, dst, entries, raw_payload=None, zstd=False):
         import subprocess
         stored = subprocess.run(['zstd', '-q', '-c', '-19'], input=raw_payload, capture_output=True,
                                 check=True).stdout
-    section = (struct.pack('<HB', 9, 1 if zstd else 0) + varint(len(stored)) + varint(len(raw_payload))
-               + struct.pack('<I', xxh32(stored)) + stored)
-    open(dst, 'wb').write(data[:at] + section + data[at:])
+    sections.insert(0, [9, 1 if zstd else 0, len(raw_payload), stored])
+    open(dst, 'wb').write(join_container(head, sections))
 
 
 def mesh_section(src):
-    """The .tsm file src's bytes, where its raw mesh section (id 10, §4.7)
-    starts and ends, and its payload."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reference_decoder import read_varint
-    data = open(src, 'rb').read()
-    hlen, p = read_varint(data, 8, len(data))
-    p += hlen + 4
-    while True:
-        sid, codec = struct.unpack_from('<HB', data, p)
-        if sid == 0:
-            sys.exit('%s: no raw mesh section' % src)
-        stored_len, q = read_varint(data, p + 3, len(data))
-        _, q = read_varint(data, q, len(data))
+    """The .tsm file src's parts (split_container), the index of its raw
+    mesh section (id 10, §4.7) and that section's payload."""
+    head, sections = split_container(open(src, 'rb').read())
+    for i, (sid, codec, _, stored) in enumerate(sections):
         if sid == 10 and codec == 0:
-            return data, p, q + 4 + stored_len, data[q + 4:q + 4 + stored_len]
-        p = q + 4 + stored_len
+            return head, sections, i, stored
+    sys.exit('%s: no raw mesh section' % src)
 
 
-def replace_section(data, start, end, payload, dst):
-    """data with its section at [start, end) replaced by a raw mesh section
-    (id 10) holding payload, written to dst."""
-    from reference_decoder import xxh32
-    section = (struct.pack('<HB', 10, 0) + varint(len(payload)) + varint(len(payload))
-               + struct.pack('<I', xxh32(payload)) + payload)
-    open(dst, 'wb').write(data[:start] + section + data[end:])
+def replace_section(head, sections, i, payload, dst):
+    """The file with its section i replaced by a raw mesh section (id 10)
+    holding payload, written to dst."""
+    sections[i] = [10, 0, len(payload), payload]
+    open(dst, 'wb').write(join_container(head, sections))
 
 
 def replace_in_mesh(src, dst, old, new):
@@ -690,10 +718,10 @@ def replace_in_mesh(src, dst, old, new):
     old in its raw mesh section (id 10, §4.7) replaced by new, and that
     section's lengths and checksum rewritten to match (a forged file that
     only the payload rules can refuse)."""
-    data, start, end, payload = mesh_section(src)
+    head, sections, i, payload = mesh_section(src)
     if old not in payload:
         sys.exit('%s: %s not in the mesh section' % (src, old.hex()))
-    replace_section(data, start, end, payload.replace(old, new, 1), dst)
+    replace_section(head, sections, i, payload.replace(old, new, 1), dst)
 
 
 def forge_topology(src, dst, op):
@@ -703,7 +731,7 @@ def forge_topology(src, dst, op):
     bytes; the stream lengths, the section's lengths and its checksum are
     rewritten to match."""
     from reference_decoder import read_varint
-    data, start, end, payload = mesh_section(src)
+    head, sections, i, payload = mesh_section(src)
     lengths, r = [], 0
     for _ in range(4):
         n, r = read_varint(payload, r, len(payload))
@@ -720,20 +748,16 @@ def forge_topology(src, dst, op):
         topo = topo[:int(value)]
     streams[2] = bytes(topo)
     payload = b''.join(varint(len(x)) for x in streams) + b''.join(streams) + payload[r:]
-    replace_section(data, start, end, payload, dst)
+    replace_section(head, sections, i, payload, dst)
 
 
 def set_version(src, dst, version):
     """Copies the .tsm file src to dst saying format version `version`, with
-    the header checksum (§3) rewritten to match: a file that only the
-    version check (§2) can refuse."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reference_decoder import read_varint, xxh32
-    data = bytearray(open(src, 'rb').read())
-    struct.pack_into('<H', data, 4, version)
-    hlen, p = read_varint(bytes(data), 8, len(data))
-    struct.pack_into('<I', data, p + hlen, xxh32(bytes(data[:p + hlen])))
-    open(dst, 'wb').write(bytes(data))
+    the first section's checksum (§4.1, which covers the header) rewritten
+    to match: a file that only the version check (§2) can refuse."""
+    head, sections = split_container(open(src, 'rb').read())
+    head = head[:4] + varint(version) + head[5:]          # version 12 takes one byte
+    open(dst, 'wb').write(join_container(head, sections))
 
 
 def main():

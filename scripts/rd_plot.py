@@ -46,18 +46,27 @@ def varint(buf, pos):
 def level_ends(path):
     """Byte offsets where the base mesh and each refinement batch end (FORMAT.md §2-4)."""
     data = open(path, 'rb').read()
-    header_length, pos = varint(data, 8)
-    pos += header_length + 4
+    pos = 4
+    for _ in range(4):  # version, vertex, face and corner counts
+        _, pos = varint(data, pos)
+    grid, level = data[pos], data[pos + 1]
+    pos += 18  # grid, level, origin, top
+    if level & 0x10:  # several segments: their count
+        _, pos = varint(data, pos)
+    if grid & 0x20:  # the exact grid's step and base
+        pos += 8
+        for _ in range(3):
+            _, pos = varint(data, pos)
     ends, base_end = [], None
     while True:
-        (sid,) = struct.unpack_from('<H', data, pos)
-        pos += 2
-        if sid == 0:
+        tag, pos = varint(data, pos)
+        if tag == 0:
             break
-        pos += 1  # codec
+        sid = tag >> 1
         stored, pos = varint(data, pos)
-        _, pos = varint(data, pos)
-        pos += 4 + stored
+        if tag & 1:
+            _, pos = varint(data, pos)
+        pos += stored + 4
         if sid in (7, 10):
             base_end = pos
         elif sid == 12:

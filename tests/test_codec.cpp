@@ -457,17 +457,16 @@ TEST(Codec, RandomSingleByteCorruptionNeverCrashes) {
 
 // An encoded file split into its header fields (format-spec/FORMAT.md §2-3)
 // and its sections, so a test can change a header field and rebuild a file
-// with a valid header checksum. The extent is stored as f32 or f64 depending
-// on the format revision; its width is taken from the encoded file.
+// with a valid checksum (the first section's, which covers the header).
 struct Parsed {
-  uint16_t version = 0, flags = 0;
+  uint64_t version = 0;
   uint64_t vertices = 0, faces = 0, corners = 0;
-  uint8_t bits = 0, level = 0;
+  uint8_t grid = 0, level = 0;  // grid: quantization bits | 0x20 exact | axis << 6; level | 0x10 segmented
   float origin[3] = {0, 0, 0};
-  double extent = 0;
-  size_t extent_bytes = 0;  // 4 or 8
+  float top = 0;  // the bounding box's maximum on the grid byte's axis
   uint64_t segments = 0;
-  std::string body;  // everything after the header checksum
+  std::string first;  // the first section up to its checksum
+  std::string rest;   // everything after the first section's checksum
 };
 
 void put_varint(std::string& s, uint64_t v) {
@@ -494,68 +493,54 @@ uint64_t get_varint(const std::string& s, size_t& p) {
     if (!(b & 0x80)) return v;
   }
 }
+float get_f32(const std::string& s, size_t& p) {
+  const uint32_t b = static_cast<uint32_t>(get_le(s, p, 4));
+  float f;
+  std::memcpy(&f, &b, 4);
+  return f;
+}
+void put_f32(std::string& s, float f) {
+  uint32_t b;
+  std::memcpy(&b, &f, 4);
+  put_le(s, b, 4);
+}
 
 Parsed parse(const std::string& file) {
   Parsed h;
   size_t p = 4;
-  h.version = static_cast<uint16_t>(get_le(file, p, 2));
-  h.flags = static_cast<uint16_t>(get_le(file, p, 2));
-  size_t len = static_cast<size_t>(get_varint(file, p));
-  const size_t fields_end = p + len;
+  h.version = get_varint(file, p);
   h.vertices = get_varint(file, p);
   h.faces = get_varint(file, p);
   h.corners = get_varint(file, p);
-  h.bits = static_cast<uint8_t>(file.at(p++));
+  h.grid = static_cast<uint8_t>(file.at(p++));
   h.level = static_cast<uint8_t>(file.at(p++));
-  for (float& o : h.origin) {
-    uint32_t b = static_cast<uint32_t>(get_le(file, p, 4));
-    std::memcpy(&o, &b, 4);
-  }
-  h.extent_bytes = fields_end - p - 1;  // the encoder writes segment_count 1: one byte
-  if (h.extent_bytes == 4) {
-    uint32_t b = static_cast<uint32_t>(get_le(file, p, 4));
-    float f;
-    std::memcpy(&f, &b, 4);
-    h.extent = f;
-  } else {
-    uint64_t b = get_le(file, p, h.extent_bytes);
-    std::memcpy(&h.extent, &b, 8);
-  }
-  h.segments = get_varint(file, p);
-  h.body = file.substr(p + 4);
+  for (float& o : h.origin) o = get_f32(file, p);
+  h.top = get_f32(file, p);
+  h.segments = (h.level & 0x10) ? get_varint(file, p) : 1;
+  const size_t first = p;
+  const uint64_t tag = get_varint(file, p);
+  const uint64_t stored = get_varint(file, p);
+  if (tag & 1) get_varint(file, p);
+  p += static_cast<size_t>(stored);
+  h.first = file.substr(first, p - first);
+  h.rest = file.substr(p + 4);
   return h;
 }
 
 std::string build(const Parsed& h) {
   std::string s = "TSM\x1a";
-  put_le(s, h.version, 2);
-  put_le(s, h.flags, 2);
-  std::string f;
-  put_varint(f, h.vertices);
-  put_varint(f, h.faces);
-  put_varint(f, h.corners);
-  f.push_back(static_cast<char>(h.bits));
-  f.push_back(static_cast<char>(h.level));
-  for (float o : h.origin) {
-    uint32_t b;
-    std::memcpy(&b, &o, 4);
-    put_le(f, b, 4);
-  }
-  if (h.extent_bytes == 4) {
-    float e = static_cast<float>(h.extent);
-    uint32_t b;
-    std::memcpy(&b, &e, 4);
-    put_le(f, b, 4);
-  } else {
-    uint64_t b;
-    std::memcpy(&b, &h.extent, 8);
-    put_le(f, b, 8);
-  }
-  put_varint(f, h.segments);
-  put_varint(s, f.size());
-  s += f;
+  put_varint(s, h.version);
+  put_varint(s, h.vertices);
+  put_varint(s, h.faces);
+  put_varint(s, h.corners);
+  s.push_back(static_cast<char>(h.grid));
+  s.push_back(static_cast<char>(h.level));
+  for (float o : h.origin) put_f32(s, o);
+  put_f32(s, h.top);
+  if (h.level & 0x10) put_varint(s, h.segments);
+  s += h.first;
   put_le(s, XXH32(s.data(), s.size(), 0), 4);
-  return s + h.body;
+  return s + h.rest;
 }
 
 TEST(Codec, ForgingHelpersRebuildTheEncodersBytes) {
@@ -563,17 +548,18 @@ TEST(Codec, ForgingHelpersRebuildTheEncodersBytes) {
   Mesh m = tsm_test::icosphere(1);
   std::string bytes = encode_ok(m, 9, 4);
   Parsed h = parse(bytes);
-  ASSERT_TRUE(h.extent_bytes == 4 || h.extent_bytes == 8) << h.extent_bytes;
-  EXPECT_EQ(h.version, 12);
+  EXPECT_EQ(h.version, 12u);
   EXPECT_EQ(h.vertices, m.vertex_count());
   EXPECT_EQ(h.faces, m.face_count());
   EXPECT_EQ(h.corners, m.corner_count());
-  EXPECT_EQ(h.bits, 9);
+  EXPECT_EQ(h.grid & 0x1f, 9);
   EXPECT_EQ(h.level, 4);
   EXPECT_EQ(h.segments, 1u);
   tsm::BoundingBox box = tsm::bounding_box(m);
   for (int a = 0; a < 3; ++a) EXPECT_EQ(h.origin[a], box.min[a]);
-  EXPECT_NEAR(h.extent, static_cast<double>(box.largest_extent()), 1e-6);
+  const int axis = h.grid >> 6;
+  ASSERT_LT(axis, 3);
+  EXPECT_EQ(static_cast<double>(h.top) - static_cast<double>(h.origin[axis]), box.largest_extent());
   EXPECT_EQ(build(h), bytes);
 }
 
@@ -629,23 +615,34 @@ TEST(Codec, ForgedHeaderFieldsRefused) {
     tsm::StreamDecoder sd;
     EXPECT_EQ(sd.feed(build(h)).code(), ErrorCode::unsupported) << version;
   }
-  {
+  {  // the exact-grid flag without the exact grid's fields
     Parsed h = good;
-    h.flags = 1;
+    h.grid |= 0x20;
     EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
   }
-  for (int bits : {0, 31, 255}) {
+  for (int bits : {0, 31}) {
     Parsed h = good;
-    h.bits = static_cast<uint8_t>(bits);
+    h.grid = static_cast<uint8_t>((h.grid & ~0x1f) | bits);
     EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << bits;
   }
-  {
+  {  // axis 3
     Parsed h = good;
-    h.segments = 0;
+    h.grid |= 0xc0;
     EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data);
   }
+  for (uint64_t segments : {0, 1}) {  // a segment count follows only for 2 or more
+    Parsed h = good;
+    h.level |= 0x10;
+    h.segments = segments;
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << segments;
+  }
+  for (int bit : {0x20, 0x40, 0x80}) {  // the level byte's bits 5-7
+    Parsed h = good;
+    h.level = static_cast<uint8_t>(h.level | bit);
+    EXPECT_EQ(tsm::decode(build(h), back).code(), ErrorCode::corrupt_data) << bit;
+  }
   {
-    // Header checksum.
+    // The header is covered by the first section's checksum.
     std::string f = build(good);
     f[10] = static_cast<char>(f[10] ^ 1);
     EXPECT_EQ(tsm::decode(f, back).code(), ErrorCode::corrupt_data);
@@ -667,19 +664,24 @@ TEST(Codec, ForgedNonFiniteGridRefused) {
   // one must not hand back NaN or infinite positions as a valid mesh.
   Mesh m = tsm_test::icosphere(1);
   const Parsed good = parse(encode_ok(m, 9, 4));
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const float fmax = std::numeric_limits<float>::max();
+  const int axis = good.grid >> 6;
   for (int which = 0; which < 7; ++which) {
     Parsed h = good;
-    if (which == 0) h.extent = nan;
-    if (which == 1) h.extent = inf;
-    if (which == 2) h.origin[1] = std::numeric_limits<float>::quiet_NaN();
-    if (which == 3) h.origin[2] = -std::numeric_limits<float>::infinity();
-    if (which == 4) h.extent = 1e300;  // finite as f64, beyond any float
-    if (which == 5) {                  // each finite, but origin + extent overflows a float
-      h.origin[0] = 3e38f;
-      h.extent = 6e38;
+    if (which == 0) h.top = nan;
+    if (which == 1) h.top = inf;
+    if (which == 2) h.origin[1] = nan;
+    if (which == 3) h.origin[2] = -inf;
+    if (which == 4) {  // the largest extent a float box has
+      h.origin[axis] = -fmax;
+      h.top = fmax;
     }
-    if (which == 6) h.extent = -1.0;
+    if (which == 5) {  // each finite, but a grid step past the top overflows a float
+      h.origin[axis] = 3e38f;
+      h.top = fmax;
+    }
+    if (which == 6) h.top = h.origin[axis] - 1.0f;
     Mesh back;
     tsm::Status s = tsm::decode(build(h), back);
     EXPECT_TRUE(!s.ok() || back.all_finite()) << "case " << which << ": decoded non-finite positions";
@@ -757,7 +759,7 @@ std::string spec_example_bytes() {
 // it).
 TEST(Codec, FormatSpecWorkedExampleIsCurrent) {
   const std::string example = spec_example_bytes();
-  ASSERT_EQ(example.size(), 74u) << "could not read the example from " << TSM_FORMAT_SPEC;
+  ASSERT_EQ(example.size(), 57u) << "could not read the example from " << TSM_FORMAT_SPEC;
   tsm::Mesh m;
   m.add_vertex(0, 0, 0);
   m.add_vertex(2, 0, 0);

@@ -4,11 +4,11 @@
 // ceiling on the memory the decoder may take for a given input.
 //
 // Format-agnostic: the tests damage whatever encode() produces. They know
-// only the container framing (format-spec/FORMAT.md §2-4: preamble, header
-// length and fields starting with the three count varints, header checksum,
-// then id / codec / stored length / raw length / XXH32 / payload per section,
-// end marker), which the geometry rewrite does not change; the payloads are
-// treated as opaque bytes.
+// only the container framing (format-spec/FORMAT.md §2-4: magic, version,
+// header fields starting with the three count varints, then id and codec /
+// stored length / raw length (zstd only) / payload / XXH32 per section, the
+// first section's checksum covering the header too, end marker), which the
+// geometry rewrite does not change; the payloads are treated as opaque bytes.
 //
 // This file is its own test binary (tsm_corruption_tests): it replaces the
 // global operator new / delete to count the bytes the decoder holds, and can
@@ -370,7 +370,7 @@ TEST(Corruption, RandomBitFlips) {
       for (int k = 0; k < flips; ++k) {
         const size_t p = at(rng);
         bad[p] = static_cast<char>(bad[p] ^ (1 << (rng() % 8)));
-        version = version || p == 4 || p == 5;
+        version = version || p == 4;
       }
       if (bad == f) continue;
       DecodeResult r = guarded_decode(bad);
@@ -415,7 +415,7 @@ TEST(Corruption, RandomByteOverwritesInsertionsAndDeletions) {
       }
       if (bad == f) continue;
       DecodeResult r = guarded_decode(bad);
-      expect_clean(r, "overwrite run " + std::to_string(i), p <= 5);
+      expect_clean(r, "overwrite run " + std::to_string(i), p <= 4);
       if (r.status.ok()) {
         ++decoded;
         EXPECT_TRUE(checksums_match(bad)) << "run " << i << ": decoded although a checksum does not match";
@@ -796,6 +796,16 @@ TEST(Corruption, ForgedMetadataRefused) {
   EXPECT_EQ(guarded_decode(build(twice)).status.code(), ErrorCode::corrupt_data) << "two metadata sections";
 }
 
+// The bytes of an attribute grid (FORMAT.md §8.12) of `components` values
+// at `at`: its grid byte, then each origin and the top, one byte when the
+// grid byte marks it short, else four.
+size_t grid_bytes(const std::string& payload, size_t at, uint32_t components) {
+  const uint32_t grid = static_cast<uint8_t>(payload.at(at));
+  size_t n = 1;
+  for (uint32_t c = 0; c < components; ++c) n += (grid >> (2 + c) & 1) ? 1 : 4;
+  return n + ((grid >> 6 & 1) ? 1 : 4);
+}
+
 // An attribute's type and quantization pair one way only (FORMAT.md §8.12):
 // integer types are coded exactly, f32 on a grid or octahedrally. fuzz_decode
 // found a forged file whose u8 attribute said "octahedral" and decoded to
@@ -823,11 +833,13 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   ASSERT_LT(at, good.sections.size()) << "no mesh section";
   ASSERT_EQ(good.sections[at].codec, 0);
   const std::string& payload = good.sections[at].stored;
-  // Header: name, kind, domain, type, components, quant, bits[, origin f32 x components, extent f64].
-  const size_t c_at = payload.find(std::string("\x05" "COLOR\x02\x00\x01\x03\x00", 10));
-  const size_t t_at = payload.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
+  // Header (FORMAT.md §8.12): name (10 + length, bytes), layout (kind | domain << 2 | type << 4 |
+  // components - 1 << 6), coding (quant | bits << 2)[, axis, origin f32 x components, top f32].
+  const size_t c_at = payload.find(std::string("\x0f" "COLOR\x92\x00", 8));
+  const size_t t_at = payload.find(std::string("\x0e" "temp\x00", 6));
   ASSERT_NE(c_at, std::string::npos) << "colour header not found";
   ASSERT_NE(t_at, std::string::npos) << "temp header not found";
+  ASSERT_EQ(payload[t_at + 6] & 3, 1) << "temp not on a grid";
   struct Case {
     const char* what;
     std::string payload;
@@ -835,17 +847,15 @@ TEST(Corruption, AttributeTypeAndQuantizationMustPair) {
   };
   std::vector<Case> cases;
   std::string octahedral_u8 = payload;  // u8 colour as octahedral, 8 bits
-  octahedral_u8[c_at + 10] = 2;
-  octahedral_u8[c_at + 11] = 8;
+  octahedral_u8[c_at + 7] = 2 | 8 << 2;
   cases.push_back({"u8 octahedral", octahedral_u8, "integer attribute not coded as exact"});
-  std::string grid_u8 = payload;  // u8 colour on a grid: origin and extent added
-  grid_u8[c_at + 10] = 1;
-  grid_u8[c_at + 11] = 8;
-  grid_u8.insert(c_at + 12, std::string(3 * 4 + 8, '\0'));
+  std::string grid_u8 = payload;  // u8 colour on a grid, 8 bits: axis, origin and top added
+  grid_u8[c_at + 7] = 1 | 8 << 2;
+  grid_u8.insert(c_at + 8, std::string(1 + 3 * 4 + 4, '\0'));
   cases.push_back({"u8 grid", grid_u8, "integer attribute not coded as exact"});
-  std::string exact_f32 = payload;  // f32 temp as exact integers: origin and extent dropped
-  exact_f32[t_at + 9] = 0;
-  exact_f32.erase(t_at + 11, 4 + 8);
+  std::string exact_f32 = payload;  // f32 temp as exact integers: the grid byte, origin and top dropped
+  exact_f32[t_at + 6] = 0;
+  exact_f32.erase(t_at + 7, grid_bytes(payload, t_at + 7, 1));
   cases.push_back({"f32 exact", exact_f32, "f32 attribute coded as exact integers"});
   for (const Case& k : cases) {
     Container c = good;
@@ -877,11 +887,12 @@ TEST(Corruption, PerVertexCodingOfAVertexAttributeRefused) {
     if (good.sections[i].id == 10) at = i;
   ASSERT_LT(at, good.sections.size()) << "no mesh section";
   ASSERT_EQ(good.sections[at].codec, 0);
-  // Header: name, kind, domain, type, components, quant, bits, origin (f32), extent (f64); then the predictor byte.
-  const size_t t_at = good.sections[at].stored.find(std::string("\x04" "temp\x00\x00\x00\x01\x01", 10));
+  // Header: name (5 bytes), layout, coding, the grid (byte, origin, top); then the predictor byte.
+  const size_t t_at = good.sections[at].stored.find(std::string("\x0e" "temp\x00", 6));
   ASSERT_NE(t_at, std::string::npos) << "temp header not found";
   Container c = good;
-  c.sections[at].stored[t_at + 23] = static_cast<char>(c.sections[at].stored[t_at + 23] | 0x10);
+  const size_t predictor_at = t_at + 7 + grid_bytes(good.sections[at].stored, t_at + 7, 1);
+  c.sections[at].stored[predictor_at] = static_cast<char>(c.sections[at].stored[predictor_at] | 0x10);
   const DecodeResult r = guarded_decode(build(c));
   expect_clean(r, "per-vertex bit on a vertex attribute");
   EXPECT_EQ(r.status.code(), ErrorCode::corrupt_data) << describe(r);

@@ -80,17 +80,22 @@ std::string rebuild(const std::string& file, const std::vector<std::pair<uint16_
   return w.finish();
 }
 
-// The same file with another version field (and the header checksum over it).
-std::string with_version(std::string file, uint16_t version) {
+// The same file with another version (a varint after the magic; version 12
+// takes one byte) and the first section's checksum, which covers it, over it.
+std::string with_version(const std::string& file, uint16_t version) {
   size_t offset = 0;
   tsm::Header h;
   std::string missing;
   EXPECT_TRUE(tsm::read_header(file, offset, h, missing).ok() && missing.empty());
-  file[4] = static_cast<char>(version & 0xFF);
-  file[5] = static_cast<char>(version >> 8);
-  const uint32_t c = tsm::checksum32(std::string_view(file).substr(0, offset - 4));
-  for (int i = 0; i < 4; ++i) file[offset - 4 + i] = static_cast<char>((c >> (8 * i)) & 0xFF);
-  return file;
+  size_t first_end = offset;
+  tsm::Section s;
+  EXPECT_TRUE(tsm::read_section(file, first_end, s, false, missing, 0, std::string_view(file).substr(0, offset)).ok());
+  std::string out = file.substr(0, 4);
+  tsm::ByteWriter w(out);
+  w.varint(version);
+  out += file.substr(5, first_end - 4 - 5);
+  w.u32(tsm::checksum32(out));
+  return out + file.substr(first_end);
 }
 
 // The mesh section's payload of a one-segment file.
@@ -142,7 +147,7 @@ TEST(Format, OnlyVersion12IsRead) {
     tsm::FileInfo fi;
     EXPECT_EQ(tsm::inspect(bad, fi).code(), tsm::ErrorCode::unsupported);
     tsm::StreamDecoder sd;
-    EXPECT_EQ(sd.feed(std::string_view(bad).substr(0, 6)).code(), tsm::ErrorCode::unsupported);
+    EXPECT_EQ(sd.feed(std::string_view(bad).substr(0, 8)).code(), tsm::ErrorCode::unsupported);
   }
 }
 
@@ -664,6 +669,35 @@ TEST(Format, EveryLevelRoundTripsCanonically) {
       expect_round_trip(m, bytes, 12, name);
       EXPECT_TRUE(encode(decode_ok(bytes), 12, level) == bytes);
     }
+}
+
+}  // namespace
+
+namespace {
+
+// FORMAT.md §8.12: a grid bound that is a multiple of 1/64 in -2 .. 2 (0,
+// 0.25, 1: texture coordinates in 0..1) takes one byte instead of four;
+// the same grid shifted off those values costs 3 bytes more per bound,
+// codes the same values, and both round trip and re-encode to their bytes.
+TEST(Format, GridBoundsOnSixtyFourthsTakeOneByte) {
+  std::string bytes[2];
+  for (int shifted = 0; shifted < 2; ++shifted) {
+    Mesh m = tsm_test::icosphere(0);
+    const float off = shifted ? 1.0f / 1024 : 0.0f;
+    tsm::Attribute uv;
+    uv.name = "texcoord";
+    uv.kind = tsm::AttributeKind::texcoord;
+    uv.components = 2;
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      uv.values.push_back(static_cast<float>(v % 5) / 4.0f + off);
+      uv.values.push_back(static_cast<float>(v % 3) / 2.0f + off);
+    }
+    m.attributes = {uv};
+    bytes[shifted] = encode(m, 12, 6);
+    expect_round_trip(m, bytes[shifted], 12, shifted ? "shifted" : "on sixty-fourths");
+    EXPECT_EQ(encode(decode_ok(bytes[shifted]), 12, 6), bytes[shifted]) << "canonical re-encoding";
+  }
+  EXPECT_EQ(bytes[0].size() + 3 * 3, bytes[1].size()) << "two origins and the top, 1 byte each instead of 4";
 }
 
 }  // namespace

@@ -469,57 +469,99 @@ struct VertexFaces {
 };
 
 // Names the readers give (FORMAT.md §8.12): a header names one of them by
-// its index (name length 1025 + index), two bytes where the name would take
-// up to twelve in a file of a few hundred.
+// its index (one byte), and any other name by its length + 10 and its bytes.
 constexpr const char* kCommonNames[] = {"normal",   "texcoord",  "color",       "texcoord0",      "texcoord1",
                                         "TANGENT",  "JOINTS_0",  "WEIGHTS_0",   "_gltf_group",    "_gltf_primitive"};
-constexpr uint64_t kCommonNameBase = kMaxAttributeNameBytes + 1;
 constexpr uint64_t kCommonNameCount = sizeof(kCommonNames) / sizeof(kCommonNames[0]);
 
+// A grid's origins and top (FORMAT.md §8.12) that are multiples of 1/64
+// in -2 .. 2 - 1/64 (0, 0.25, 1, -1: texture coordinates and colours in
+// 0..1) take one byte, an i8 of the value times 64; the grid byte says
+// which (bit 2 + c for origin[c], bit 6 for top) besides the axis (bits
+// 0-1). A writer uses the short form for exactly those values (-0 is not
+// one), so a decoded file re-encodes to the same bytes.
+constexpr float kGridShortScale = 64.0f;
+constexpr int kGridTopShortBit = 6;
+
+bool short_grid_value(float v, int8_t& k) {
+  const float scaled = v * kGridShortScale;  // exact: a power of two, no overflow in range
+  if (!(scaled >= -128.0f && scaled <= 127.0f) || scaled != std::floor(scaled) || (v == 0.0f && std::signbit(v)))
+    return false;
+  k = static_cast<int8_t>(scaled);
+  return true;
+}
+
+void write_grid_value(ByteWriter& w, float v, bool is_short) {
+  int8_t k = 0;
+  if (is_short && short_grid_value(v, k)) {
+    w.u8(static_cast<uint8_t>(k));
+  } else {
+    w.f32(v);
+  }
+}
+
+// The header's layout byte: kind, domain, type, components - 1 (2 bits
+// each); its coding byte: quant (2 bits), then bits (5 bits; 0 for exact).
 void write_header(ByteWriter& w, const AttributeHeader& h) {
   uint64_t common = kCommonNameCount;
   for (uint64_t k = 0; k < kCommonNameCount; ++k)
     if (h.name == kCommonNames[k]) common = k;
   if (common < kCommonNameCount) {
-    w.varint(kCommonNameBase + common);
+    w.varint(common);
   } else {
-    w.varint(h.name.size());
+    w.varint(kCommonNameCount + h.name.size());
     w.bytes(h.name);
   }
-  w.u8(static_cast<uint8_t>(h.kind));
-  w.u8(static_cast<uint8_t>(h.domain));
-  w.u8(static_cast<uint8_t>(h.type));
-  w.u8(static_cast<uint8_t>(h.components));
-  w.u8(static_cast<uint8_t>(h.quant));
-  w.u8(static_cast<uint8_t>(h.bits));
+  w.u8(static_cast<uint8_t>(static_cast<uint32_t>(h.kind) | static_cast<uint32_t>(h.domain) << 2 |
+                            static_cast<uint32_t>(h.type) << 4 | (h.components - 1) << 6));
+  const int bits = h.quant == AttributeQuant::exact ? 0 : h.bits;
+  w.u8(static_cast<uint8_t>(static_cast<uint32_t>(h.quant) | static_cast<uint32_t>(bits) << 2));
   if (h.quant == AttributeQuant::grid) {
-    for (uint32_t c = 0; c < h.components; ++c) w.f32(h.origin[c]);
-    w.f64(h.extent);
+    float top = 0;
+    const int axis = extent_axis(h.origin, static_cast<int>(h.components), h.extent, top);
+    uint32_t grid = static_cast<uint32_t>(axis);
+    int8_t k = 0;
+    for (uint32_t c = 0; c < h.components; ++c) grid |= static_cast<uint32_t>(short_grid_value(h.origin[c], k)) << (2 + c);
+    grid |= static_cast<uint32_t>(short_grid_value(top, k)) << kGridTopShortBit;
+    w.u8(static_cast<uint8_t>(grid));
+    for (uint32_t c = 0; c < h.components; ++c) write_grid_value(w, h.origin[c], grid >> (2 + c) & 1);
+    write_grid_value(w, top, grid >> kGridTopShortBit & 1);
   }
+}
+
+// A grid value, short (an i8, the value times 64) or an f32.
+bool read_grid_value(ByteReader& r, bool is_short, float& v) {
+  uint8_t k = 0;
+  if (!is_short) return r.f32(v);
+  if (!r.u8(k)) return false;
+  v = static_cast<float>(static_cast<int8_t>(k)) / kGridShortScale;
+  return true;
 }
 
 Status read_header(ByteReader& r, AttributeHeader& h) {
   uint64_t len = 0;
   std::string_view name;
-  uint8_t kind, domain, type, comps, quant, bits;
+  uint8_t layout = 0, coding = 0;
   if (!r.varint(len)) return corrupt("truncated attribute header");
-  if (len >= kCommonNameBase) {
-    if (len - kCommonNameBase >= kCommonNameCount) return corrupt("bad attribute name length");
-    name = kCommonNames[len - kCommonNameBase];
-  } else if (!r.bytes(static_cast<size_t>(len), name)) {
+  if (len < kCommonNameCount) {
+    name = kCommonNames[len];
+  } else if (len - kCommonNameCount > kMaxAttributeNameBytes) {
+    return corrupt("bad attribute name length");
+  } else if (!r.bytes(static_cast<size_t>(len - kCommonNameCount), name)) {
     return corrupt("truncated attribute header");
   }
-  if (!r.u8(kind) || !r.u8(domain) || !r.u8(type) || !r.u8(comps) || !r.u8(quant) || !r.u8(bits))
-    return corrupt("truncated attribute header");
+  if (!r.u8(layout) || !r.u8(coding)) return corrupt("truncated attribute header");
   h.name.assign(name);
-  if (kind > 3 || domain > 2 || type > 3 || comps < 1 || comps > 4 || quant > 2) return corrupt("bad attribute header");
-  h.kind = static_cast<AttributeKind>(kind);
+  const uint32_t domain = layout >> 2 & 3, quant = coding & 3, bits = coding >> 2;
+  if (domain > 2 || quant > 2 || bits > 24) return corrupt("bad attribute header");
+  h.kind = static_cast<AttributeKind>(layout & 3);
   h.domain = static_cast<AttributeDomain>(domain);
-  h.type = static_cast<AttributeType>(type);
-  h.components = comps;
+  h.type = static_cast<AttributeType>(layout >> 4 & 3);
+  h.components = (layout >> 6) + 1u;
   h.quant = static_cast<AttributeQuant>(quant);
-  h.bits = bits;
-  if (h.quant != AttributeQuant::exact && (bits < 1 || bits > 24)) return corrupt("bad quantization bits");
+  h.bits = static_cast<int>(bits);
+  const uint32_t comps = h.components;
+  if ((h.quant == AttributeQuant::exact) != (bits == 0)) return corrupt("bad quantization bits");
   if ((h.type == AttributeType::f32) == (h.quant == AttributeQuant::exact))
     return corrupt(h.quant == AttributeQuant::exact ? "an f32 attribute coded as exact integers"
                                                     : "an integer attribute not coded as exact integers");
@@ -528,10 +570,19 @@ Status read_header(ByteReader& r, AttributeHeader& h) {
   if (h.kind == AttributeKind::texcoord && comps != 2) return corrupt("a texture coordinate has 2 components");
   if (h.kind == AttributeKind::color && comps < 3) return corrupt("a colour has 3 or 4 components");
   if (h.quant == AttributeQuant::grid) {
+    uint8_t grid = 0;
+    float top = 0;
+    if (!r.u8(grid)) return corrupt("truncated attribute header");
+    const uint32_t axis = grid & 3;
+    if (axis >= comps || grid >> 7 || (grid >> (2 + comps) & ((1u << (kGridTopShortBit - 2 - comps)) - 1)))
+      return corrupt("bad grid byte");
     for (uint32_t c = 0; c < comps; ++c)
-      if (!r.f32(h.origin[c]) || !std::isfinite(h.origin[c])) return corrupt("bad grid origin");
-    if (!r.f64(h.extent) || !std::isfinite(h.extent) || h.extent < 0 || h.extent > 6.9e38)
-      return corrupt("bad grid extent");
+      if (!read_grid_value(r, grid >> (2 + c) & 1, h.origin[c]) || !std::isfinite(h.origin[c]))
+        return corrupt("bad grid origin");
+    if (!read_grid_value(r, grid >> kGridTopShortBit & 1, top) || !std::isfinite(top))
+      return corrupt("bad grid maximum");
+    h.extent = static_cast<double>(top) - static_cast<double>(h.origin[axis]);
+    if (!(h.extent >= 0)) return corrupt("bad grid maximum (below the origin)");
   }
   return Status::Ok();
 }

@@ -77,6 +77,20 @@ class ByteReader {
   const uint8_t* begin_ = nullptr;
 };
 
+// A grid's extent as the file stores it (FORMAT.md §3 and §8.12): the
+// component whose extent is the largest and that component's maximum
+// `top`, so extent = f64(top) - f64(origin[axis]). An extent computed as
+// such a difference of two floats (the encoders') always has an axis; for
+// any other, axis 0 with top = origin[0] is returned.
+inline int extent_axis(const float* origin, int components, double extent, float& top) {
+  for (int a = 0; a < components; ++a) {
+    top = static_cast<float>(static_cast<double>(origin[a]) + extent);
+    if (static_cast<double>(top) - static_cast<double>(origin[a]) == extent) return a;
+  }
+  top = origin[0];
+  return 0;
+}
+
 // Streams one after another behind their byte lengths (a segment payload,
 // FORMAT.md §4.5, and the mesh section, §4.7): the lengths as varints, the
 // streams, then `rest`, whose length is what remains.

@@ -39,7 +39,7 @@ enum SectionId : uint16_t {
 const char* section_name(uint16_t id);
 
 struct Header {
-  uint16_t version = kFormatVersion;  // the preamble's version field (read_header accepts only kFormatVersion)
+  uint16_t version = kFormatVersion;  // the version after the magic (read_header accepts only kFormatVersion)
   uint64_t vertex_count = 0;
   uint64_t face_count = 0;
   uint64_t corner_count = 0;
@@ -55,6 +55,15 @@ struct Header {
   int64_t exact_base[3] = {0, 0, 0};
 };
 constexpr uint16_t kHeaderExactGrid = 1;
+// The header's grid byte (FORMAT.md §3): quantization bits, the exact-grid
+// flag and the axis whose maximum the header stores.
+constexpr uint8_t kGridBitsMask = 0x1f;
+constexpr uint8_t kGridExact = 0x20;
+constexpr int kGridAxisShift = 6;
+// The header's level byte: the level (bits 0-3) and, in bit 4, that a
+// segment count (2 or more) follows the grid's top; without it, 1 segment.
+constexpr uint8_t kLevelMask = 0x0f;
+constexpr uint8_t kLevelSegmented = 0x10;
 
 struct Section {
   uint16_t id = 0;
@@ -75,11 +84,17 @@ class ContainerWriter {
 
  private:
   std::string out_;
+  bool first_ = true;  // the next section is the first: its checksum covers the header too
 };
 
 // Appends a raw section (FORMAT.md §4.1) to a file's bytes (for sections
-// added after the end marker is taken off).
+// added after the end marker is taken off; never the file's first section).
 void append_raw_section(std::string& file, uint16_t id, std::string_view payload);
+// The end marker (FORMAT.md §4.4): one byte.
+constexpr size_t kEndMarkerBytes = 1;
+inline void append_end_marker(std::string& file) { file.push_back(static_cast<char>(kSectionEnd)); }
+// The bytes of a section's framing (id and codec, lengths, checksum).
+uint64_t section_framing_bytes(const Section& s);
 
 // Incremental reading, for bytes that may still be arriving: each reads one
 // piece starting at `offset` of the bytes received so far and advances
@@ -88,9 +103,11 @@ void append_raw_section(std::string& file, uint16_t id, std::string_view payload
 // at hand already show is an error at once.
 Status read_header(std::string_view bytes, size_t& offset, Header& header, std::string& missing);
 // A section, or the end marker (s.id == kSectionEnd). `base` is the file
-// offset of bytes[0] (for messages and Section::offset).
+// offset of bytes[0] (for messages and Section::offset). For the file's
+// first section `header` holds the file's bytes before it (preamble and
+// header), which its checksum covers too; empty for every later section.
 Status read_section(std::string_view bytes, size_t& offset, Section& s, bool decode_payload, std::string& missing,
-                    size_t base = 0);
+                    size_t base = 0, std::string_view header = {});
 
 // Which ids may follow which (FORMAT.md §4.3): segment sections only in a
 // file of several segments, at most segment_count of them; the mesh section
@@ -119,6 +136,8 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
                       bool decode_payloads = true);
 
 uint32_t checksum32(std::string_view bytes);
+// XXH32 of `first` followed by `second`.
+uint32_t checksum32(std::string_view first, std::string_view second);
 
 // The metadata section's payload (FORMAT.md §4.6): Mesh::metadata entries.
 std::string write_metadata(const std::vector<MetadataEntry>& entries);

@@ -1,7 +1,8 @@
 // Reading the .tsm container (format-spec/FORMAT.md §2-4; the decoder's
 // first step): magic, version, header, then self-delimiting sections, each
-// with an id, a codec (raw or zstd), its lengths and an XXH32 checksum,
-// ended by an end marker; the mesh section's streams and the metadata.
+// with an id and codec (raw or zstd), its lengths, its payload and an XXH32
+// checksum of its bytes (the first section's covers the header too, so the
+// header is verified with it), ended by an end marker; the mesh section's streams and the metadata.
 // Sections are read in order, so a decoder can start on a section as soon
 // as its bytes are in. (Writing: container_write.cpp.)
 //
@@ -9,6 +10,7 @@
 // allocated, and every section's checksum is verified before it is used.
 #include "container.hpp"
 
+#define XXH_STATIC_LINKING_ONLY  // XXH32_state_t on the stack
 #include <xxhash.h>
 #include <algorithm>
 #include <cmath>
@@ -37,6 +39,15 @@ const char* section_name(uint16_t id) {
 
 uint32_t checksum32(std::string_view bytes) { return XXH32(bytes.data(), bytes.size(), 0); }
 
+uint32_t checksum32(std::string_view first, std::string_view second) {
+  if (first.empty()) return checksum32(second);
+  XXH32_state_t state;
+  XXH32_reset(&state, 0);
+  XXH32_update(&state, first.data(), first.size());
+  XXH32_update(&state, second.data(), second.size());
+  return XXH32_digest(&state);
+}
+
 namespace {
 
 Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data, what); }
@@ -55,8 +66,11 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
   const size_t have = std::min<size_t>(bytes.size(), 4);
   if (bytes.substr(0, have) != std::string_view(kMagic, have))
     return corrupt("not a .tsm file (bad magic; expected the bytes 'TSM' 0x1A)");
-  uint16_t version = 0, flags = 0;
-  if (!r.bytes(4, magic) || !r.u16(version)) {
+  // A varint that fails with bytes left after it is invalid; one cut off
+  // by the end of the bytes at hand has consumed them all.
+  uint64_t version = 0;
+  if (!r.bytes(4, magic) || !r.varint(version)) {
+    if (magic.size() == 4 && r.remaining() > 0) return corrupt("the format version is not a valid varint");
     missing = "file ends inside the header";
     return Status::Ok();
   }
@@ -65,105 +79,106 @@ Status read_header(std::string_view bytes, size_t& offset, Header& header, std::
                                               ": this decoder reads only format version " +
                                               std::to_string(kFormatVersion) +
                                               " (tsm keeps one format until 1.0; re-encode from the source mesh)");
-  header.version = version;
-  if (!r.u16(flags)) {
-    missing = "file ends inside the header";
-    return Status::Ok();
-  }
-  if (flags & ~kHeaderExactGrid) return corrupt("unknown header flags " + std::to_string(flags));
-  header.flags = flags;
-  uint64_t header_len = 0;
-  std::string_view fields;
-  if (!r.varint(header_len)) {
-    if (r.remaining() >= 10) return corrupt("header length is not a valid varint");
-    missing = "file ends inside the header";
-    return Status::Ok();
-  }
-  if (header_len > (uint64_t{1} << 20)) return corrupt("header length " + std::to_string(header_len) + " is implausible");
-  if (!r.bytes(static_cast<size_t>(header_len), fields)) {
-    missing = "header length runs past the end of the file";
-    return Status::Ok();
-  }
-  size_t header_end = r.offset();
-  uint32_t sum = 0;
-  if (!r.u32(sum)) {
-    missing = "file ends before the header checksum";
-    return Status::Ok();
-  }
-  if (sum != checksum32(bytes.substr(0, header_end))) return corrupt("header checksum mismatch");
-  ByteReader h(fields);
-  uint64_t segments = 0;
-  bool ok = h.varint(header.vertex_count) && h.varint(header.face_count) && h.varint(header.corner_count) &&
-            h.u8(header.quantization_bits) && h.u8(header.level);
-  for (float& o : header.origin) ok = ok && h.f32(o);
-  ok = ok && h.f64(header.extent) && h.varint(segments);
-  if (ok && (flags & kHeaderExactGrid)) {
-    ok = h.f64(header.exact_step);
+  header.version = kFormatVersion;
+  // A read cut off by the end of the bytes leaves fewer than 8 of them
+  // (the widest fixed field): with more, a varint is invalid.
+  uint8_t grid = 0, level = 0;
+  float top = 0;
+  uint64_t segments = 1;
+  bool ok = r.varint(header.vertex_count) && r.varint(header.face_count) && r.varint(header.corner_count) &&
+            r.u8(grid) && r.u8(level);
+  for (float& o : header.origin) ok = ok && r.f32(o);
+  ok = ok && r.f32(top) && (!(level & kLevelSegmented) || r.varint(segments));
+  header.flags = (grid & kGridExact) ? kHeaderExactGrid : 0;
+  if (ok && (grid & kGridExact)) {
+    ok = r.f64(header.exact_step);
     for (int64_t& b : header.exact_base) {
       uint64_t z = 0;
-      ok = ok && h.varint(z);
+      ok = ok && r.varint(z);
       b = static_cast<int64_t>(z >> 1) ^ -static_cast<int64_t>(z & 1);
     }
   }
-  if (!ok) return corrupt("header fields are truncated");
-  if ((flags & kHeaderExactGrid) && !(header.exact_step > 0 && std::isfinite(header.exact_step)))
+  if (!ok) {
+    if (r.remaining() >= 8) return corrupt("header fields are not valid varints");
+    missing = "file ends inside the header";
+    return Status::Ok();
+  }
+  header.quantization_bits = grid & kGridBitsMask;
+  header.level = level & kLevelMask;
+  if (level & ~(kLevelMask | kLevelSegmented)) return corrupt("header level byte has bits 5-7 set");
+  const int axis = grid >> kGridAxisShift;
+  if (axis > 2) return corrupt("header grid byte names axis 3");
+  if (header.quantization_bits < 1 || header.quantization_bits > 30)
+    return corrupt("quantization bits " + std::to_string(header.quantization_bits) + " outside 1..30");
+  for (float o : header.origin)
+    if (!std::isfinite(o)) return corrupt("header origin is not a finite number");
+  header.extent = static_cast<double>(top) - static_cast<double>(header.origin[axis]);
+  if (!std::isfinite(top) || !(header.extent >= 0))
+    return corrupt("header bounding-box maximum is not a finite number at or above the origin");
+  if ((grid & kGridExact) && !(header.exact_step > 0 && std::isfinite(header.exact_step)))
     return corrupt("the exact grid's step is not a finite positive number");
   for (int64_t b : header.exact_base)
     if (b > (int64_t{1} << 62) || b < -(int64_t{1} << 62)) return corrupt("the exact grid's base is out of range");
-  if (segments == 0 || segments > 0xffffffffu) return corrupt("bad segment count");
+  if ((level & kLevelSegmented) && (segments < 2 || segments > 0xffffffffu)) return corrupt("bad segment count");
   header.segment_count = static_cast<uint32_t>(segments);
-  for (float o : header.origin)
-    if (!std::isfinite(o)) return corrupt("header origin is not a finite number");
-  if (!std::isfinite(header.extent) || header.extent < 0 || header.extent > 6.9e38)
-    return corrupt("header extent is not a finite, non-negative number");
-  if (header.quantization_bits < 1 || header.quantization_bits > 30)
-    return corrupt("quantization bits " + std::to_string(header.quantization_bits) + " outside 1..30");
   offset = r.offset();
   return Status::Ok();
 }
 
+uint64_t section_framing_bytes(const Section& s) {
+  auto varint_bytes = [](uint64_t v) {
+    uint64_t n = 1;
+    for (; v >= 0x80; v >>= 7) ++n;
+    return n;
+  };
+  const uint64_t tag = uint64_t{s.id} << 1 | static_cast<uint64_t>(s.codec);
+  return varint_bytes(tag) + varint_bytes(s.stored_bytes) +
+         (s.codec == SectionCodec::zstd ? varint_bytes(s.raw_bytes) : 0) + 4;
+}
+
 Status read_section(std::string_view bytes, size_t& offset, Section& s, bool decode_payload, std::string& missing,
-                    size_t base) {
+                    size_t base, std::string_view header) {
   missing.clear();
   const size_t at = base + offset;
   ByteReader r(bytes.substr(offset));
-  uint16_t id = 0;
-  if (!r.u16(id)) {
+  uint64_t tag = 0;
+  if (!r.varint(tag)) {
+    if (r.remaining() > 0) return corrupt("section at byte " + std::to_string(at) + ": bad id");
     missing = "file ends before the end marker (truncated at byte " + std::to_string(at) + ")";
     return Status::Ok();
   }
+  if (tag >> 1 > 0xffff) return corrupt("section at byte " + std::to_string(at) + ": id above 65535");
   s = Section();
-  s.id = id;
-  if (id == kSectionEnd) {
+  s.id = static_cast<uint16_t>(tag >> 1);
+  const uint16_t id = s.id;
+  if (tag == kSectionEnd) {
     offset += r.offset();
     return Status::Ok();
   }
-  uint8_t codec = 0;
+  if (id == kSectionEnd) return corrupt("section at byte " + std::to_string(at) + ": a zstd-coded end marker");
+  const bool zstd = (tag & 1) != 0;
   uint64_t stored_len = 0, raw_len = 0;
-  uint32_t csum = 0;
-  if (!r.u8(codec)) {
+  // A varint cut off by the end of the bytes has consumed them all: one
+  // that fails with bytes left is invalid.
+  if (!r.varint(stored_len) || (zstd && !r.varint(raw_len))) {
+    if (r.remaining() > 0) return corrupt("section at byte " + std::to_string(at) + ": bad length field");
     missing = "section at byte " + std::to_string(at) + ": truncated section header";
     return Status::Ok();
   }
-  if (codec > 1) return corrupt("section at byte " + std::to_string(at) + ": unknown codec " + std::to_string(codec));
-  // The fields below are at most 10 + 10 + 4 bytes: a reader that has that
-  // many and still fails has a bad varint.
-  if (!r.varint(stored_len) || !r.varint(raw_len) || !r.u32(csum)) {
-    if (r.remaining() >= 24) return corrupt("section at byte " + std::to_string(at) + ": bad length field");
-    missing = "section at byte " + std::to_string(at) + ": truncated section header";
-    return Status::Ok();
-  }
-  if (codec == 0 ? raw_len != stored_len : raw_len > stored_len * kMaxExpansion)
+  if (!zstd) raw_len = stored_len;
+  if (raw_len > stored_len * kMaxExpansion)
     return corrupt_at(at, id, "implausible raw length " + std::to_string(raw_len));
   std::string_view stored;
-  if (!r.bytes(static_cast<size_t>(std::min<uint64_t>(stored_len, SIZE_MAX)), stored)) {
+  uint32_t csum = 0;
+  if (!r.bytes(static_cast<size_t>(std::min<uint64_t>(stored_len, SIZE_MAX)), stored) || !r.u32(csum)) {
     missing = "section '" + std::string(section_name(id)) + "' at byte " + std::to_string(at) + ": length " +
               std::to_string(stored_len) + " runs past the end of the file (" + std::to_string(r.remaining()) +
               " bytes left)";
     return Status::Ok();
   }
-  if (checksum32(stored) != csum) return corrupt_at(at, id, "checksum mismatch (the file is damaged)");
-  s.codec = static_cast<SectionCodec>(codec);
+  if (checksum32(header, bytes.substr(offset, r.offset() - 4)) != csum)
+    return corrupt_at(at, id, "checksum mismatch (the file is damaged)");
+  s.codec = zstd ? SectionCodec::zstd : SectionCodec::raw;
   s.stored_bytes = stored_len;
   s.raw_bytes = raw_len;
   s.offset = at;
@@ -236,10 +251,11 @@ Status read_container(std::string_view bytes, Header& header, std::vector<Sectio
   std::string missing;
   TSM_RETURN_IF_ERROR(read_header(bytes, offset, header, missing));
   if (!missing.empty()) return corrupt(missing);
+  const std::string_view head = bytes.substr(0, offset);
   SectionRules rules;
-  for (;;) {
+  for (bool first = true;; first = false) {
     Section s;
-    TSM_RETURN_IF_ERROR(read_section(bytes, offset, s, decode_payloads, missing));
+    TSM_RETURN_IF_ERROR(read_section(bytes, offset, s, decode_payloads, missing, 0, first ? head : std::string_view()));
     if (!missing.empty()) return corrupt(missing);
     if (s.id == kSectionEnd) break;
     TSM_RETURN_IF_ERROR(rules.admit(s, header));

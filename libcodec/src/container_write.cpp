@@ -1,6 +1,7 @@
 // Writing the .tsm container (format-spec/FORMAT.md §2-4; the encoder's
-// last step): magic, version, header, then the sections, each with its id,
-// codec, lengths and XXH32 checksum, and the end marker. The method's
+// last step): magic, version, header, then the sections, each with its id
+// and codec, lengths, payload and XXH32 checksum (the first section's covers
+// the header too), and the end marker. The method's
 // streams (seed 004 §3-4: vertex tree, triangle tree, marching pattern,
 // geometry) go in one section per segment (a mesh of one segment: the mesh
 // section); side data is zstd-compressed where that wins. The only use of
@@ -18,15 +19,31 @@ void write_header_fields(ByteWriter& w, const Header& h) {
   w.varint(h.vertex_count);
   w.varint(h.face_count);
   w.varint(h.corner_count);
-  w.u8(h.quantization_bits);
-  w.u8(h.level);
+  float top = 0;
+  const int axis = extent_axis(h.origin, 3, h.extent, top);
+  const bool exact = (h.flags & kHeaderExactGrid) != 0;
+  w.u8(static_cast<uint8_t>(h.quantization_bits | (exact ? kGridExact : 0) | axis << kGridAxisShift));
+  w.u8(static_cast<uint8_t>(h.level | (h.segment_count > 1 ? kLevelSegmented : 0)));
   for (float o : h.origin) w.f32(o);
-  w.f64(h.extent);
-  w.varint(h.segment_count);
-  if (h.flags & kHeaderExactGrid) {
+  w.f32(top);
+  if (h.segment_count > 1) w.varint(h.segment_count);
+  if (exact) {
     w.f64(h.exact_step);
     for (int64_t b : h.exact_base) w.varint((static_cast<uint64_t>(b) << 1) ^ static_cast<uint64_t>(b >> 63));
   }
+}
+
+// A section's framing, its stored bytes and its checksum, which covers
+// `out` from `covered_from` (the section's first byte; for the first
+// section, the file's) to the last stored byte.
+void put_section(std::string& out, size_t covered_from, uint16_t id, SectionCodec codec, std::string_view stored,
+                 uint64_t raw_bytes) {
+  ByteWriter w(out);
+  w.varint(uint64_t{id} << 1 | static_cast<uint64_t>(codec));
+  w.varint(stored.size());
+  if (codec == SectionCodec::zstd) w.varint(raw_bytes);
+  w.bytes(stored);
+  w.u32(checksum32(std::string_view(out).substr(covered_from)));
 }
 
 }  // namespace
@@ -34,14 +51,8 @@ void write_header_fields(ByteWriter& w, const Header& h) {
 ContainerWriter::ContainerWriter(const Header& header) {
   ByteWriter w(out_);
   w.bytes(std::string_view(kMagic, 4));
-  w.u16(header.version);
-  w.u16(header.flags);
-  std::string fields;
-  ByteWriter fw(fields);
-  write_header_fields(fw, header);
-  w.varint(fields.size());
-  w.bytes(fields);
-  w.u32(checksum32(std::string_view(out_)));
+  w.varint(header.version);
+  write_header_fields(w, header);
 }
 
 void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zstd_level) {
@@ -56,28 +67,16 @@ void ContainerWriter::add_section(uint16_t id, std::string_view payload, int zst
     }
   }
   if (codec == SectionCodec::raw) stored.assign(payload.data(), payload.size());
-  ByteWriter w(out_);
-  w.u16(id);
-  w.u8(static_cast<uint8_t>(codec));
-  w.varint(stored.size());
-  w.varint(payload.size());
-  w.u32(checksum32(stored));
-  w.bytes(stored);
+  put_section(out_, first_ ? 0 : out_.size(), id, codec, stored, payload.size());
+  first_ = false;
 }
 
 void append_raw_section(std::string& file, uint16_t id, std::string_view payload) {
-  ByteWriter w(file);
-  w.u16(id);
-  w.u8(static_cast<uint8_t>(SectionCodec::raw));
-  w.varint(payload.size());
-  w.varint(payload.size());
-  w.u32(checksum32(payload));
-  w.bytes(payload);
+  put_section(file, file.size(), id, SectionCodec::raw, payload, payload.size());
 }
 
 std::string ContainerWriter::finish() {
-  ByteWriter w(out_);
-  w.u16(kSectionEnd);
+  append_end_marker(out_);
   return std::move(out_);
 }
 

@@ -593,12 +593,6 @@ void add_attribute_costs(const std::vector<AttributeCost>& costs, std::vector<At
 
 namespace {
 
-uint64_t varint_bytes(uint64_t v) {
-  uint64_t n = 1;
-  for (; v >= 0x80; v >>= 7) ++n;
-  return n;
-}
-
 // A progressive file's batches (FORMAT.md §4.8): their headers (the
 // counts follow from the split counts; decode() checks the splits).
 Status inspect_batches(const Header& h, const std::vector<Section>& sections, FileInfo& info) {
@@ -616,7 +610,7 @@ Status inspect_batches(const Header& h, const std::vector<Section>& sections, Fi
     vertices += bh.splits;
     faces += 2 * bh.splits - bh.border;
     FileInfo::Batch b;
-    b.bytes = 7 + varint_bytes(s.stored_bytes) + varint_bytes(s.raw_bytes) + s.stored_bytes;
+    b.bytes = section_framing_bytes(s) + s.stored_bytes;
     b.vertices = vertices;
     b.faces = faces;
     b.error = bh.error_after;
@@ -709,6 +703,7 @@ struct StreamDecoder::Impl {
   std::string buf;      // bytes received and not yet consumed
   size_t base = 0;      // file offset of buf[0]
   bool have_header = false, ended = false;
+  std::string head;     // preamble and header, until the first section (its checksum covers them) is in
   Header h;
   SectionRules rules;
   std::vector<Section> whole;  // a one-segment file's sections, until the end marker
@@ -807,8 +802,9 @@ struct StreamDecoder::Impl {
 
   // The next section's id, when its first bytes are in (0 otherwise).
   uint16_t next_id(size_t pos) const {
-    if (buf.size() < pos + 2) return 0;
-    return static_cast<uint16_t>(static_cast<uint8_t>(buf[pos]) | static_cast<uint8_t>(buf[pos + 1]) << 8);
+    ByteReader r(std::string_view(buf).substr(std::min(pos, buf.size())));
+    uint64_t tag = 0;
+    return r.varint(tag) && tag >> 1 <= 0xffff ? static_cast<uint16_t>(tag >> 1) : 0;
   }
 
   // The base is shown as soon as it is whole and a refinement section
@@ -830,7 +826,10 @@ struct StreamDecoder::Impl {
     if (!have_header) {
       TSM_RETURN_IF_ERROR(read_header(buf, pos, h, missing));
       if (!missing.empty()) return Status::Ok();
+      // The caller's limits apply at once; the header's checksum comes
+      // with the first section.
       TSM_RETURN_IF_ERROR(check_user_limits(h, options));
+      head = buf.substr(0, pos);
       have_header = true;
     }
     pending = false;
@@ -843,8 +842,9 @@ struct StreamDecoder::Impl {
         }
       }
       Section s;
-      TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base));
+      TSM_RETURN_IF_ERROR(read_section(buf, pos, s, true, missing, base, head));
       if (!missing.empty()) break;
+      head.clear();  // the first section's checksum has verified the header
       if (s.id == kSectionEnd) {
         if (pos != buf.size())
           return corrupt(std::to_string(buf.size() - pos) + " unexpected bytes after the end marker");
@@ -902,7 +902,7 @@ Status StreamDecoder::finish() {
   } else {
     size_t pos = 0;
     Section s;
-    Status st = read_section(impl_->buf, pos, s, false, missing, impl_->base);
+    Status st = read_section(impl_->buf, pos, s, false, missing, impl_->base, impl_->head);
     impl_->failed = st.ok() ? corrupt(missing.empty() ? "file ends before the end marker" : missing) : st;
   }
   return impl_->failed;

@@ -34,6 +34,7 @@ Status decode_partial(std::string_view bytes, Mesh& out, const PartialOptions& p
   std::string missing;
   TSM_RETURN_IF_ERROR(read_header(bytes, pos, h, missing));
   if (!missing.empty()) return Status(ErrorCode::corrupt_data, "the file ends inside its header: " + missing);
+  const size_t head = pos;
   // Where to cut: after the base's last section, then after each whole
   // refinement within the byte budget, until the error asked for is met.
   const uint64_t budget = partial.max_bytes ? std::min<uint64_t>(partial.max_bytes, bytes.size()) : bytes.size();
@@ -45,7 +46,8 @@ Status decode_partial(std::string_view bytes, Mesh& out, const PartialOptions& p
   while (true) {
     Section s;
     const size_t at = pos;
-    TSM_RETURN_IF_ERROR(read_section(bytes.substr(0, budget), pos, s, true, missing));
+    TSM_RETURN_IF_ERROR(read_section(bytes.substr(0, budget), pos, s, true, missing, 0,
+                                     at == head ? bytes.substr(0, head) : std::string_view()));
     if (!missing.empty()) break;
     if (s.id == kSectionEnd) {
       rep.complete = base_done && pos == bytes.size();
@@ -70,10 +72,9 @@ Status decode_partial(std::string_view bytes, Mesh& out, const PartialOptions& p
     return Status(ErrorCode::corrupt_data,
                   "the bytes end before the base mesh is whole (" + std::to_string(bytes.size()) + " bytes)");
   std::string prefix(bytes.substr(0, cut));
-  prefix.push_back('\0');
-  prefix.push_back('\0');
+  append_end_marker(prefix);
   TSM_RETURN_IF_ERROR(decode(prefix, out, options));
-  if (rep.complete && cut + 2 != bytes.size()) rep.complete = false;
+  if (rep.complete && cut + kEndMarkerBytes != bytes.size()) rep.complete = false;
   rep.batches = batches;
   rep.bytes_used = rep.complete ? bytes.size() : cut;
   rep.error = error;

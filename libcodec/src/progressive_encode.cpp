@@ -86,7 +86,7 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
   std::vector<uint32_t> id;
   map_base(plan, q, level, id);
 
-  out.assign(base, 0, base.size() - 2);  // without the end marker
+  out.assign(base, 0, base.size() - kEndMarkerBytes);  // without the end marker
   // The plan's errors are in grid steps; the file's in model units.
   auto error_of = [&](size_t b) { return static_cast<float>(plan.errors[b] * grid.step); };
   float before = plan.batches.empty() ? 0.0f : error_of(plan.batches.size() - 1);
@@ -119,8 +119,7 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
       for (int a = 0; a < 3; ++a) lq.push_back(q[3 * size_t{i} + a]);
     append_raw_section(out, kSectionLoose, encode_loose(std::move(lq)));
   }
-  out.push_back('\0');
-  out.push_back('\0');
+  append_end_marker(out);
   return Status::Ok();
 }
 

@@ -37,31 +37,38 @@ let at = 0;
 const varint = () => { let v = 0, s = 1; for (;;) { const c = src[at++]; v += (c & 0x7f) * s; s *= 128; if (c < 0x80) return v; } };
 const putVarint = (v, out) => { while (v >= 0x80) { out.push((v % 128) | 0x80); v = Math.floor(v / 128); } out.push(v); };
 if (src.subarray(0, 4).toString('latin1') !== 'TSM\x1a') throw new Error('not a .tsm file');
-at = 8;
-const hlen = varint();
-at += hlen + 4; // header fields and their checksum stay as they are
+// The header (FORMAT.md §3): version, three counts, grid and level bytes,
+// origin and top (16 bytes), the segment count (level bit 4), the exact
+// grid's fields (grid bit 5).
+at = 4;
+for (let i = 0; i < 4; i++) varint();
+const grid = src[at], level = src[at + 1];
+at += 18;
+if (level & 0x10) varint();
+if (grid & 0x20) { at += 8; for (let i = 0; i < 3; i++) varint(); }
 const parts = [src.subarray(0, at)];
-let recoded = 0;
+let first = true, recoded = 0;
 for (;;) {
-  const id = src[at] | (src[at + 1] << 8);
-  if (id === 0) { parts.push(src.subarray(at, at + 2)); at += 2; break; }
-  const codec = src[at + 2];
-  at += 3;
-  const stored = varint(), raw = varint();
-  at += 4;
+  const tag = varint();
+  if (tag === 0) { parts.push(Buffer.from([0])); break; }
+  const id = Math.floor(tag / 2), codec = tag % 2;
+  const stored = varint(), raw = codec ? varint() : stored;
   const payload = src.subarray(at, at + stored);
-  at += stored;
-  let out = payload, outCodec = codec;
+  at += stored + 4;
+  let out = payload;
   if (codec === 0) {
-    const z = execFileSync('zstd', ['-19', '-q', '-c'], { input: payload, maxBuffer: 1 << 30 });
-    out = z; outCodec = 1; recoded++;
+    out = execFileSync('zstd', ['-19', '-q', '-c'], { input: payload, maxBuffer: 1 << 30 });
+    recoded++;
   }
-  const head = [id & 0xff, id >> 8, outCodec];
+  const head = [];
+  putVarint(id * 2 + 1, head);
   putVarint(out.length, head);
   putVarint(raw, head);
-  const sum = xxh32(out);
-  head.push(sum & 0xff, (sum >>> 8) & 0xff, (sum >>> 16) & 0xff, sum >>> 24);
-  parts.push(Buffer.from(head), out);
+  const section = Buffer.concat([Buffer.from(head), out]);
+  // A section's checksum covers its bytes; the first section's, the header's too (FORMAT.md §4.1).
+  const sum = xxh32(first ? Buffer.concat([parts[0], section]) : section);
+  parts.push(section, Buffer.from([sum & 0xff, (sum >>> 8) & 0xff, (sum >>> 16) & 0xff, sum >>> 24]));
+  first = false;
 }
 if (at !== src.length) throw new Error(`${src.length - at} bytes after the end marker`);
 fs.writeFileSync(process.argv[3], Buffer.concat(parts));
