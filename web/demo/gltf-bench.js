@@ -10,6 +10,9 @@ import { loadDraco } from './draco.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
+// Untimed decodes before the timed ones: V8 compiles WebAssembly with its baseline compiler first and
+// optimizes hot functions in the background, so the first decodes run slower code.
+const WARMUP = Number(params.get('warmup') || 2);
 const result = (window.benchResult = { state: 'running', reps: REPS, rows: [] });
 const log = (s) => { document.getElementById('log').textContent += '\n' + s; };
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
@@ -118,9 +121,17 @@ async function main() {
       if (!f.jobs.length) { log(`${url}: nothing compressed with ${codec}, left out`); delete files[codec]; }
     }
     const times = Object.fromEntries(Object.keys(files).map((c) => [c, []]));
-    const runAll = (c) => { const t0 = performance.now(); let info; for (const j of files[c].jobs) info = codecs[c].run(j); return [performance.now() - t0, info]; };
-    for (let i = 0; i < 2; ++i) for (const c of Object.keys(files)) runAll(c);
-    for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c)[0]);
+    // One sample decodes the file's streams `inner` times (about 20 ms of the slowest codec's
+    // work): the page's clock ticks in 0.1 ms steps, coarser than a small file's decode.
+    const runAll = (c, inner = 1) => {
+      const t0 = performance.now();
+      for (let k = 0; k < inner; ++k) for (const j of files[c].jobs) codecs[c].run(j);
+      return (performance.now() - t0) / inner;
+    };
+    for (let i = 0; i < WARMUP; ++i) for (const c of Object.keys(files)) runAll(c);
+    const slowest = Math.max(...Object.keys(files).map((c) => Math.min(runAll(c), runAll(c), runAll(c))));
+    const inner = Math.max(1, Math.ceil(20 / Math.max(0.1, slowest)));
+    for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c, inner));
     const row = { name: asset.name };
     for (const c of Object.keys(files)) row[c] = { fileBytes: files[c].fileBytes, geometryBytes: files[c].geometryBytes,
       streams: files[c].jobs.length, ms: median(times[c]), minMs: Math.min(...times[c]) };
