@@ -10,9 +10,12 @@ import { loadDraco } from './draco.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
-// Untimed decodes before the timed ones: V8 compiles WebAssembly with its baseline compiler first and
-// optimizes hot functions in the background, so the first decodes run slower code.
-const WARMUP = Number(params.get('warmup') || 2);
+// Untimed decodes before the timed ones, for at least WARMUP_MS of each decoder's time and at least
+// twice: V8 runs WebAssembly from its baseline compiler first and swaps in optimized code of each hot
+// function when its background compile is done (a large function, on a loaded machine, takes a while):
+// with 2 decodes the first asset was timed on baseline code (Fox, tsm 13.5 ms; after 40, 4.9 ms).
+const WARMUP_MS = Number(params.get('warmup') || 500);
+const warm = (f) => { const t0 = performance.now(); for (let i = 0; i < 2 || performance.now() - t0 < WARMUP_MS; ++i) f(); };
 const result = (window.benchResult = { state: 'running', reps: REPS, rows: [] });
 const log = (s) => { document.getElementById('log').textContent += '\n' + s; };
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
@@ -128,7 +131,7 @@ async function main() {
       for (let k = 0; k < inner; ++k) for (const j of files[c].jobs) codecs[c].run(j);
       return (performance.now() - t0) / inner;
     };
-    for (let i = 0; i < WARMUP; ++i) for (const c of Object.keys(files)) runAll(c);
+    for (const c of Object.keys(files)) warm(() => runAll(c));
     const slowest = Math.max(...Object.keys(files).map((c) => Math.min(runAll(c), runAll(c), runAll(c))));
     const inner = Math.max(1, Math.ceil(20 / Math.max(0.1, slowest)));
     for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c, inner));

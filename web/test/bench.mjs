@@ -19,7 +19,7 @@ if (r.state !== 'done') { console.error('bench failed:', r.error); process.exit(
 const n = (x) => x.toLocaleString('en-US');
 const f = (x, d = 1) => (x == null ? '-' : x.toFixed(d));
 const lines = [];
-lines.push(`Chromium ${r.chromium}, headless, this machine; median of ${r.reps} samples (each the mean of enough decodes of bytes already in memory to take about 20 ms), after 2 warm-up runs.`);
+lines.push(`Chromium ${r.chromium}, headless, this machine; median of ${r.reps} samples (each the mean of enough decodes of bytes already in memory to take about 20 ms), after 0.5 s of warm-up decodes each.`);
 lines.push('');
 lines.push('Draco decodes positions and faces only; "tsm attributes": the attributes tsm decodes besides (bunny: confidence and intensity; bunny_pos is the same mesh without them).');
 lines.push('');
