@@ -16,13 +16,16 @@ CORPUS="${CORPUS:-$ROOT/../shared/corpus}"
 OUT="$ROOT/build/web/data"
 mkdir -p "$OUT"
 
-# name:source (relative to the corpus)[:faces per segment, when the encoder has --segment-faces]
+# name:source (relative to the corpus)[:faces per segment, when the encoder has --segment-faces][:level]
+# [:progressive][:drop (--drop-attributes: bunny_pos is the bunny as Draco's PLY reader sees it, positions
+# only, so the bench times the same content for both)]
 MESHES="bunny:bun_zipper.ply dragon_res4:dragon_vrip_res4.ply dragon_res3:dragon_vrip_res3.ply
 dragon_res2:dragon_vrip_res2.ply dragon:dragon_vrip.ply cube_quads:edge/cube_quads.obj
 dragon_seg16k:dragon_vrip.ply:16384 bunny_seg4k:bun_zipper.ply:4096
 dragon_res4_l0:dragon_vrip_res4.ply::0 bunny_l0:bun_zipper.ply::0 bunny_l2:bun_zipper.ply::2
 dragon_res3_l1:dragon_vrip_res3.ply::1
-bunny_prog:bun_zipper.ply:::progressive dragon_res4_prog:dragon_vrip_res4.ply:::progressive"
+bunny_prog:bun_zipper.ply:::progressive dragon_res4_prog:dragon_vrip_res4.ply:::progressive
+bunny_pos:bun_zipper.ply::::drop"
 SEGMENTS=0
 "$TSM" encode --help 2>/dev/null | grep -q -- --segment-faces && SEGMENTS=1
 
@@ -43,7 +46,7 @@ make_ref() {  # NAME: NAME.ref.json from the native decoder's output
 want=("$@")
 list=()
 for entry in $MESHES; do
-  IFS=: read -r name rel segfaces level progressive <<<"$entry"
+  IFS=: read -r name rel segfaces level progressive drop <<<"$entry"
   src="$CORPUS/$rel"
   extra="${TSM_ENCODE_ARGS:-}"
   if [ -n "$segfaces" ]; then
@@ -56,6 +59,7 @@ for entry in $MESHES; do
   [ -n "$level" ] && extra="$extra -l $level"
   # A progressive file (a base mesh, then batches of vertex splits).
   [ -n "$progressive" ] && extra="$extra --progressive --drop-attributes"
+  [ -n "$drop" ] && extra="$extra --drop-attributes"
   if [ "${#want[@]}" -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
   [ -f "$src" ] || { echo "prepare-data: $src missing, skipped" >&2; continue; }
   list+=("$name")
@@ -68,7 +72,7 @@ for entry in $MESHES; do
     rm -f "$ref"
   fi
   make_ref "$name"
-  if [ -n "$segfaces" ] || [ -n "$level" ] || [ -n "$progressive" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
+  if [ -n "$segfaces" ] || [ -n "$level" ] || [ -n "$progressive" ] || [ -n "$drop" ]; then drc=/nonexistent  # the same mesh as its whole-file entry for Draco
   elif [ "$HAVE_DRACO" = 1 ] && { [ ! -f "$drc" ] || [ "$src" -nt "$drc" ]; }; then
     draco_encoder -i "$src" -o "$drc" -cl 10 -qp 14 >/dev/null
   fi

@@ -10,6 +10,12 @@ import { loadDraco } from './draco.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
+// Untimed decodes before the timed ones, for at least WARMUP_MS of each decoder's time and at least
+// twice: V8 runs WebAssembly from its baseline compiler first and swaps in optimized code of each hot
+// function when its background compile is done (a large function, on a loaded machine, takes a while):
+// with 2 decodes the first asset was timed on baseline code (Fox, tsm 13.5 ms; after 40, 4.9 ms).
+const WARMUP_MS = Number(params.get('warmup') || 500);
+const warm = (f) => { const t0 = performance.now(); for (let i = 0; i < 2 || performance.now() - t0 < WARMUP_MS; ++i) f(); };
 const result = (window.benchResult = { state: 'running', reps: REPS, rows: [] });
 const log = (s) => { document.getElementById('log').textContent += '\n' + s; };
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
@@ -118,9 +124,17 @@ async function main() {
       if (!f.jobs.length) { log(`${url}: nothing compressed with ${codec}, left out`); delete files[codec]; }
     }
     const times = Object.fromEntries(Object.keys(files).map((c) => [c, []]));
-    const runAll = (c) => { const t0 = performance.now(); let info; for (const j of files[c].jobs) info = codecs[c].run(j); return [performance.now() - t0, info]; };
-    for (let i = 0; i < 2; ++i) for (const c of Object.keys(files)) runAll(c);
-    for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c)[0]);
+    // One sample decodes the file's streams `inner` times (about 20 ms of the slowest codec's
+    // work): the page's clock ticks in 0.1 ms steps, coarser than a small file's decode.
+    const runAll = (c, inner = 1) => {
+      const t0 = performance.now();
+      for (let k = 0; k < inner; ++k) for (const j of files[c].jobs) codecs[c].run(j);
+      return (performance.now() - t0) / inner;
+    };
+    for (const c of Object.keys(files)) warm(() => runAll(c));
+    const slowest = Math.max(...Object.keys(files).map((c) => Math.min(runAll(c), runAll(c), runAll(c))));
+    const inner = Math.max(1, Math.ceil(20 / Math.max(0.1, slowest)));
+    for (let i = 0; i < REPS; ++i) for (const c of Object.keys(files)) times[c].push(runAll(c, inner));
     const row = { name: asset.name };
     for (const c of Object.keys(files)) row[c] = { fileBytes: files[c].fileBytes, geometryBytes: files[c].geometryBytes,
       streams: files[c].jobs.length, ms: median(times[c]), minMs: Math.min(...times[c]) };

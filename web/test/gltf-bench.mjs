@@ -99,7 +99,7 @@ if (given) {
 }
 const n = (x) => x.toLocaleString('en-US');
 const lines = [`Chromium ${r.chromium}, headless, this machine; geometry of each file decoded into typed arrays, ` +
-  `median of ${r.reps} runs after 2 warm-up runs, the three decoders taking turns.`, '',
+  `median of ${r.reps} samples (each the mean of enough decodes to take about 20 ms) after 0.5 s of warm-up decodes each, the decoders taking turns.`, '',
   '| asset | tsm ms | tsm -l 0 ms | Draco ms | meshopt ms | tsm .glb bytes | tsm -l 0 .glb bytes | Draco .glb bytes | meshopt .glb bytes | ' +
   'tsm geometry bytes | tsm -l 0 geometry bytes | Draco geometry bytes | meshopt geometry bytes |',
   '|---|---|---|---|---|---|---|---|---|---|---|---|---|'];
