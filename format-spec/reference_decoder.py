@@ -2772,9 +2772,9 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
     ids), per walk vertex its output id and its point."""
     d = RangeDecoder(stream)
-    fresh = probs(4 * 3 * 6 * 2)                           # fresh[nb][before][closeness][4 or more candidates]
-    rank = [[UIntModel(), UIntModel()] for _ in range(6)]   # [best][4 or more candidates]
-    copy = probs(4)                                         # copy[nb]
+    fresh = probs(4 * 3 * 6 * 3 * 2)                       # fresh[nb][before][best][second's class][4 or more]
+    rank = [[[UIntModel(), UIntModel()] for _ in range(6)] for _ in range(6)]   # [best][second][4 or more]
+    copy = probs(4 * 6)                                     # copy[nb][best]
     copy_rank = UIntModel()
     orig = []                                               # per walk vertex: the one whose values it has
     made = [[] for _ in range(points)]
@@ -2813,15 +2813,21 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 for w in reversed(made[p]):
                     if w not in cand:
                         cand.append(w)
-                close = [split_closeness(fn, total[w]) for w in cand]
+                ref = fn
+                if not any(fn):                 # a face flat on the grid: its corners' vertices so far
+                    ref = split_reduced([sum(total[v[j]][a] for j in range(i)) for a in range(3)])
+                close = [split_closeness(ref, total[w]) for w in cand]
                 order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
                 cand = [cand[k] for k in order]
                 best = close[order[0]]
-                before = 1 if d.bit(fresh, ((nb * 3 + before) * 6 + best) * 2 + (1 if len(cand) >= 4 else 0)) else 2
+                second = close[order[1]] if len(cand) > 1 else 6
+                sc = 0 if second == 6 else 1 if second <= 3 else 2
+                many = 1 if len(cand) >= 4 else 0
+                before = 1 if d.bit(fresh, (((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) else 2
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
-                    if d.bit(copy, nb):
+                    if d.bit(copy, nb * 6 + best):
                         r = copy_rank.decode(d) if len(cand) > 1 else 0
                         if r >= len(cand):
                             reject('split: copy rank')
@@ -2830,7 +2836,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     orig.append(o)
                     made[p].append(v[i])
                 else:
-                    r = rank[best][1 if len(cand) >= 4 else 0].decode(d) if len(cand) > 1 else 0
+                    r = rank[best][second][many].decode(d) if len(cand) > 1 else 0
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]

@@ -15,6 +15,7 @@
 #include "split_layout.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <unordered_map>
 
 #include "range_coder.hpp"
@@ -75,11 +76,15 @@ int closeness(const Normal& f, const int64_t sum[3]) {
 // same vertex, 3 two different vertices.
 struct SplitModels {
   // [neighbours (0-3)][the face's previous corner: 0 none, 1 a new vertex,
-  // 2 an old one][the first candidate's closeness (0-5)][4 or more
-  // candidates: a point of many vertices, as a CAD part's slivers make]
-  Prob fresh[4][3][6][2];
-  UIntModel rank[6][2];  // [the first candidate's closeness][4 or more candidates]
-  Prob copy[4];       // a new vertex with an earlier vertex's values, [neighbours]
+  // 2 an old one][the first candidate's closeness (0-5)][the second's class
+  // (none, 0-3, 4-5)][4 or more candidates: a point of many vertices, as a
+  // CAD part's slivers make]
+  Prob fresh[4][3][6][3][2];
+  // [the first candidate's closeness][the second's (0-5)][4 or more]: two
+  // candidates as close to the face say little which it is, a near one
+  // beside a far one much
+  UIntModel rank[6][6][2];
+  Prob copy[4][6];  // a new vertex with an earlier vertex's values, [neighbours][first closeness]
   UIntModel copy_rank;
 };
 
@@ -114,9 +119,7 @@ class EdgeMap {
     uint64_t key = kEmpty;
     Ends ends;
   };
-  size_t slot_of(uint64_t key) const {
-    return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
-  }
+  size_t slot_of(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
   void grow() {
     std::vector<Slot> old = std::move(slots_);
     slots_.assign(old.empty() ? 1024 : 2 * old.size(), Slot());
@@ -132,7 +135,20 @@ class EdgeMap {
 class SplitWalk {
  public:
   SplitWalk(uint32_t points, const std::vector<uint32_t>& q) : made_(points), q_(q) {}
-  void start_face(const uint32_t* c, uint32_t n) { normal_ = n >= 3 ? face_normal(q_, c) : Normal(); }
+  void start_face(const uint32_t* c, uint32_t n) {
+    normal_ = n >= 3 ? face_normal(q_, c) : Normal();
+    ref_ = normal_;
+  }
+  // The direction candidates are ranked by at the face's corner i: the
+  // face's normal, or where that is zero (a sliver flat on the grid) the
+  // summed normals of the vertices its corners 0 .. i-1 took (`v`).
+  void refer(const uint32_t* v, uint32_t i) {
+    if (!normal_.zero()) return;
+    int64_t t[3] = {0, 0, 0};
+    for (uint32_t j = 0; j < i; ++j)
+      for (int a = 0; a < 3; ++a) t[a] += sum_[v[j]].x[a];
+    ref_ = reduced(t);
+  }
   // The candidates for a corner at p whose face continues to `next` and
   // comes from `prev`, in cand(): the vertices of the neighbours across the
   // corner's two edges, then the point's other vertices (the latest made
@@ -153,7 +169,7 @@ class SplitWalk {
     close_.resize(cand_.size());
     order_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) {
-      close_[i] = closeness(normal_, sum_[cand_[i]].x);
+      close_[i] = closeness(ref_, sum_[cand_[i]].x);
       order_[i] = static_cast<uint32_t>(i);
     }
     // Stable insertion sort: a point has a handful of vertices.
@@ -170,6 +186,10 @@ class SplitWalk {
   }
   const std::vector<uint32_t>& cand() const { return sorted_; }
   int best() const { return best_; }
+  // The second candidate's closeness, 6 if there is none; in three classes
+  // (none, 0-3, 4-5) for the new-vertex bit.
+  int second() const { return order_.size() > 1 ? close_[order_[1]] : 6; }
+  int second_class() const { return second() == 6 ? 0 : second() <= 3 ? 1 : 2; }
   size_t vertices_at(uint32_t p) const { return made_[p].size(); }
   // A new vertex at p; `original`: the vertex whose attribute values it
   // has (kNoVertex: its own).
@@ -217,6 +237,7 @@ class SplitWalk {
   std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
   std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
   Normal normal_;                   // the current face's
+  Normal ref_;                      // what candidates are ranked by (refer)
   EdgeMap edge_;
   std::vector<uint32_t> cand_, sorted_, order_;
   std::vector<int> close_;
@@ -232,7 +253,8 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
                                 std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point,
                                 std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& indices) {
   RangeEncoder e;
-  SplitModels m;
+  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  SplitModels& m = *models;
   SplitWalk walk(points, q);
   std::unordered_map<uint32_t, uint32_t> walk_of;  // input vertex -> walk vertex
   std::vector<uint32_t> input_of;                  // walk vertex -> input vertex
@@ -251,21 +273,22 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
       if (walk.vertices_at(p) == 0) {
         v[i] = walk.make(p);
       } else {
+        walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        e.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0], fresh);
+        e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0], fresh);
         if (fresh) {
           // A copy: the values of a vertex of the point (the first such
           // candidate).
           const auto& cand = walk.cand();
           uint32_t r = 0;
           while (r < cand.size() && value_class[input_of[cand[r]]] != value_class[x]) ++r;
-          e.bit(m.copy[nb], r < cand.size());
+          e.bit(m.copy[nb][walk.best()], r < cand.size());
           if (r < cand.size() && cand.size() > 1) m.copy_rank.encode(e, r);
           v[i] = walk.make(p, r < cand.size() ? cand[r] : kNoVertex);
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
-          if (cand.size() > 1) m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].encode(e, r);
+          if (cand.size() > 1) m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0].encode(e, r);
           v[i] = it->second;
         }
       }
@@ -292,7 +315,8 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
                            std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
   auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
   RangeDecoder d(stream);
-  SplitModels m;
+  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  SplitModels& m = *models;
   SplitWalk walk(points, q);
   std::vector<uint32_t> v;
   for (uint32_t f = 0; f < faces.face_count(); ++f) {
@@ -309,12 +333,13 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
         v[i] = walk.make(p);
         before = 1;
       } else {
+        walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        before = d.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0]) ? 1 : 2;
+        before = d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0]) ? 1 : 2;
         if (before == 1) {
           const auto& cand = walk.cand();
           uint32_t original = kNoVertex;
-          if (d.bit(m.copy[nb])) {
+          if (d.bit(m.copy[nb][walk.best()])) {
             const uint32_t r = cand.size() > 1 ? m.copy_rank.decode(d) : 0;
             if (r >= cand.size()) return corrupt("a copy's rank out of range");
             original = cand[r];
@@ -322,7 +347,8 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
           v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
-          const uint32_t r = cand.size() > 1 ? m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].decode(d) : 0;
+          const uint32_t r =
+              cand.size() > 1 ? m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0].decode(d) : 0;
           if (r >= cand.size()) return corrupt("a vertex rank out of range");
           v[i] = cand[r];
         }
