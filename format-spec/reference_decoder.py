@@ -1940,7 +1940,8 @@ def squared_distance(a, b):
 
 def geometry_normals(faces, rank, q, bits, weights=0):
     """§8.12 "Geometry normals": per own rank the octahedral integers of the
-    summed fan cross products, or None where the sum is zero. Sums in face order,
+    summed fan cross products, or None where the sum is zero, and per own rank
+    the stray (the residuals' class for predictors 1, 3, 4). Sums in face order,
     a face's fan summed first, then added to each of its corners times the
     corner's weight (weights 0: 1, by area; 1: 1 / the vector's length, by face;
     2: 1 / sqrt of the product of the corner's two squared edge lengths, by
@@ -1977,7 +1978,42 @@ def geometry_normals(faces, rank, q, bits, weights=0):
     for r in range(n):
         if sx[r] != 0 or sy[r] != 0 or sz[r] != 0:
             out[r] = octahedral_ints(sx[r], sy[r], sz[r], bits)
-    return out
+    stray = [2] * n                     # §8.12 "the stray": 2 where there is no normal
+    for r in range(n):
+        if out[r] is not None:
+            stray[r] = 0
+    for f in faces:
+        k = len(f)
+        if k < 3 or any(rank[c] == NONE for c in f):
+            continue
+        vx, vy, vz = fan_vector(f, rank, q)
+        vv = (vx * vx + vy * vy) + vz * vz
+        if vv == 0:
+            continue
+        for c in f:
+            r = rank[c]
+            if out[r] is None:
+                continue
+            dot = (vx * sx[r] + vy * sy[r]) + vz * sz[r]
+            nn = vv * ((sx[r] * sx[r] + sy[r] * sy[r]) + sz[r] * sz[r])
+            cls = 0 if dot > 0 and 100000 * (dot * dot) >= 99998 * nn else \
+                1 if dot > 0 and 10000 * (dot * dot) >= 9998 * nn else 2
+            stray[r] = max(stray[r], cls)
+    return out, stray
+
+
+def fan_vector(f, rank, q):
+    """§8.12 "Geometry normals": a face's vector, its fan's cross products summed."""
+    p0 = q[rank[f[0]]]
+    nx = ny = nz = 0.0
+    for i in range(1, len(f) - 1):
+        p1, p2 = q[rank[f[i]]], q[rank[f[i + 1]]]
+        a0, a1, a2 = float(p1[0] - p0[0]), float(p1[1] - p0[1]), float(p1[2] - p0[2])
+        b0, b1, b2 = float(p2[0] - p0[0]), float(p2[1] - p0[1]), float(p2[2] - p0[2])
+        nx += a1 * b2 - a2 * b1
+        ny += a2 * b0 - a0 * b2
+        nz += a0 * b1 - a1 * b0
+    return nx, ny, nz
 
 
 class AttrModels:
@@ -2062,7 +2098,7 @@ class AttrWalk:
     def __init__(self, h, predictor, faces, rank, q, around):
         self.h, self.predictor, self.faces, self.rank, self.q = h, predictor, faces, rank, q
         weights = {3: 1, 4: 2}.get(predictor, 0)      # predictors 3 and 4: by face, by angle
-        self.gnormal = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else None
+        self.gnormal, self.stray = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else (None, None)
         self.around = around            # predictor 2: faces_around()
         self.sigma = 1                  # predictor 2: the texture orientation so far
         self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
@@ -2149,8 +2185,10 @@ def predict_value(walk, item):
     h = walk.h
     if item[0] == 'vertex':
         r, v = item[1], item[2]
-        if walk.predictor in (1, 3, 4) and walk.gnormal[r] is not None:
-            return list(walk.gnormal[r]) + walk.prev[2:], 0
+        if walk.predictor in (1, 3, 4):
+            if walk.gnormal[r] is None:
+                return list(walk.prev), 2
+            return list(walk.gnormal[r]) + walk.prev[2:], walk.stray[r]
         if walk.predictor == 2:
             rank, vals = walk.rank, walk.values
             sx = sy = 0.0
