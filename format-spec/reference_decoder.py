@@ -2810,14 +2810,15 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
     ids), per walk vertex its output id and its point."""
     d = RangeDecoder(stream)
-    fresh = probs(4 * 3 * 6 * 3 * 2)                       # fresh[nb][before][best][second's class][4 or more]
-    rank = [[[UIntModel(), UIntModel()] for _ in range(6)] for _ in range(6)]   # [best][second][4 or more]
+    fresh = probs(4 * 3 * 6 * 3 * 2 * 2)                   # fresh[nb][before][best][second's class][4 or more][linked]
+    rank = [[[[UIntModel(), UIntModel()] for _ in range(2)] for _ in range(6)] for _ in range(6)]   # [best][second][4 or more][linked]
     copy = probs(4 * 6)                                     # copy[nb][best]
     copy_rank = UIntModel()
     orig = []                                               # per walk vertex: the one whose values it has
     made = [[] for _ in range(points)]
     total = []                                              # per walk vertex: its faces' normals summed
     edge = {}
+    linked = set()                                          # vertex pairs (lower first) an edge of a face so far joins
     out_faces = []
     for f in faces:
         n = len(f)
@@ -2855,13 +2856,15 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 if not any(fn):                 # a face flat on the grid: its corners' vertices so far
                     ref = split_reduced([sum(total[v[j]][a] for j in range(i)) for a in range(3)])
                 close = [split_closeness(ref, total[w]) for w in cand]
-                order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
+                link = [any((min(u, w), max(u, w)) in linked for u in v[:i]) for w in cand]
+                order = sorted(range(len(cand)), key=lambda k: (0 if link[k] else 8) + close[k])    # stable
                 cand = [cand[k] for k in order]
                 best = close[order[0]]
+                lf = 1 if link[order[0]] else 0
                 second = close[order[1]] if len(cand) > 1 else 6
                 sc = 0 if second == 6 else 1 if second <= 3 else 2
                 many = 1 if len(cand) >= 4 else 0
-                before = 1 if d.bit(fresh, (((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) else 2
+                before = 1 if d.bit(fresh, ((((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) * 2 + lf) else 2
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
@@ -2874,7 +2877,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     orig.append(o)
                     made[p].append(v[i])
                 else:
-                    r = rank[best][second][many].decode(d) if len(cand) > 1 else 0
+                    r = rank[best][second][many][lf].decode(d) if len(cand) > 1 else 0
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]
@@ -2882,6 +2885,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 reject('split: too many vertices or truncated')
         for i in range(n):
             edge[(f[i], f[(i + 1) % n])] = (v[i], v[(i + 1) % n])
+            linked.add((min(v[i], v[(i + 1) % n]), max(v[i], v[(i + 1) % n])))
             total[v[i]] = [total[v[i]][a] + fn[a] for a in range(3)]
         out_faces.append(v)
     walk_out = [NONE] * len(total)

@@ -8,7 +8,9 @@
 // first vertex; each later corner is either a new vertex or one of the
 // point's vertices so far, ranked with those the neighbouring faces across
 // the corner's two edges use at the point first (across an edge that is not
-// a seam the corner is the neighbour's vertex: rank 0 at a small cost).
+// a seam the corner is the neighbour's vertex: rank 0 at a small cost), then
+// those an earlier edge joins to the face's vertices so far, then by how
+// close their normals are to the face's.
 // The vertices are then numbered point by point in point order, each
 // point's in the order its corners made them: a decoded mesh welds back to
 // the same points in the same order, and codes the same layout again.
@@ -78,12 +80,13 @@ struct SplitModels {
   // [neighbours (0-3)][the face's previous corner: 0 none, 1 a new vertex,
   // 2 an old one][the first candidate's closeness (0-5)][the second's class
   // (none, 0-3, 4-5)][4 or more candidates: a point of many vertices, as a
-  // CAD part's slivers make]
-  Prob fresh[4][3][6][3][2];
-  // [the first candidate's closeness][the second's (0-5)][4 or more]: two
-  // candidates as close to the face say little which it is, a near one
-  // beside a far one much
-  UIntModel rank[6][6][2];
+  // CAD part's slivers make][the first candidate linked to the face's
+  // vertices so far]
+  Prob fresh[4][3][6][3][2][2];
+  // [the first candidate's closeness][the second's (0-5)][4 or more][the
+  // first linked]: two candidates as close to the face say little which it
+  // is, a near one beside a far one much
+  UIntModel rank[6][6][2][2];
   Prob copy[4][6];  // a new vertex with an earlier vertex's values, [neighbours][first closeness]
   UIntModel copy_rank;
 };
@@ -139,10 +142,13 @@ class SplitWalk {
     normal_ = n >= 3 ? face_normal(q_, c) : Normal();
     ref_ = normal_;
   }
-  // The direction candidates are ranked by at the face's corner i: the
-  // face's normal, or where that is zero (a sliver flat on the grid) the
-  // summed normals of the vertices its corners 0 .. i-1 took (`v`).
+  // What candidates are ranked by at the face's corner i, given the
+  // vertices its corners 0 .. i-1 took (`v`): those vertices (a candidate
+  // an edge already links to one of them is of the same surface piece,
+  // where parts overlap or touch at a point), and the face's normal, or
+  // where that is zero (a sliver flat on the grid) their summed normals.
   void refer(const uint32_t* v, uint32_t i) {
+    taken_.assign(v, v + i);
     if (!normal_.zero()) return;
     int64_t t[3] = {0, 0, 0};
     for (uint32_t j = 0; j < i; ++j)
@@ -152,8 +158,10 @@ class SplitWalk {
   // The candidates for a corner at p whose face continues to `next` and
   // comes from `prev`, in cand(): the vertices of the neighbours across the
   // corner's two edges, then the point's other vertices (the latest made
-  // first), then stably by closeness to the face's normal. Returns the
-  // neighbours' say (0-3); best() is the first candidate's closeness.
+  // first), then stably those linked to the face's vertices so far first,
+  // each group by closeness to the face's normal. Returns the neighbours'
+  // say (0-3); best() is the first candidate's closeness, linked() whether
+  // it is linked.
   int gather(uint32_t p, uint32_t next, uint32_t prev) {
     cand_.clear();
     auto offer = [&](uint32_t v) {
@@ -168,24 +176,30 @@ class SplitWalk {
     for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
     close_.resize(cand_.size());
     order_.resize(cand_.size());
+    rank_key_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) {
       close_[i] = closeness(ref_, sum_[cand_[i]].x);
       order_[i] = static_cast<uint32_t>(i);
+      bool linked = false;
+      for (uint32_t u : taken_) linked = linked || linked_.find(pair_key(u, cand_[i])) != nullptr;
+      rank_key_[i] = (linked ? 0 : 8) + close_[i];
     }
     // Stable insertion sort: a point has a handful of vertices.
     for (size_t i = 1; i < order_.size(); ++i) {
       const uint32_t x = order_[i];
       size_t j = i;
-      for (; j > 0 && close_[x] < close_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
+      for (; j > 0 && rank_key_[x] < rank_key_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
       order_[j] = x;
     }
     sorted_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) sorted_[i] = cand_[order_[i]];
     best_ = close_[order_[0]];
+    linked_first_ = rank_key_[order_[0]] < 8 ? 1 : 0;
     return nb;
   }
   const std::vector<uint32_t>& cand() const { return sorted_; }
   int best() const { return best_; }
+  int linked() const { return linked_first_; }
   // The second candidate's closeness, 6 if there is none; in three classes
   // (none, 0-3, 4-5) for the new-vertex bit.
   int second() const { return order_.size() > 1 ? close_[order_[1]] : 6; }
@@ -206,6 +220,7 @@ class SplitWalk {
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t j = (i + 1) % n;
       edge_.set(key(c[i], c[j]), {v[i], v[j]});
+      linked_.set(pair_key(v[i], v[j]), {v[i], v[j]});
       for (int a = 0; a < 3; ++a) sum_[v[i]].x[a] += normal_.x[a];
     }
   }
@@ -232,6 +247,7 @@ class SplitWalk {
 
  private:
   static uint64_t key(uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; }
+  static uint64_t pair_key(uint32_t a, uint32_t b) { return a < b ? key(a, b) : key(b, a); }
   std::vector<std::vector<uint32_t>> made_;
   const std::vector<uint32_t>& q_;
   std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
@@ -239,8 +255,11 @@ class SplitWalk {
   Normal normal_;                   // the current face's
   Normal ref_;                      // what candidates are ranked by (refer)
   EdgeMap edge_;
+  EdgeMap linked_;               // vertex pairs an edge of a face so far joins (either way)
+  std::vector<uint32_t> taken_;  // the current face's vertices so far (refer)
   std::vector<uint32_t> cand_, sorted_, order_;
-  std::vector<int> close_;
+  std::vector<int> close_, rank_key_;
+  int linked_first_ = 0;
   int best_ = 5;
   uint32_t next_ = 0;
 };
@@ -275,7 +294,8 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
       } else {
         walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0], fresh);
+        e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()],
+              fresh);
         if (fresh) {
           // A copy: the values of a vertex of the point (the first such
           // candidate).
@@ -288,7 +308,7 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
-          if (cand.size() > 1) m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0].encode(e, r);
+          if (cand.size() > 1) m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0][walk.linked()].encode(e, r);
           v[i] = it->second;
         }
       }
@@ -335,7 +355,10 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
       } else {
         walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        before = d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0]) ? 1 : 2;
+        before =
+            d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()])
+                ? 1
+                : 2;
         if (before == 1) {
           const auto& cand = walk.cand();
           uint32_t original = kNoVertex;
@@ -347,8 +370,9 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
           v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
-          const uint32_t r =
-              cand.size() > 1 ? m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0].decode(d) : 0;
+          const uint32_t r = cand.size() > 1
+                                 ? m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0][walk.linked()].decode(d)
+                                 : 0;
           if (r >= cand.size()) return corrupt("a vertex rank out of range");
           v[i] = cand[r];
         }
