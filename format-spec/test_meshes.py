@@ -34,6 +34,9 @@
                 every kind and type
   flat.ply      a flat-shaded sphere and box (a vertex per face corner carrying
                 the face's normal, slivers, a vertex on no face): welded (§8.13)
+  cad.ply       a cylinder with a smooth side and flat caps, slivers flat on the
+                grid and an overlapping copy: welded (§8.13), normals predicted
+                from the geometry (§8.12, the stray)
   uv_vertex.ply   curved surfaces with per-vertex texture coordinates (s t) in
                 smooth charts, one mirrored: predictor 2 in the vertex domain
   uv_corner.obj   a UV sphere, a torus and a box with corner texture
@@ -490,6 +493,57 @@ def flat_ply(path):
             f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
 
 
+def cad_ply(path):
+    """A CAD-like part as glTF has it: a cylinder with a smooth side (radial
+    normals) and flat caps (their own vertices at the rims), slivers flat on
+    the grid (a rim edge and its midpoint), and a second copy of the whole
+    part in the same place (overlapping parts): welded (§8.13), its candidates
+    told apart by their normals and by the edges that link them, its normals
+    predicted from the geometry with every stray class (§8.12)."""
+    S, R = 32, 4
+    V, N, F = [], [], []
+
+    def vertex(p, n):
+        V.append(p)
+        N.append(n)
+        return len(V) - 1
+    for copy in range(2):
+        side = [[vertex((math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S), 2.0 * r / R),
+                        (math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S), 0.0))
+                 for j in range(S)] for r in range(R + 1)]
+        for r in range(R):
+            for j in range(S):
+                k = (j + 1) % S
+                F.append([side[r][j], side[r][k], side[r + 1][k]])
+                F.append([side[r][j], side[r + 1][k], side[r + 1][j]])
+        for top in range(2):
+            z, nz = (2.0, 1.0) if top else (0.0, -1.0)
+            rows = [[vertex(((1 - r / 3) * math.cos(2 * math.pi * j / S), (1 - r / 3) * math.sin(2 * math.pi * j / S), z),
+                            (0.0, 0.0, nz)) for j in range(S)] for r in range(3)]
+            c = vertex((0.0, 0.0, z), (0.0, 0.0, nz))
+            for r in range(2):
+                for j in range(S):
+                    k = (j + 1) % S
+                    a, b, d, e = rows[r][j], rows[r][k], rows[r + 1][k], rows[r + 1][j]
+                    F.extend([[a, b, d], [a, d, e]] if top else [[a, d, b], [a, e, d]])
+            for j in range(S):
+                a, b = rows[2][j], rows[2][(j + 1) % S]
+                F.append([a, b, c] if top else [a, c, b])
+        if copy == 0:
+            for j in range(0, S, 4):
+                x, y = math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S)
+                F.append([side[0][j], side[R][j], vertex((x, y, 1.0), (x, y, 0.0))])
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
+        f.write('property float x\nproperty float y\nproperty float z\n')
+        f.write('property float nx\nproperty float ny\nproperty float nz\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
+        for (x, y, z), (a, b, c) in zip(V, N):
+            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
+        for fa in F:
+            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+
+
 def uv_vertex_ply(path):
     """uv_surfaces() as ASCII PLY with per-vertex texture coordinates (s t):
     a vertex-domain texcoord (predictor 2 in the vertex domain)."""
@@ -774,6 +828,7 @@ def main():
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
     flat_ply(os.path.join(out, 'flat.ply'))
+    cad_ply(os.path.join(out, 'cad.ply'))
     uv_corner_obj(os.path.join(out, 'uv_corner.obj'))
 
 
