@@ -2703,9 +2703,10 @@ def decode_part(streams, counts, bits, earlier, trace):
     return out_faces, out_q, glob, info, attrs
 
 
-def point_value_ranks(ranks, point, attrs, n):
+def point_value_ranks(ranks, point, attrs, n, faces):
     """§8.13 points out, the ranks: per output vertex whose point has more than
-    one output vertex, its rank; then per corner attribute coded per vertex,
+    one output vertex, its rank (model by its neighbours' ranks decoded so far:
+    none, all 0, some above 0); then per corner attribute coded per vertex,
     per output vertex whose value (binary32 bits) another shares, its rank.
     Each below the count sharing it. All 0 when the stream is empty."""
     prank = [0] * n
@@ -2713,15 +2714,27 @@ def point_value_ranks(ranks, point, attrs, n):
     if not ranks:
         return prank, vrank
     d = RangeDecoder(ranks)
-    pm, vm = UIntModel(), UIntModel()
+    pm, vm = [UIntModel(), UIntModel(), UIntModel()], UIntModel()
     share = {}
     for p in point:
         share[p] = share.get(p, 0) + 1
+    nbr = [[] for _ in range(n)]                # output vertices an edge joins (either way)
+    for f in faces:
+        for i in range(len(f)):
+            a, b = f[i], f[(i + 1) % len(f)]
+            nbr[a].append(b)
+            nbr[b].append(a)
+    coded = [None] * n
     for o in range(n):
         if share[point[o]] > 1:
-            prank[o] = pm.decode(d)
+            say = 0
+            for x in nbr[o]:
+                if coded[x] is not None:
+                    say = max(say, 2 if coded[x] > 0 else 1)
+            prank[o] = pm[say].decode(d)
             if prank[o] >= share[point[o]]:
                 reject('points-out rank')
+            coded[o] = prank[o]
     for i, a in enumerate(attrs):
         if a['header'].domain != 2 or not a['header'].per_vertex:
             continue
@@ -2750,7 +2763,7 @@ def points_out(faces, q, glob, info, attrs, walk_out, walk_point, ranks):
     point = [0] * n
     for w, o in enumerate(walk_out):
         point[o] = walk_point[w]
-    prank, vrank = point_value_ranks(ranks, point, attrs, n)
+    prank, vrank = point_value_ranks(ranks, point, attrs, n, faces)
     keys = sorted(set(zip(point, prank)))
     vid_of = {k: v for v, k in enumerate(keys)}
     vid = [vid_of[(point[o], prank[o])] for o in range(n)]

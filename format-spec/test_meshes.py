@@ -37,6 +37,8 @@
   cad.ply       a cylinder with a smooth side and flat caps, slivers flat on the
                 grid and an overlapping copy: welded (§8.13), normals predicted
                 from the geometry (§8.12, the stray)
+  cad.obj       the same with shared position and normal lists: points out
+                with point ranks (§8.13)
   uv_vertex.ply   curved surfaces with per-vertex texture coordinates (s t) in
                 smooth charts, one mirrored: predictor 2 in the vertex domain
   uv_corner.obj   a UV sphere, a torus and a box with corner texture
@@ -493,13 +495,12 @@ def flat_ply(path):
             f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
 
 
-def cad_ply(path):
+def cad_part():
     """A CAD-like part as glTF has it: a cylinder with a smooth side (radial
     normals) and flat caps (their own vertices at the rims), slivers flat on
     the grid (a rim edge and its midpoint), and a second copy of the whole
-    part in the same place (overlapping parts): welded (§8.13), its candidates
-    told apart by their normals and by the edges that link them, its normals
-    predicted from the geometry with every stray class (§8.12)."""
+    part 10^-5 away (overlapping parts, on the same grid points). Returns
+    (positions, normals, faces), a vertex per (position, normal)."""
     S, R = 32, 4
     V, N, F = [], [], []
 
@@ -533,6 +534,16 @@ def cad_ply(path):
             for j in range(0, S, 4):
                 x, y = math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S)
                 F.append([side[0][j], side[R][j], vertex((x, y, 1.0), (x, y, 0.0))])
+            first = len(V)
+    V = V[:first] + [(x + 1e-5, y, z) for x, y, z in V[first:]]
+    return V, N, F
+
+
+def cad_ply(path):
+    """cad_part() as PLY: welded (§8.13), its candidates told apart by their
+    normals and by the edges that link them, its normals predicted from the
+    geometry with every stray class (§8.12)."""
+    V, N, F = cad_part()
     with open(path, 'w') as f:
         f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
         f.write('property float x\nproperty float y\nproperty float z\n')
@@ -542,6 +553,25 @@ def cad_ply(path):
             f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
         for fa in F:
             f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+
+
+def cad_obj(path):
+    """cad_part() as an OBJ with shared lists (each distinct position and
+    normal once, `f v//vn`): points out (§8.13), the copies' positions ranked
+    at their grid points."""
+    V, N, F = cad_part()
+    vid, nid = {}, {}
+    with open(path, 'w') as f:
+        for p in V:
+            if p not in vid:
+                vid[p] = len(vid) + 1
+                f.write('v %.6f %.6f %.6f\n' % p)
+        for n in N:
+            if n not in nid:
+                nid[n] = len(nid) + 1
+                f.write('vn %.6f %.6f %.6f\n' % n)
+        for fa in F:
+            f.write('f %s\n' % ' '.join('%d//%d' % (vid[V[x]], nid[N[x]]) for x in fa))
 
 
 def uv_vertex_ply(path):
@@ -829,6 +859,7 @@ def main():
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
     flat_ply(os.path.join(out, 'flat.ply'))
     cad_ply(os.path.join(out, 'cad.ply'))
+    cad_obj(os.path.join(out, 'cad.obj'))
     uv_corner_obj(os.path.join(out, 'uv_corner.obj'))
 
 

@@ -441,4 +441,37 @@ Mesh corner_attributes_on_vertices(const Mesh& mesh, uint64_t mask) {
   return m;
 }
 
+RankNeighbours rank_neighbours(const Mesh& faces, size_t n) {
+  RankNeighbours nb;
+  nb.start.assign(n + 1, 0);
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t* c = faces.face(f);
+    for (uint32_t i = 0, k = faces.face_size(f); i < k; ++i) {
+      ++nb.start[c[i] + 1];
+      ++nb.start[c[(i + 1) % k] + 1];
+    }
+  }
+  for (size_t o = 0; o < n; ++o) nb.start[o + 1] += nb.start[o];
+  nb.list.resize(nb.start[n]);
+  std::vector<uint32_t> at(nb.start.begin(), nb.start.end() - 1);
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t* c = faces.face(f);
+    for (uint32_t i = 0, k = faces.face_size(f); i < k; ++i) {
+      const uint32_t a = c[i], b = c[(i + 1) % k];
+      nb.list[at[a]++] = b;
+      nb.list[at[b]++] = a;
+    }
+  }
+  return nb;
+}
+
+int neighbours_say(const RankNeighbours& nb, uint32_t o, const std::vector<uint32_t>& coded) {
+  int say = 0;
+  for (uint32_t j = nb.start[o]; j < nb.start[o + 1]; ++j) {
+    const uint32_t r = coded[nb.list[j]];
+    if (r != kNoVertex) say = std::max(say, r > 0 ? 2 : 1);
+  }
+  return say;
+}
+
 }  // namespace tsm
