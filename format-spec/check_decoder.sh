@@ -149,6 +149,8 @@ corpus_case acheck sphere_obj_q14 "$edge/sphere.obj" 14 6  # parallelograms with
 corpus_case acheck test_pos_color_ply_segments "$edge/test_pos_color.ply" 11 6 40
 # welded meshes (§8.13): flat-shaded with slivers, and the glTF assets
 for l in 0 6 9; do acheck flat_l$l "$work/flat.ply" 12 $l; done
+for l in 0 6; do acheck cad_l$l "$work/cad.ply" 11 $l; done
+acheck cad_obj "$work/cad.obj" 11 6
 for f in Fox/Fox.gltf CesiumMilkTruck/CesiumMilkTruck.gltf MultiUVTest/MultiUVTest.gltf VertexColorTest/VertexColorTest.gltf; do
   corpus_case acheck "$(basename "$f" .gltf)" "$corpus/assets/$f" 11 6
 done

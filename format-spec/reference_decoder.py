@@ -1943,7 +1943,8 @@ def squared_distance(a, b):
 
 def geometry_normals(faces, rank, q, bits, weights=0):
     """§8.12 "Geometry normals": per own rank the octahedral integers of the
-    summed fan cross products, or None where the sum is zero. Sums in face order,
+    summed fan cross products, or None where the sum is zero, and per own rank
+    the stray (the residuals' class for predictors 1, 3, 4). Sums in face order,
     a face's fan summed first, then added to each of its corners times the
     corner's weight (weights 0: 1, by area; 1: 1 / the vector's length, by face;
     2: 1 / sqrt of the product of the corner's two squared edge lengths, by
@@ -1980,7 +1981,42 @@ def geometry_normals(faces, rank, q, bits, weights=0):
     for r in range(n):
         if sx[r] != 0 or sy[r] != 0 or sz[r] != 0:
             out[r] = octahedral_ints(sx[r], sy[r], sz[r], bits)
-    return out
+    stray = [2] * n                     # §8.12 "the stray": 2 where there is no normal
+    for r in range(n):
+        if out[r] is not None:
+            stray[r] = 0
+    for f in faces:
+        k = len(f)
+        if k < 3 or any(rank[c] == NONE for c in f):
+            continue
+        vx, vy, vz = fan_vector(f, rank, q)
+        vv = (vx * vx + vy * vy) + vz * vz
+        if vv == 0:
+            continue
+        for c in f:
+            r = rank[c]
+            if out[r] is None:
+                continue
+            dot = (vx * sx[r] + vy * sy[r]) + vz * sz[r]
+            nn = vv * ((sx[r] * sx[r] + sy[r] * sy[r]) + sz[r] * sz[r])
+            cls = 0 if dot > 0 and 100000 * (dot * dot) >= 99998 * nn else \
+                1 if dot > 0 and 10000 * (dot * dot) >= 9998 * nn else 2
+            stray[r] = max(stray[r], cls)
+    return out, stray
+
+
+def fan_vector(f, rank, q):
+    """§8.12 "Geometry normals": a face's vector, its fan's cross products summed."""
+    p0 = q[rank[f[0]]]
+    nx = ny = nz = 0.0
+    for i in range(1, len(f) - 1):
+        p1, p2 = q[rank[f[i]]], q[rank[f[i + 1]]]
+        a0, a1, a2 = float(p1[0] - p0[0]), float(p1[1] - p0[1]), float(p1[2] - p0[2])
+        b0, b1, b2 = float(p2[0] - p0[0]), float(p2[1] - p0[1]), float(p2[2] - p0[2])
+        nx += a1 * b2 - a2 * b1
+        ny += a2 * b0 - a0 * b2
+        nz += a0 * b1 - a1 * b0
+    return nx, ny, nz
 
 
 class AttrModels:
@@ -2065,7 +2101,7 @@ class AttrWalk:
     def __init__(self, h, predictor, faces, rank, q, around):
         self.h, self.predictor, self.faces, self.rank, self.q = h, predictor, faces, rank, q
         weights = {3: 1, 4: 2}.get(predictor, 0)      # predictors 3 and 4: by face, by angle
-        self.gnormal = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else None
+        self.gnormal, self.stray = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else (None, None)
         self.around = around            # predictor 2: faces_around()
         self.sigma = 1                  # predictor 2: the texture orientation so far
         self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
@@ -2152,8 +2188,10 @@ def predict_value(walk, item):
     h = walk.h
     if item[0] == 'vertex':
         r, v = item[1], item[2]
-        if walk.predictor in (1, 3, 4) and walk.gnormal[r] is not None:
-            return list(walk.gnormal[r]) + walk.prev[2:], 0
+        if walk.predictor in (1, 3, 4):
+            if walk.gnormal[r] is None:
+                return list(walk.prev), 2
+            return list(walk.gnormal[r]) + walk.prev[2:], walk.stray[r]
         if walk.predictor == 2:
             rank, vals = walk.rank, walk.values
             sx = sy = 0.0
@@ -2668,9 +2706,10 @@ def decode_part(streams, counts, bits, earlier, trace):
     return out_faces, out_q, glob, info, attrs
 
 
-def point_value_ranks(ranks, point, attrs, n):
+def point_value_ranks(ranks, point, attrs, n, faces):
     """§8.13 points out, the ranks: per output vertex whose point has more than
-    one output vertex, its rank; then per corner attribute coded per vertex,
+    one output vertex, its rank (model by its neighbours' ranks decoded so far:
+    none, all 0, some above 0); then per corner attribute coded per vertex,
     per output vertex whose value (binary32 bits) another shares, its rank.
     Each below the count sharing it. All 0 when the stream is empty."""
     prank = [0] * n
@@ -2678,15 +2717,27 @@ def point_value_ranks(ranks, point, attrs, n):
     if not ranks:
         return prank, vrank
     d = RangeDecoder(ranks)
-    pm, vm = UIntModel(), UIntModel()
+    pm, vm = [UIntModel(), UIntModel(), UIntModel()], UIntModel()
     share = {}
     for p in point:
         share[p] = share.get(p, 0) + 1
+    nbr = [[] for _ in range(n)]                # output vertices an edge joins (either way)
+    for f in faces:
+        for i in range(len(f)):
+            a, b = f[i], f[(i + 1) % len(f)]
+            nbr[a].append(b)
+            nbr[b].append(a)
+    coded = [None] * n
     for o in range(n):
         if share[point[o]] > 1:
-            prank[o] = pm.decode(d)
+            say = 0
+            for x in nbr[o]:
+                if coded[x] is not None:
+                    say = max(say, 2 if coded[x] > 0 else 1)
+            prank[o] = pm[say].decode(d)
             if prank[o] >= share[point[o]]:
                 reject('points-out rank')
+            coded[o] = prank[o]
     for i, a in enumerate(attrs):
         if a['header'].domain != 2 or not a['header'].per_vertex:
             continue
@@ -2715,7 +2766,7 @@ def points_out(faces, q, glob, info, attrs, walk_out, walk_point, ranks):
     point = [0] * n
     for w, o in enumerate(walk_out):
         point[o] = walk_point[w]
-    prank, vrank = point_value_ranks(ranks, point, attrs, n)
+    prank, vrank = point_value_ranks(ranks, point, attrs, n, faces)
     keys = sorted(set(zip(point, prank)))
     vid_of = {k: v for v, k in enumerate(keys)}
     vid = [vid_of[(point[o], prank[o])] for o in range(n)]
@@ -2775,14 +2826,15 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     """§8.13: the faces' points to walk vertices. Returns the faces (walk vertex
     ids), per walk vertex its output id and its point."""
     d = RangeDecoder(stream)
-    fresh = probs(4 * 3 * 6 * 2)                           # fresh[nb][before][closeness][4 or more candidates]
-    rank = [[UIntModel(), UIntModel()] for _ in range(6)]   # [best][4 or more candidates]
-    copy = probs(4)                                         # copy[nb]
+    fresh = probs(4 * 3 * 6 * 3 * 2 * 2)                   # fresh[nb][before][best][second's class][4 or more][linked]
+    rank = [[[[UIntModel(), UIntModel()] for _ in range(2)] for _ in range(6)] for _ in range(6)]   # [best][second][4 or more][linked]
+    copy = probs(4 * 6)                                     # copy[nb][best]
     copy_rank = UIntModel()
     orig = []                                               # per walk vertex: the one whose values it has
     made = [[] for _ in range(points)]
     total = []                                              # per walk vertex: its faces' normals summed
     edge = {}
+    linked = set()                                          # vertex pairs (lower first) an edge of a face so far joins
     out_faces = []
     for f in faces:
         n = len(f)
@@ -2816,15 +2868,23 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 for w in reversed(made[p]):
                     if w not in cand:
                         cand.append(w)
-                close = [split_closeness(fn, total[w]) for w in cand]
-                order = sorted(range(len(cand)), key=lambda k: close[k])    # stable
+                ref = fn
+                if not any(fn):                 # a face flat on the grid: its corners' vertices so far
+                    ref = split_reduced([sum(total[v[j]][a] for j in range(i)) for a in range(3)])
+                close = [split_closeness(ref, total[w]) for w in cand]
+                link = [any((min(u, w), max(u, w)) in linked for u in v[:i]) for w in cand]
+                order = sorted(range(len(cand)), key=lambda k: (0 if link[k] else 8) + close[k])    # stable
                 cand = [cand[k] for k in order]
                 best = close[order[0]]
-                before = 1 if d.bit(fresh, ((nb * 3 + before) * 6 + best) * 2 + (1 if len(cand) >= 4 else 0)) else 2
+                lf = 1 if link[order[0]] else 0
+                second = close[order[1]] if len(cand) > 1 else 6
+                sc = 0 if second == 6 else 1 if second <= 3 else 2
+                many = 1 if len(cand) >= 4 else 0
+                before = 1 if d.bit(fresh, ((((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) * 2 + lf) else 2
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
-                    if d.bit(copy, nb):
+                    if d.bit(copy, nb * 6 + best):
                         r = copy_rank.decode(d) if len(cand) > 1 else 0
                         if r >= len(cand):
                             reject('split: copy rank')
@@ -2833,7 +2893,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     orig.append(o)
                     made[p].append(v[i])
                 else:
-                    r = rank[best][1 if len(cand) >= 4 else 0].decode(d) if len(cand) > 1 else 0
+                    r = rank[best][second][many][lf].decode(d) if len(cand) > 1 else 0
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]
@@ -2841,6 +2901,7 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 reject('split: too many vertices or truncated')
         for i in range(n):
             edge[(f[i], f[(i + 1) % n])] = (v[i], v[(i + 1) % n])
+            linked.add((min(v[i], v[(i + 1) % n]), max(v[i], v[(i + 1) % n])))
             total[v[i]] = [total[v[i]][a] + fn[a] for a in range(3)]
         out_faces.append(v)
     walk_out = [NONE] * len(total)

@@ -34,6 +34,11 @@
                 every kind and type
   flat.ply      a flat-shaded sphere and box (a vertex per face corner carrying
                 the face's normal, slivers, a vertex on no face): welded (§8.13)
+  cad.ply       a cylinder with a smooth side and flat caps, slivers flat on the
+                grid and an overlapping copy: welded (§8.13), normals predicted
+                from the geometry (§8.12, the stray)
+  cad.obj       the same with shared position and normal lists: points out
+                with point ranks (§8.13)
   uv_vertex.ply   curved surfaces with per-vertex texture coordinates (s t) in
                 smooth charts, one mirrored: predictor 2 in the vertex domain
   uv_corner.obj   a UV sphere, a torus and a box with corner texture
@@ -490,6 +495,85 @@ def flat_ply(path):
             f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
 
 
+def cad_part():
+    """A CAD-like part as glTF has it: a cylinder with a smooth side (radial
+    normals) and flat caps (their own vertices at the rims), slivers flat on
+    the grid (a rim edge and its midpoint), and a second copy of the whole
+    part 10^-5 away (overlapping parts, on the same grid points). Returns
+    (positions, normals, faces), a vertex per (position, normal)."""
+    S, R = 32, 4
+    V, N, F = [], [], []
+
+    def vertex(p, n):
+        V.append(p)
+        N.append(n)
+        return len(V) - 1
+    for copy in range(2):
+        side = [[vertex((math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S), 2.0 * r / R),
+                        (math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S), 0.0))
+                 for j in range(S)] for r in range(R + 1)]
+        for r in range(R):
+            for j in range(S):
+                k = (j + 1) % S
+                F.append([side[r][j], side[r][k], side[r + 1][k]])
+                F.append([side[r][j], side[r + 1][k], side[r + 1][j]])
+        for top in range(2):
+            z, nz = (2.0, 1.0) if top else (0.0, -1.0)
+            rows = [[vertex(((1 - r / 3) * math.cos(2 * math.pi * j / S), (1 - r / 3) * math.sin(2 * math.pi * j / S), z),
+                            (0.0, 0.0, nz)) for j in range(S)] for r in range(3)]
+            c = vertex((0.0, 0.0, z), (0.0, 0.0, nz))
+            for r in range(2):
+                for j in range(S):
+                    k = (j + 1) % S
+                    a, b, d, e = rows[r][j], rows[r][k], rows[r + 1][k], rows[r + 1][j]
+                    F.extend([[a, b, d], [a, d, e]] if top else [[a, d, b], [a, e, d]])
+            for j in range(S):
+                a, b = rows[2][j], rows[2][(j + 1) % S]
+                F.append([a, b, c] if top else [a, c, b])
+        if copy == 0:
+            for j in range(0, S, 4):
+                x, y = math.cos(2 * math.pi * j / S), math.sin(2 * math.pi * j / S)
+                F.append([side[0][j], side[R][j], vertex((x, y, 1.0), (x, y, 0.0))])
+            first = len(V)
+    V = V[:first] + [(x + 1e-5, y, z) for x, y, z in V[first:]]
+    return V, N, F
+
+
+def cad_ply(path):
+    """cad_part() as PLY: welded (§8.13), its candidates told apart by their
+    normals and by the edges that link them, its normals predicted from the
+    geometry with every stray class (§8.12)."""
+    V, N, F = cad_part()
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
+        f.write('property float x\nproperty float y\nproperty float z\n')
+        f.write('property float nx\nproperty float ny\nproperty float nz\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
+        for (x, y, z), (a, b, c) in zip(V, N):
+            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
+        for fa in F:
+            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+
+
+def cad_obj(path):
+    """cad_part() as an OBJ with shared lists (each distinct position and
+    normal once, `f v//vn`): points out (§8.13), the copies' positions ranked
+    at their grid points."""
+    V, N, F = cad_part()
+    vid, nid = {}, {}
+    with open(path, 'w') as f:
+        for p in V:
+            if p not in vid:
+                vid[p] = len(vid) + 1
+                f.write('v %.6f %.6f %.6f\n' % p)
+        for n in N:
+            if n not in nid:
+                nid[n] = len(nid) + 1
+                f.write('vn %.6f %.6f %.6f\n' % n)
+        for fa in F:
+            f.write('f %s\n' % ' '.join('%d//%d' % (vid[V[x]], nid[N[x]]) for x in fa))
+
+
 def uv_vertex_ply(path):
     """uv_surfaces() as ASCII PLY with per-vertex texture coordinates (s t):
     a vertex-domain texcoord (predictor 2 in the vertex domain)."""
@@ -798,6 +882,8 @@ def main():
     attr_ply(os.path.join(out, 'attributes.ply'), *mixed(12, 20))
     uv_vertex_ply(os.path.join(out, 'uv_vertex.ply'))
     flat_ply(os.path.join(out, 'flat.ply'))
+    cad_ply(os.path.join(out, 'cad.ply'))
+    cad_obj(os.path.join(out, 'cad.obj'))
     uv_corner_obj(os.path.join(out, 'uv_corner.obj'))
 
 

@@ -18,7 +18,8 @@ using namespace tsm_test;
 
 namespace {
 
-Attribute make(const std::string& name, AttributeKind kind, AttributeDomain domain, AttributeType type, uint32_t comps) {
+Attribute make(const std::string& name, AttributeKind kind, AttributeDomain domain, AttributeType type,
+               uint32_t comps) {
   Attribute a;
   a.name = name;
   a.kind = kind;
@@ -119,9 +120,9 @@ TEST(Attributes, VertexNormalsColoursAndUVsRoundTrip) {
   EXPECT_TRUE(r.equal) << r.difference;
   ASSERT_EQ(back.attributes.size(), 3u);
   EXPECT_EQ(back.attributes[1].type, AttributeType::u8);
-  EXPECT_LT(max_error(m.attributes[0], back.attributes[0]), 4e-3);  // 10-bit octahedral normals (~0.2 degrees)
-  EXPECT_EQ(max_error(m.attributes[1], back.attributes[1]), 0.0);   // u8 colours exactly
-  EXPECT_LT(max_error(m.attributes[2], back.attributes[2]), 1.5e-4); // 12-bit UVs on [0, 1]
+  EXPECT_LT(max_error(m.attributes[0], back.attributes[0]), 4e-3);    // 10-bit octahedral normals (~0.2 degrees)
+  EXPECT_EQ(max_error(m.attributes[1], back.attributes[1]), 0.0);     // u8 colours exactly
+  EXPECT_LT(max_error(m.attributes[2], back.attributes[2]), 1.5e-4);  // 12-bit UVs on [0, 1]
 }
 
 TEST(Attributes, CornerSeamsCreasesFaceValuesAndUnusedValuesRoundTrip) {
@@ -225,7 +226,8 @@ TEST(Attributes, VertexAndFaceAttributesInSegmentsAndStreamed) {
   ASSERT_TRUE(sd.finish().ok());
   const Mesh& streamed = sd.mesh();
   ASSERT_EQ(streamed.attributes.size(), back.attributes.size());
-  for (size_t i = 0; i < back.attributes.size(); ++i) EXPECT_EQ(streamed.attributes[i].values, back.attributes[i].values);
+  for (size_t i = 0; i < back.attributes.size(); ++i)
+    EXPECT_EQ(streamed.attributes[i].values, back.attributes[i].values);
 }
 
 TEST(Attributes, NormalsPredictedFromTheGeometryAreSmall) {
@@ -237,7 +239,8 @@ TEST(Attributes, NormalsPredictedFromTheGeometryAreSmall) {
   std::string a, b;
   ASSERT_TRUE(encode(plain, eo, a).ok());
   ASSERT_TRUE(encode(normals_only, eo, b).ok());
-  const double bits_per_normal = 8.0 * static_cast<double>(b.size() - a.size()) / static_cast<double>(plain.vertex_count());
+  const double bits_per_normal =
+      8.0 * static_cast<double>(b.size() - a.size()) / static_cast<double>(plain.vertex_count());
   EXPECT_LT(bits_per_normal, 8.0) << "smooth sphere normals should cost well under 20 bits (10-bit octahedral)";
   RecordProperty("bits_per_normal", std::to_string(bits_per_normal));
   std::printf("sphere normals: %.2f bits per normal\n", bits_per_normal);
@@ -384,8 +387,10 @@ TEST(Attributes, LongNamesAreRefusedBeforeTheEncoderWritesThem) {
   const Status s = encode(m, EncodeOptions{}, bytes);
   EXPECT_EQ(s.code(), ErrorCode::invalid_argument);
   EXPECT_NE(s.message().find("1025 bytes"), std::string::npos) << s.message();
-  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                          "property float z\nproperty float " + std::string(1118, 'p') + "\nend_header\n0 0 0 1\n";
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float " +
+      std::string(1118, 'p') + "\nend_header\n0 0 0 1\n";
   Mesh r;
   const Status rs = read_ply(ply, "long.ply", r, ReadOptions{}, nullptr);
   EXPECT_EQ(rs.code(), ErrorCode::parse_error) << rs.to_string();
@@ -403,8 +408,10 @@ TEST(Attributes, DamagedAttributeStreamsAreRefused) {
     bad[rng() % bad.size()] ^= static_cast<char>(1 << (rng() % 8));
     Mesh back;
     Status s = decode(bad, back);
-    if (!s.ok()) ++refused;
-    else EXPECT_TRUE(back.valid());
+    if (!s.ok())
+      ++refused;
+    else
+      EXPECT_TRUE(back.valid());
   }
   EXPECT_GT(refused, 280);
   for (size_t n = 0; n < bytes.size(); ++n) {
@@ -484,8 +491,10 @@ TEST(Attributes, TextureCoordinatesPredictedFromTheGeometryAreSmall) {
   const Attribute spherical = sphere.attributes[2];
   sphere.attributes.clear();
   const double sphere_bits = bits_per_uv(sphere, spherical);
-  std::printf("bits per texture coordinate: affine grid %.2f, per corner in 4 charts %.2f (in segments %.2f), "
-              "sphere %.2f\n", vertex_bits, corner_bits, segmented_bits, sphere_bits);
+  std::printf(
+      "bits per texture coordinate: affine grid %.2f, per corner in 4 charts %.2f (in segments %.2f), "
+      "sphere %.2f\n",
+      vertex_bits, corner_bits, segmented_bits, sphere_bits);
   // Delta coding along the vertex order costs over 12 bits here; the
   // quantization's rounding alone about 3.
   EXPECT_LT(vertex_bits, 4.5);
@@ -514,4 +523,107 @@ TEST(Attributes, CommonNamesTakeOneByte) {
     size[spelt] = bytes.size();
   }
   EXPECT_EQ(size[0] + 8, size[1]) << "JOINTS_0 by its index (1 byte), JOINTS_1 in full (9 bytes)";
+}
+
+namespace {
+
+// A cylinder of `segments` sides and `rings` rows with smooth radial
+// normals; with `caps`, two flat caps of `rings` concentric rows each, whose
+// vertices (normal +-z) start at the rims beside the side's (welded there).
+Mesh capped_cylinder(int segments, int rings, bool caps) {
+  Mesh m;
+  Attribute n = make("normal", AttributeKind::normal, AttributeDomain::vertex, AttributeType::f32, 3);
+  auto vertex = [&](double x, double y, double z, double nx, double ny, double nz) {
+    m.add_vertex(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    n.values.insert(n.values.end(), {static_cast<float>(nx), static_cast<float>(ny), static_cast<float>(nz)});
+    return static_cast<uint32_t>(m.vertex_count() - 1);
+  };
+  const double kPi = 3.14159265358979323846;
+  auto grid = [&](std::vector<uint32_t>& row, int r, bool flip) {  // quads between rows r - 1 and r
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = row[(r - 1) * segments + j], b = row[(r - 1) * segments + (j + 1) % segments];
+      const uint32_t c = row[r * segments + (j + 1) % segments], d = row[r * segments + j];
+      if (flip) {
+        m.add_triangle(a, c, b);
+        m.add_triangle(a, d, c);
+      } else {
+        m.add_triangle(a, b, c);
+        m.add_triangle(a, c, d);
+      }
+    }
+  };
+  std::vector<uint32_t> side;
+  for (int r = 0; r <= rings; ++r)
+    for (int j = 0; j < segments; ++j) {
+      const double a = 2 * kPi * j / segments, x = std::cos(a), y = std::sin(a);
+      side.push_back(vertex(x, y, 2.0 * r / rings, x, y, 0));
+    }
+  for (int r = 1; r <= rings; ++r) grid(side, r, false);
+  for (int top = 0; caps && top < 2; ++top) {
+    std::vector<uint32_t> cap;  // rows from the rim inwards
+    const double z = top ? 2 : 0, nz = top ? 1 : -1;
+    for (int r = 0; r < rings; ++r)
+      for (int j = 0; j < segments; ++j) {
+        const double a = 2 * kPi * j / segments, rad = 1.0 - static_cast<double>(r) / rings;
+        cap.push_back(vertex(rad * std::cos(a), rad * std::sin(a), z, 0, 0, nz));
+      }
+    for (int r = 1; r < rings; ++r) grid(cap, r, top == 0);
+    const uint32_t centre = vertex(0, 0, z, 0, 0, nz);
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = cap[(rings - 1) * segments + j], b = cap[(rings - 1) * segments + (j + 1) % segments];
+      if (top)
+        m.add_triangle(a, b, centre);
+      else
+        m.add_triangle(a, centre, b);
+    }
+  }
+  m.attributes = {n};
+  return m;
+}
+
+uint64_t normal_bytes(const Mesh& m, std::string& bytes) {
+  EncodeOptions eo;
+  eo.quantization_bits = 11;
+  eo.attribute_bits.normal = 8;
+  EXPECT_TRUE(encode(m, eo, bytes).ok());
+  FileInfo info;
+  EXPECT_TRUE(inspect(bytes, info).ok());
+  return info.attributes.empty() ? 0 : info.attributes[0].coded_bytes;
+}
+
+}  // namespace
+
+// FORMAT.md §8.12 "the stray": normals predicted from the geometry code
+// their residuals by how far the vertex's faces stray from its predicted
+// normal, so a CAD part's flat caps cost next to nothing beside its curved
+// side (whose residuals are rarely zero); exact, canonical, and damaged
+// bytes refused or valid.
+TEST(Attributes, FlatRegionsNormalsCostLittleBesideCurvedOnes) {
+  std::string side_bytes, part_bytes;
+  const Mesh side = capped_cylinder(96, 12, false), part = capped_cylinder(96, 12, true);
+  const uint64_t side_normals = normal_bytes(side, side_bytes), part_normals = normal_bytes(part, part_bytes);
+  const double cap_vertices = 2.0 * (96 * 12 + 1);
+  const double bits = 8.0 * (static_cast<double>(part_normals) - static_cast<double>(side_normals)) / cap_vertices;
+  std::printf("cap normals: %.3f bits each (side %llu bytes, part %llu)\n", bits,
+              static_cast<unsigned long long>(side_normals), static_cast<unsigned long long>(part_normals));
+  EXPECT_LT(bits, 0.1);
+  Mesh back;
+  ASSERT_TRUE(decode(part_bytes, back).ok());
+  AttributeQuantization aq;
+  aq.normal = 8;
+  const CompareResult r = compare_meshes(part, back, 11, aq);
+  EXPECT_TRUE(r.equal) << r.difference;
+  std::string again;
+  normal_bytes(back, again);
+  EXPECT_TRUE(again == part_bytes);
+  int refused = 0;
+  for (size_t i = part_bytes.size() / 2; i < part_bytes.size(); i += 7) {
+    std::string bad = part_bytes;
+    bad[i] = static_cast<char>(bad[i] ^ 0x21);
+    Mesh out;
+    const Status s = decode(bad, out);
+    refused += s.ok() ? 0 : 1;
+    EXPECT_TRUE(s.ok() ? out.valid() : !s.message().empty());
+  }
+  EXPECT_GT(refused, 0);
 }

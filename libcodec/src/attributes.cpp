@@ -111,14 +111,10 @@ void oct_decode(int32_t u, int32_t v, int bits, float out[3]) {
   out[2] = static_cast<float>(z / n);
 }
 
-double grid_step(const AttributeHeader& h) {
-  return h.extent > 0 ? h.extent / (std::ldexp(1.0, h.bits) - 1.0) : 0.0;
-}
+double grid_step(const AttributeHeader& h) { return h.extent > 0 ? h.extent / (std::ldexp(1.0, h.bits) - 1.0) : 0.0; }
 
 // Integers per value: 2 for octahedral, else the components.
-uint32_t int_components(const AttributeHeader& h) {
-  return h.quant == AttributeQuant::octahedral ? 2 : h.components;
-}
+uint32_t int_components(const AttributeHeader& h) { return h.quant == AttributeQuant::octahedral ? 2 : h.components; }
 
 void to_ints(const AttributeHeader& h, const float* v, int32_t* out) {
   if (h.quant == AttributeQuant::octahedral) {
@@ -131,7 +127,8 @@ void to_ints(const AttributeHeader& h, const float* v, int32_t* out) {
     } else {
       const double step = grid_step(h);
       const int64_t top = (int64_t{1} << h.bits) - 1;
-      int64_t q = step > 0 ? static_cast<int64_t>(std::floor((static_cast<double>(v[c]) - h.origin[c]) / step + 0.5)) : 0;
+      int64_t q =
+          step > 0 ? static_cast<int64_t>(std::floor((static_cast<double>(v[c]) - h.origin[c]) / step + 0.5)) : 0;
       out[c] = static_cast<int32_t>(std::clamp<int64_t>(q, 0, top));
     }
   }
@@ -143,7 +140,8 @@ void from_ints(const AttributeHeader& h, const int32_t* x, float* out) {
     return;
   }
   for (uint32_t c = 0; c < h.components; ++c)
-    out[c] = h.quant == AttributeQuant::exact ? static_cast<float>(x[c]) : attribute_grid_value(h, static_cast<int>(c), x[c]);
+    out[c] = h.quant == AttributeQuant::exact ? static_cast<float>(x[c])
+                                              : attribute_grid_value(h, static_cast<int>(c), x[c]);
 }
 
 // The integer range of one component (decoder checks).
@@ -157,10 +155,10 @@ struct Models {
   UIntModel symbol[6];
   UIntModel far;
   UIntModel unused;
-  UIntModel imported[2];    // [the corner's vertex is a reference]: is a new value one of an earlier segment
-  SIntModelT<4> import_id;  // its id in the file's value list, from the previous one
-  UIntModel recent_hit[2];  // [the previous vertex's was one]: the value is one of the recent values
-  UIntModel recent_index;   // which, most recent first
+  UIntModel imported[2];        // [the corner's vertex is a reference]: is a new value one of an earlier segment
+  SIntModelT<4> import_id;      // its id in the file's value list, from the previous one
+  UIntModel recent_hit[2];      // [the previous vertex's was one]: the value is one of the recent values
+  UIntModel recent_index;       // which, most recent first
   UIntModel sibling_hit[2][2];  // [the previous was a hit][more than one wedge value]: an earlier sibling's value
   UIntModel sibling_index;      // which of the siblings' distinct values, latest first
   UIntModel transfer;           // predictor 2, across a seam: which turn or mirror of the edge
@@ -335,31 +333,46 @@ double squared_distance(const uint32_t* a, const uint32_t* b) {
   return s;
 }
 
+// A face's vector (FORMAT.md §8.12 "Geometry normals"): the cross
+// products of its fan from corner 0 summed; false unless every corner is
+// an own vertex and it has 3 or more.
+bool face_vector(const Mesh& faces, size_t f, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q,
+                 double out[3]) {
+  const uint32_t k = faces.face_size(f);
+  const uint32_t* c = faces.face(f);
+  bool own = k >= 3;
+  for (uint32_t i = 0; i < k && own; ++i) own = rank[c[i]] != kNone;
+  if (!own) return false;
+  const uint32_t* p0 = &q[3 * static_cast<size_t>(rank[c[0]])];
+  out[0] = out[1] = out[2] = 0;
+  for (uint32_t i = 1; i + 1 < k; ++i) {
+    const uint32_t* p1 = &q[3 * static_cast<size_t>(rank[c[i]])];
+    const uint32_t* p2 = &q[3 * static_cast<size_t>(rank[c[i + 1]])];
+    const double a[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
+    const double b[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
+    out[0] += a[1] * b[2] - a[2] * b[1];
+    out[1] += a[2] * b[0] - a[0] * b[2];
+    out[2] += a[0] * b[1] - a[1] * b[0];
+  }
+  return true;
+}
+
 // Normals of the own vertices from the faces whose corners are all own
-// (fans for polygons), weighted as `weights` says, as octahedral indices;
-// has[r] = 0 where the sum is zero.
-void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q,
-                      int bits, NormalWeights weights, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
+// (fans for polygons), weighted as `weights` says, as octahedral indices.
+// has[r]: 0 where the sum is zero, else 1 + how far the vertex's faces
+// stray from the sum (the residuals' class): 0 every face within about
+// 0.26 degrees (a flat region: the prediction is near exact), 1 within
+// 0.8, 2 farther (a curved region or a crease).
+void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q, int bits,
+                      NormalWeights weights, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
   const size_t n = q.size() / 3;
   std::vector<double> sum(3 * n, 0.0);
   for (size_t f = 0; f < faces.face_count(); ++f) {
+    double v[3];
+    if (!face_vector(faces, f, rank, q, v)) continue;
     const uint32_t k = faces.face_size(f);
     const uint32_t* c = faces.face(f);
-    bool own = k >= 3;
-    for (uint32_t i = 0; i < k && own; ++i) own = rank[c[i]] != kNone;
-    if (!own) continue;
-    const uint32_t* p0 = &q[3 * static_cast<size_t>(rank[c[0]])];
-    double nx = 0, ny = 0, nz = 0;
-    for (uint32_t i = 1; i + 1 < k; ++i) {
-      const uint32_t* p1 = &q[3 * static_cast<size_t>(rank[c[i]])];
-      const uint32_t* p2 = &q[3 * static_cast<size_t>(rank[c[i + 1]])];
-      const double a[3] = {double(p1[0]) - p0[0], double(p1[1]) - p0[1], double(p1[2]) - p0[2]};
-      const double b[3] = {double(p2[0]) - p0[0], double(p2[1]) - p0[1], double(p2[2]) - p0[2]};
-      nx += a[1] * b[2] - a[2] * b[1];
-      ny += a[2] * b[0] - a[0] * b[2];
-      nz += a[0] * b[1] - a[1] * b[0];
-    }
-    const double len = std::sqrt((nx * nx + ny * ny) + nz * nz);
+    const double len = std::sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]);
     for (uint32_t i = 0; i < k; ++i) {
       double w = 1;
       if (weights == NormalWeights::face) {
@@ -371,9 +384,9 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
         w = e > 0 ? 1 / std::sqrt(e) : 0;
       }
       double* s = &sum[3 * static_cast<size_t>(rank[c[i]])];
-      s[0] += nx * w;
-      s[1] += ny * w;
-      s[2] += nz * w;
+      s[0] += v[0] * w;
+      s[1] += v[1] * w;
+      s[2] += v[2] * w;
     }
   }
   oct.assign(2 * n, 0);
@@ -383,6 +396,29 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
     if (s[0] == 0 && s[1] == 0 && s[2] == 0) continue;
     has[r] = 1;
     oct_encode(s[0], s[1], s[2], bits, &oct[2 * r]);
+  }
+  // The stray: per face with a non-zero vector, against each corner's sum,
+  // cos^2 >= 0.99998 keeps class 0, >= 0.9998 class 1 (10^5 dot^2 against
+  // 99998 |v|^2 |s|^2, 10^4 dot^2 against 9998, dot > 0), else class 2; a
+  // vertex takes its faces' largest.
+  for (size_t f = 0; f < faces.face_count(); ++f) {
+    double v[3];
+    if (!face_vector(faces, f, rank, q, v)) continue;
+    const double vv = (v[0] * v[0] + v[1] * v[1]) + v[2] * v[2];
+    if (vv == 0) continue;
+    const uint32_t k = faces.face_size(f);
+    const uint32_t* c = faces.face(f);
+    for (uint32_t i = 0; i < k; ++i) {
+      const uint32_t r = rank[c[i]];
+      if (!has[r]) continue;
+      const double* s = &sum[3 * static_cast<size_t>(r)];
+      const double dot = (v[0] * s[0] + v[1] * s[1]) + v[2] * s[2];
+      const double nn = vv * ((s[0] * s[0] + s[1] * s[1]) + s[2] * s[2]);
+      const int cls = dot > 0 && 100000 * (dot * dot) >= 99998 * nn ? 0
+                      : dot > 0 && 10000 * (dot * dot) >= 9998 * nn ? 1
+                                                                    : 2;
+      has[r] = static_cast<uint8_t>(std::max(int{has[r]}, 1 + cls));
+    }
   }
 }
 
@@ -397,8 +433,8 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
 // edge's texture vector turned a quarter (a conformal map) to the side
 // `sigma` says (the sign of the texture triangle's area, which a chart keeps
 // from face to face). Positions are grid indices.
-void uv_from_triangle(const uint32_t* pw, const uint32_t* pa, const uint32_t* pb, const int32_t* ua,
-                      const int32_t* ub, const uint32_t* pc, const int32_t* uc, int sigma, double out[2]) {
+void uv_from_triangle(const uint32_t* pw, const uint32_t* pa, const uint32_t* pb, const int32_t* ua, const int32_t* ub,
+                      const uint32_t* pc, const int32_t* uc, int sigma, double out[2]) {
   const double ex = double(pb[0]) - pa[0], ey = double(pb[1]) - pa[1], ez = double(pb[2]) - pa[2];
   const double l2 = ex * ex + ey * ey + ez * ez;
   const double dx = double(ub[0]) - ua[0], dy = double(ub[1]) - ua[1];
@@ -623,12 +659,12 @@ struct AttributeWalk {
   const AttributeHeader& h;
   ValueCoder<Coder>& vc;
   Coder& io;
-  const Mesh& faces;                  // part output faces
-  const std::vector<uint32_t>& rank;  // per part vertex: own rank or kNone
+  const Mesh& faces;                    // part output faces
+  const std::vector<uint32_t>& rank;    // per part vertex: own rank or kNone
   const std::vector<int32_t>* gnormal;  // per own rank: geometry normal (octahedral)
   const std::vector<uint8_t>* ghas;
   const std::vector<uint32_t>* q = nullptr;  // own vertices' grid positions (predictor 2)
-  const VertexFaces* around = nullptr;        // faces around each vertex (predictor 2)
+  const VertexFaces* around = nullptr;       // faces around each vertex (predictor 2)
 
   // Predictor 2 for the value at position i of face f (vertex w): the mean
   // of the texture-space placements from the face's triangles (w, i+1, i+2)
@@ -725,11 +761,14 @@ struct AttributeWalk {
         }
       }
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
-      if ((predictor == 1 || predictor >= 3) && (*ghas)[r]) {
-        pred[0] = (*gnormal)[2 * r];
-        pred[1] = (*gnormal)[2 * r + 1];
-      }
       int cls = 0;
+      if (predictor == 1 || predictor >= 3) {
+        cls = (*ghas)[r] ? (*ghas)[r] - 1 : 2;  // how far its faces stray (geometry_normals)
+        if ((*ghas)[r]) {
+          pred[0] = (*gnormal)[2 * r];
+          pred[1] = (*gnormal)[2 * r + 1];
+        }
+      }
       if (predictor == 2) {
         double sum[2] = {0, 0};
         int count = 0;
@@ -772,9 +811,8 @@ struct AttributeWalk {
   // edge is looked for: along the chain of earlier vertices at v's position
   // (latest first, at most kSiblingVertices), the first corner decoded
   // before v of their faces (same order) at that corner's position.
-  void seam_transfer(size_t v, uint32_t r, const std::vector<uint32_t>& earlier,
-                     const std::vector<uint32_t>& vertex_of, const std::vector<int32_t>& x, int32_t* pred,
-                     SeamTransfer& t) const {
+  void seam_transfer(size_t v, uint32_t r, const std::vector<uint32_t>& earlier, const std::vector<uint32_t>& vertex_of,
+                     const std::vector<int32_t>& x, int32_t* pred, SeamTransfer& t) const {
     const uint32_t ra = first_known_corner(v, r, nullptr);
     if (ra == kNone) return;
     std::copy_n(&x[2 * size_t{ra}], 2, pred);
@@ -1086,7 +1124,8 @@ struct AttributeWalk {
           values.resize(values.size() + n);
           int32_t* x = &values[n * static_cast<size_t>(id)];
           if constexpr (Coder::kEncoder) {
-            std::copy(&in_ints[n * static_cast<size_t>(in_value[k])], &in_ints[n * static_cast<size_t>(in_value[k])] + n, x);
+            std::copy(&in_ints[n * static_cast<size_t>(in_value[k])],
+                      &in_ints[n * static_cast<size_t>(in_value[k])] + n, x);
             out_of[in_value[k]] = id;
             in_of.push_back(in_value[k]);
           }
@@ -1114,7 +1153,8 @@ struct AttributeWalk {
       }
       if (predictor == 2 && fk >= 3) {
         uv.clear();
-        for (uint32_t i = 0; i < fk; ++i) uv.push_back(&values[n * static_cast<size_t>(index[faces.face_offsets[g] + i])]);
+        for (uint32_t i = 0; i < fk; ++i)
+          uv.push_back(&values[n * static_cast<size_t>(index[faces.face_offsets[g] + i])]);
         const int o = uv_orientation(uv.data(), fk);
         if (o != 0) sigma = o;
       }
@@ -1309,7 +1349,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     }
     if (h.domain == AttributeDomain::face) {
       std::vector<int32_t> x(n * faces.face_count());
-      for (size_t g = 0; g < faces.face_count(); ++g) to_ints(h, &a.values[h.components * static_cast<size_t>(face_of[g])], &x[n * g]);
+      for (size_t g = 0; g < faces.face_count(); ++g)
+        to_ints(h, &a.values[h.components * static_cast<size_t>(face_of[g])], &x[n * g]);
       return walk.face_values(x);
     }
     const size_t count = a.value_count();
@@ -1324,7 +1365,8 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     std::vector<int32_t> values;
     std::vector<uint32_t> index, alias, in_of;
     const std::vector<uint32_t>* imported = in.imported ? &(*in.imported)[i] : nullptr;
-    if (!walk.corners(predictor, in.segmented, imported, in_value, ints, count, UINT64_MAX, values, index, alias, in_of))
+    if (!walk.corners(predictor, in.segmented, imported, in_value, ints, count, UINT64_MAX, values, index, alias,
+                      in_of))
       return false;
     if (own_values) {  // the values this part adds to the file's list, in its order
       own_values->clear();
@@ -1499,8 +1541,15 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (h.quant == AttributeQuant::octahedral)
       geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor[i]), gn, gh);
     ValueCoder<Dec> vc{dec, {}};
-    AttributeWalk<Dec> walk{h, vc, dec, faces, rank, h.quant == AttributeQuant::octahedral ? &gn : nullptr,
-                            h.quant == AttributeQuant::octahedral ? &gh : nullptr, in.q, &around};
+    AttributeWalk<Dec> walk{h,
+                            vc,
+                            dec,
+                            faces,
+                            rank,
+                            h.quant == AttributeQuant::octahedral ? &gn : nullptr,
+                            h.quant == AttributeQuant::octahedral ? &gh : nullptr,
+                            in.q,
+                            &around};
     Attribute a;
     a.name = h.name;
     a.kind = h.kind;

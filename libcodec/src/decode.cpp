@@ -174,7 +174,7 @@ Status split_welded(std::string_view& attributes, uint64_t vertex_count, uint32_
 
 // FORMAT.md §8.13, points out: the ranks. Per output vertex whose point
 // has more than one output vertex, its rank among the input vertices at
-// that point; then per corner attribute coded per vertex, per output vertex
+// that point (in a model chosen by its neighbours' ranks decoded so far); then per corner attribute coded per vertex, per output vertex
 // whose value (binary32 bits) is shared by another, its rank among the
 // input values equal to it. Each rank is below the count sharing it.
 Status decode_ranks(const DecodedPart& out, std::vector<uint32_t>& point_rank,
@@ -185,13 +185,16 @@ Status decode_ranks(const DecodedPart& out, std::vector<uint32_t>& point_rank,
   value_rank.assign(out.faces.attributes.size(), std::vector<uint32_t>());
   if (out.rank_stream.empty()) return Status::Ok();
   RangeDecoder d(out.rank_stream);
-  UIntModel point_model, value_model;
+  UIntModel point_model[3], value_model;
   std::vector<uint32_t> share(np, 0);
   for (uint32_t p : point) ++share[p];
+  const RankNeighbours neighbours = rank_neighbours(out.faces, n);
+  std::vector<uint32_t> coded(n, kNone);
   for (size_t o = 0; o < n; ++o) {
     if (share[point[o]] < 2) continue;
-    point_rank[o] = point_model.decode(d);
+    point_rank[o] = point_model[neighbours_say(neighbours, static_cast<uint32_t>(o), coded)].decode(d);
     if (point_rank[o] >= share[point[o]]) return corrupt("a points-out rank is not below its point's vertex count");
+    coded[o] = point_rank[o];
   }
   for (size_t i = 0; i < out.faces.attributes.size(); ++i) {
     const Attribute& at = out.faces.attributes[i];

@@ -1095,15 +1095,25 @@ std::vector<uint32_t> value_ranks(const Attribute& a, const AttributeHeader& h) 
 
 // FORMAT.md §8.13, points out: the rank stream, per output split vertex
 // (`split_of`: its split vertex; `first`: per split vertex its first
-// corner): the point ranks where a point has several split vertices, then
-// per corner attribute coded per vertex (`per_vertex`) the value ranks
-// where a value is shared. Empty when every rank is 0.
+// corner; `split_corners`: per corner of `mesh` its split vertex): the point
+// ranks where a point has several split vertices, each in a model chosen by
+// its neighbours' ranks coded so far, then per corner attribute coded per
+// vertex (`per_vertex`) the value ranks where a value is shared. Empty when
+// every rank is 0.
 std::string rank_stream(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint32_t>& split_of,
-                        const std::vector<uint32_t>& first, const std::vector<uint32_t>& point_rank,
-                        const std::vector<AttributeHeader>& headers, uint64_t per_vertex) {
+                        const std::vector<uint32_t>& first, const std::vector<uint32_t>& split_corners,
+                        const std::vector<uint32_t>& point_rank, const std::vector<AttributeHeader>& headers,
+                        uint64_t per_vertex) {
   const size_t n = split_of.size();
   RangeEncoder e;
-  UIntModel point_model, value_model;
+  UIntModel point_model[3], value_model;
+  std::vector<uint32_t> out_of(n);
+  for (size_t o = 0; o < n; ++o) out_of[split_of[o]] = static_cast<uint32_t>(o);
+  Mesh faces;
+  faces.face_offsets = mesh.face_offsets;
+  faces.indices.resize(split_corners.size());
+  for (size_t k = 0; k < split_corners.size(); ++k) faces.indices[k] = out_of[split_corners[k]];
+  const RankNeighbours neighbours = rank_neighbours(faces, n);
   bool any = false;
   std::map<std::array<uint32_t, 3>, uint32_t> share;
   auto grid = [&](size_t o) {
@@ -1111,10 +1121,12 @@ std::string rank_stream(const Mesh& mesh, const std::vector<uint32_t>& qin, cons
     return std::array<uint32_t, 3>{qin[3 * v], qin[3 * v + 1], qin[3 * v + 2]};
   };
   for (size_t o = 0; o < n; ++o) ++share[grid(o)];
+  std::vector<uint32_t> coded(n, kNone);
   for (size_t o = 0; o < n; ++o) {
     if (share[grid(o)] < 2) continue;
     const uint32_t r = point_rank[mesh.indices[first[split_of[o]]]];
-    point_model.encode(e, r);
+    point_model[neighbours_say(neighbours, static_cast<uint32_t>(o), coded)].encode(e, r);
+    coded[o] = r;
     any = any || r != 0;
   }
   for (size_t i = 0; i < mesh.attributes.size(); ++i) {
@@ -1245,8 +1257,8 @@ Status encode_split_route(const Mesh& input, const std::vector<uint32_t>& qinput
     return Status(ErrorCode::internal, "the split route's points do not map to the input's vertices");
   for (uint32_t& v : vertex_from) v = perm[v];
   const std::string ranks =
-      rank_stream(mesh, qin, out.vertex_from, first, point_rank, attribute_headers(mesh, options.attribute_bits),
-                  per_vertex_corner_attributes(s));
+      rank_stream(mesh, qin, out.vertex_from, first, s.indices, point_rank,
+                  attribute_headers(mesh, options.attribute_bits), per_vertex_corner_attributes(s));
   // The rank stream goes after the order byte (the split stream's length,
   // the stream, the byte), which says so by its bit 2.
   if (!ranks.empty()) {

@@ -8,13 +8,16 @@
 // first vertex; each later corner is either a new vertex or one of the
 // point's vertices so far, ranked with those the neighbouring faces across
 // the corner's two edges use at the point first (across an edge that is not
-// a seam the corner is the neighbour's vertex: rank 0 at a small cost).
+// a seam the corner is the neighbour's vertex: rank 0 at a small cost), then
+// those an earlier edge joins to the face's vertices so far, then by how
+// close their normals are to the face's.
 // The vertices are then numbered point by point in point order, each
 // point's in the order its corners made them: a decoded mesh welds back to
 // the same points in the same order, and codes the same layout again.
 #include "split_layout.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <unordered_map>
 
 #include "range_coder.hpp"
@@ -75,11 +78,16 @@ int closeness(const Normal& f, const int64_t sum[3]) {
 // same vertex, 3 two different vertices.
 struct SplitModels {
   // [neighbours (0-3)][the face's previous corner: 0 none, 1 a new vertex,
-  // 2 an old one][the first candidate's closeness (0-5)][4 or more
-  // candidates: a point of many vertices, as a CAD part's slivers make]
-  Prob fresh[4][3][6][2];
-  UIntModel rank[6][2];  // [the first candidate's closeness][4 or more candidates]
-  Prob copy[4];       // a new vertex with an earlier vertex's values, [neighbours]
+  // 2 an old one][the first candidate's closeness (0-5)][the second's class
+  // (none, 0-3, 4-5)][4 or more candidates: a point of many vertices, as a
+  // CAD part's slivers make][the first candidate linked to the face's
+  // vertices so far]
+  Prob fresh[4][3][6][3][2][2];
+  // [the first candidate's closeness][the second's (0-5)][4 or more][the
+  // first linked]: two candidates as close to the face say little which it
+  // is, a near one beside a far one much
+  UIntModel rank[6][6][2][2];
+  Prob copy[4][6];  // a new vertex with an earlier vertex's values, [neighbours][first closeness]
   UIntModel copy_rank;
 };
 
@@ -114,9 +122,7 @@ class EdgeMap {
     uint64_t key = kEmpty;
     Ends ends;
   };
-  size_t slot_of(uint64_t key) const {
-    return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_;
-  }
+  size_t slot_of(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
   void grow() {
     std::vector<Slot> old = std::move(slots_);
     slots_.assign(old.empty() ? 1024 : 2 * old.size(), Slot());
@@ -132,12 +138,30 @@ class EdgeMap {
 class SplitWalk {
  public:
   SplitWalk(uint32_t points, const std::vector<uint32_t>& q) : made_(points), q_(q) {}
-  void start_face(const uint32_t* c, uint32_t n) { normal_ = n >= 3 ? face_normal(q_, c) : Normal(); }
+  void start_face(const uint32_t* c, uint32_t n) {
+    normal_ = n >= 3 ? face_normal(q_, c) : Normal();
+    ref_ = normal_;
+  }
+  // What candidates are ranked by at the face's corner i, given the
+  // vertices its corners 0 .. i-1 took (`v`): those vertices (a candidate
+  // an edge already links to one of them is of the same surface piece,
+  // where parts overlap or touch at a point), and the face's normal, or
+  // where that is zero (a sliver flat on the grid) their summed normals.
+  void refer(const uint32_t* v, uint32_t i) {
+    taken_.assign(v, v + i);
+    if (!normal_.zero()) return;
+    int64_t t[3] = {0, 0, 0};
+    for (uint32_t j = 0; j < i; ++j)
+      for (int a = 0; a < 3; ++a) t[a] += sum_[v[j]].x[a];
+    ref_ = reduced(t);
+  }
   // The candidates for a corner at p whose face continues to `next` and
   // comes from `prev`, in cand(): the vertices of the neighbours across the
   // corner's two edges, then the point's other vertices (the latest made
-  // first), then stably by closeness to the face's normal. Returns the
-  // neighbours' say (0-3); best() is the first candidate's closeness.
+  // first), then stably those linked to the face's vertices so far first,
+  // each group by closeness to the face's normal. Returns the neighbours'
+  // say (0-3); best() is the first candidate's closeness, linked() whether
+  // it is linked.
   int gather(uint32_t p, uint32_t next, uint32_t prev) {
     cand_.clear();
     auto offer = [&](uint32_t v) {
@@ -152,24 +176,34 @@ class SplitWalk {
     for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
     close_.resize(cand_.size());
     order_.resize(cand_.size());
+    rank_key_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) {
-      close_[i] = closeness(normal_, sum_[cand_[i]].x);
+      close_[i] = closeness(ref_, sum_[cand_[i]].x);
       order_[i] = static_cast<uint32_t>(i);
+      bool linked = false;
+      for (uint32_t u : taken_) linked = linked || linked_.find(pair_key(u, cand_[i])) != nullptr;
+      rank_key_[i] = (linked ? 0 : 8) + close_[i];
     }
     // Stable insertion sort: a point has a handful of vertices.
     for (size_t i = 1; i < order_.size(); ++i) {
       const uint32_t x = order_[i];
       size_t j = i;
-      for (; j > 0 && close_[x] < close_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
+      for (; j > 0 && rank_key_[x] < rank_key_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
       order_[j] = x;
     }
     sorted_.resize(cand_.size());
     for (size_t i = 0; i < cand_.size(); ++i) sorted_[i] = cand_[order_[i]];
     best_ = close_[order_[0]];
+    linked_first_ = rank_key_[order_[0]] < 8 ? 1 : 0;
     return nb;
   }
   const std::vector<uint32_t>& cand() const { return sorted_; }
   int best() const { return best_; }
+  int linked() const { return linked_first_; }
+  // The second candidate's closeness, 6 if there is none; in three classes
+  // (none, 0-3, 4-5) for the new-vertex bit.
+  int second() const { return order_.size() > 1 ? close_[order_[1]] : 6; }
+  int second_class() const { return second() == 6 ? 0 : second() <= 3 ? 1 : 2; }
   size_t vertices_at(uint32_t p) const { return made_[p].size(); }
   // A new vertex at p; `original`: the vertex whose attribute values it
   // has (kNoVertex: its own).
@@ -186,6 +220,7 @@ class SplitWalk {
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t j = (i + 1) % n;
       edge_.set(key(c[i], c[j]), {v[i], v[j]});
+      linked_.set(pair_key(v[i], v[j]), {v[i], v[j]});
       for (int a = 0; a < 3; ++a) sum_[v[i]].x[a] += normal_.x[a];
     }
   }
@@ -212,14 +247,19 @@ class SplitWalk {
 
  private:
   static uint64_t key(uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; }
+  static uint64_t pair_key(uint32_t a, uint32_t b) { return a < b ? key(a, b) : key(b, a); }
   std::vector<std::vector<uint32_t>> made_;
   const std::vector<uint32_t>& q_;
   std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
   std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
   Normal normal_;                   // the current face's
+  Normal ref_;                      // what candidates are ranked by (refer)
   EdgeMap edge_;
+  EdgeMap linked_;               // vertex pairs an edge of a face so far joins (either way)
+  std::vector<uint32_t> taken_;  // the current face's vertices so far (refer)
   std::vector<uint32_t> cand_, sorted_, order_;
-  std::vector<int> close_;
+  std::vector<int> close_, rank_key_;
+  int linked_first_ = 0;
   int best_ = 5;
   uint32_t next_ = 0;
 };
@@ -232,7 +272,8 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
                                 std::vector<uint32_t>& walk_out, std::vector<uint32_t>& walk_point,
                                 std::vector<uint32_t>& walk_orig, std::vector<uint32_t>& indices) {
   RangeEncoder e;
-  SplitModels m;
+  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  SplitModels& m = *models;
   SplitWalk walk(points, q);
   std::unordered_map<uint32_t, uint32_t> walk_of;  // input vertex -> walk vertex
   std::vector<uint32_t> input_of;                  // walk vertex -> input vertex
@@ -251,21 +292,23 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
       if (walk.vertices_at(p) == 0) {
         v[i] = walk.make(p);
       } else {
+        walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        e.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0], fresh);
+        e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()],
+              fresh);
         if (fresh) {
           // A copy: the values of a vertex of the point (the first such
           // candidate).
           const auto& cand = walk.cand();
           uint32_t r = 0;
           while (r < cand.size() && value_class[input_of[cand[r]]] != value_class[x]) ++r;
-          e.bit(m.copy[nb], r < cand.size());
+          e.bit(m.copy[nb][walk.best()], r < cand.size());
           if (r < cand.size() && cand.size() > 1) m.copy_rank.encode(e, r);
           v[i] = walk.make(p, r < cand.size() ? cand[r] : kNoVertex);
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
-          if (cand.size() > 1) m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].encode(e, r);
+          if (cand.size() > 1) m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0][walk.linked()].encode(e, r);
           v[i] = it->second;
         }
       }
@@ -292,7 +335,8 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
                            std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
   auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
   RangeDecoder d(stream);
-  SplitModels m;
+  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  SplitModels& m = *models;
   SplitWalk walk(points, q);
   std::vector<uint32_t> v;
   for (uint32_t f = 0; f < faces.face_count(); ++f) {
@@ -309,12 +353,16 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
         v[i] = walk.make(p);
         before = 1;
       } else {
+        walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        before = d.bit(m.fresh[nb][before][walk.best()][walk.cand().size() >= 4 ? 1 : 0]) ? 1 : 2;
+        before =
+            d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()])
+                ? 1
+                : 2;
         if (before == 1) {
           const auto& cand = walk.cand();
           uint32_t original = kNoVertex;
-          if (d.bit(m.copy[nb])) {
+          if (d.bit(m.copy[nb][walk.best()])) {
             const uint32_t r = cand.size() > 1 ? m.copy_rank.decode(d) : 0;
             if (r >= cand.size()) return corrupt("a copy's rank out of range");
             original = cand[r];
@@ -322,7 +370,9 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
           v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
-          const uint32_t r = cand.size() > 1 ? m.rank[walk.best()][cand.size() >= 4 ? 1 : 0].decode(d) : 0;
+          const uint32_t r = cand.size() > 1
+                                 ? m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0][walk.linked()].decode(d)
+                                 : 0;
           if (r >= cand.size()) return corrupt("a vertex rank out of range");
           v[i] = cand[r];
         }
@@ -389,6 +439,39 @@ Mesh corner_attributes_on_vertices(const Mesh& mesh, uint64_t mask) {
     a.indices.clear();
   }
   return m;
+}
+
+RankNeighbours rank_neighbours(const Mesh& faces, size_t n) {
+  RankNeighbours nb;
+  nb.start.assign(n + 1, 0);
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t* c = faces.face(f);
+    for (uint32_t i = 0, k = faces.face_size(f); i < k; ++i) {
+      ++nb.start[c[i] + 1];
+      ++nb.start[c[(i + 1) % k] + 1];
+    }
+  }
+  for (size_t o = 0; o < n; ++o) nb.start[o + 1] += nb.start[o];
+  nb.list.resize(nb.start[n]);
+  std::vector<uint32_t> at(nb.start.begin(), nb.start.end() - 1);
+  for (uint32_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t* c = faces.face(f);
+    for (uint32_t i = 0, k = faces.face_size(f); i < k; ++i) {
+      const uint32_t a = c[i], b = c[(i + 1) % k];
+      nb.list[at[a]++] = b;
+      nb.list[at[b]++] = a;
+    }
+  }
+  return nb;
+}
+
+int neighbours_say(const RankNeighbours& nb, uint32_t o, const std::vector<uint32_t>& coded) {
+  int say = 0;
+  for (uint32_t j = nb.start[o]; j < nb.start[o + 1]; ++j) {
+    const uint32_t r = coded[nb.list[j]];
+    if (r != kNoVertex) say = std::max(say, r > 0 ? 2 : 1);
+  }
+  return say;
 }
 
 }  // namespace tsm

@@ -51,4 +51,17 @@ uint64_t per_vertex_corner_attributes(const Mesh& mesh);
 // values no corner uses, both in order.
 Mesh corner_attributes_on_vertices(const Mesh& mesh, uint64_t mask);
 
+// Points out (FORMAT.md §8.13): per output vertex, the output vertices an
+// edge of a face joins it to (either way; `faces` on output ids below n).
+struct RankNeighbours {
+  std::vector<uint32_t> start, list;  // vertex o's are list[start[o] .. start[o + 1])
+};
+RankNeighbours rank_neighbours(const Mesh& faces, size_t n);
+
+// The model of output vertex o's point rank: 0 when no neighbour's rank is
+// coded yet (`coded`: per output vertex its point rank, or 0xFFFFFFFF), 1
+// when those are all 0, 2 when one is above 0 (the input vertices of one
+// part come in the same order at each of their points).
+int neighbours_say(const RankNeighbours& nb, uint32_t o, const std::vector<uint32_t>& coded);
+
 }  // namespace tsm
