@@ -1608,6 +1608,42 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   return encode_geometry_with(g, q, bits, pred, K, lattice, weights, tangent, mix, top, tables, nullptr);
 }
 
+namespace {
+
+constexpr uint32_t kFewOffSurface = 8;
+
+// find_anchors for one vertex v off the surface, by a scan of the surface
+// vertices: the nearest whose cell (2^shift steps a side) is at most one
+// cell from v's on every axis, else at most two; kNone if none is.
+uint32_t nearest_in_cells(const std::vector<uint32_t>& q, const std::vector<uint8_t>& on_surface, uint32_t v,
+                          int shift) {
+  const uint32_t* p = &q[3 * size_t{v}];
+  const int64_t c[3] = {p[0] >> shift, p[1] >> shift, p[2] >> shift};
+  uint64_t best[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};  // per cell distance 1, 2
+  uint32_t at[3] = {kNone, kNone, kNone};
+  for (uint32_t u = 0; u < on_surface.size(); ++u) {
+    if (!on_surface[u]) continue;
+    const uint32_t* o = &q[3 * size_t{u}];
+    int64_t cells = 0;
+    uint64_t d = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t k = (o[a] >> shift) - c[a];
+      cells = std::max(cells, k < 0 ? -k : k);
+      const int64_t e = int64_t{p[a]} - o[a];
+      d += static_cast<uint64_t>(e * e);
+    }
+    if (cells > 2) continue;
+    for (int64_t r = std::max<int64_t>(cells, 1); r <= 2; ++r)
+      if (d < best[r]) {  // (ids ascending: the first of equal distances stays)
+        best[r] = d;
+        at[r] = u;
+      }
+  }
+  return at[1] != kNone ? at[1] : at[2];
+}
+
+}  // namespace
+
 std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
   const uint32_t n = g.vertex_count;
   std::vector<uint32_t> anchor(n, kNone);
@@ -1626,6 +1662,14 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
     return (static_cast<uint64_t>(c[0] + 4) << 42) ^ (static_cast<uint64_t>(c[1] + 4) << 21) ^
            static_cast<uint64_t>(c[2] + 4);
   };
+  // A few vertices off the surface (a scan's stray points): each compared
+  // with every surface vertex, the same nearest (by squared distance, then
+  // id) within one cell, else two, without sorting the cells.
+  if (n - surface <= kFewOffSurface) {
+    for (uint32_t v = 0; v < n; ++v)
+      if (!on_surface[v]) anchor[v] = nearest_in_cells(q, on_surface, v, shift);
+    return anchor;
+  }
   std::vector<std::pair<uint64_t, uint32_t>> cells;
   cells.reserve(surface);
   for (uint32_t v = 0; v < n; ++v)
