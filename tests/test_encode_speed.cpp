@@ -1,5 +1,5 @@
 // The encoder's faster steps keep its choices: fit_alpha (geometry_predict.cpp),
-// whose SSE2 fast path must pick the weight that one sum per weight over
+// whose SSE2 and AVX2 paths must pick the weight that one sum per weight over
 // the samples in order picks, whatever the samples (inside the log table,
 // across its end, far outside it, more than its sampling stride);
 // find_anchors, whose scan for a few vertices off the surface must pick
@@ -17,7 +17,7 @@
 #include "geometry_predict.hpp"
 
 namespace tsm {
-int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples);
+int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples, bool wide);
 }
 
 namespace {
@@ -45,6 +45,13 @@ int32_t plain_fit_alpha(const Samples& samples) {
   return best << 8;
 }
 
+// fit_alpha by its SSE2 sums and by its AVX2 sums (where the processor has
+// it; else the SSE2 sums again): the same weight, else -1.
+int32_t fit_both(const Samples& s) {
+  const int32_t narrow = tsm::fit_alpha(s, false), wide = tsm::fit_alpha(s, true);
+  return narrow == wide ? narrow : -1;
+}
+
 // y near alpha * d for a random alpha in 0 .. 1.5, plus noise of the
 // given size: the weights' costs are close, as on a scan.
 Samples make_samples(std::mt19937_64& rng, size_t n, int64_t dmax, int64_t noise) {
@@ -69,7 +76,7 @@ TEST(EncoderSpeed, FitAlphaPicksThePlainSumsWeight) {
   for (auto [dmax, noise] : regimes)
     for (size_t n : {size_t{1}, size_t{7}, size_t{100}, size_t{5000}}) {
       const Samples s = make_samples(rng, n, dmax, noise);
-      EXPECT_EQ(tsm::fit_alpha(s), plain_fit_alpha(s)) << "dmax " << dmax << " noise " << noise << " n " << n;
+      EXPECT_EQ(fit_both(s), plain_fit_alpha(s)) << "dmax " << dmax << " noise " << noise << " n " << n;
       ++cases;
     }
   Samples mixed;
@@ -77,10 +84,10 @@ TEST(EncoderSpeed, FitAlphaPicksThePlainSumsWeight) {
     const Samples s = make_samples(rng, 3000, dmax, noise);
     mixed.insert(mixed.end(), s.begin(), s.end());
   }
-  EXPECT_EQ(tsm::fit_alpha(mixed), plain_fit_alpha(mixed));
+  EXPECT_EQ(fit_both(mixed), plain_fit_alpha(mixed));
   // More samples than the stride's 200,000: every second one is summed.
   const Samples many = make_samples(rng, 450001, 500, 60);
-  EXPECT_EQ(tsm::fit_alpha(many), plain_fit_alpha(many));
+  EXPECT_EQ(fit_both(many), plain_fit_alpha(many));
   EXPECT_EQ(cases, 32);
 }
 
@@ -88,10 +95,10 @@ TEST(EncoderSpeed, FitAlphaPicksThePlainSumsWeight) {
 // weight wins, as in the plain sums.
 TEST(EncoderSpeed, FitAlphaTieKeepsTheSmallerWeight) {
   const Samples zero_d(50, {0, 5});  // every weight predicts 0: all costs equal
-  EXPECT_EQ(tsm::fit_alpha(zero_d), 0);
+  EXPECT_EQ(fit_both(zero_d), 0);
   EXPECT_EQ(plain_fit_alpha(zero_d), 0);
   const Samples exact = {{16, 16}, {-32, -32}, {160, 160}};  // alpha 1.0 exactly
-  EXPECT_EQ(tsm::fit_alpha(exact), 1 << 12);
+  EXPECT_EQ(fit_both(exact), 1 << 12);
   EXPECT_EQ(plain_fit_alpha(exact), 1 << 12);
 }
 
