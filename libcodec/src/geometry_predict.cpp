@@ -1380,8 +1380,7 @@ constexpr int64_t kAlphaTable = 4096;  // fit_alpha's table of log2(1 + r), r < 
 // sample's terms outside the table.
 template <class Terms>
 __attribute__((target("avx2"))) void alpha_costs_avx2(const std::vector<std::pair<int64_t, int64_t>>& samples,
-                                                      size_t stride, const double* table, Terms term_of,
-                                                      double* cost) {
+                                                      size_t stride, const double* table, Terms term_of, double* cost) {
   constexpr int kLanes = AlphaCosts::kLanes;
   __m256d acc[kLanes / 4];
   for (__m256d& x : acc) x = _mm256_setzero_pd();
@@ -1392,8 +1391,8 @@ __attribute__((target("avx2"))) void alpha_costs_avx2(const std::vector<std::pai
       // |d| < 2^13 here: 32 bits hold a16 d. Lanes 28-31 are computed but
       // not read.
       const int32_t d32 = static_cast<int32_t>(d);
-      __m256i t = _mm256_setr_epi32(8, 8 + d32, 8 + 2 * d32, 8 + 3 * d32, 8 + 4 * d32, 8 + 5 * d32, 8 + 6 * d32,
-                                    8 + 7 * d32);
+      __m256i t =
+          _mm256_setr_epi32(8, 8 + d32, 8 + 2 * d32, 8 + 3 * d32, 8 + 4 * d32, 8 + 5 * d32, 8 + 6 * d32, 8 + 7 * d32);
       const __m256i step = _mm256_set1_epi32(8 * d32), yv = _mm256_set1_epi32(static_cast<int32_t>(y));
       // (The masked gather: the plain one starts from an undefined vector,
       // which GCC 12 warns about.)
@@ -1401,10 +1400,11 @@ __attribute__((target("avx2"))) void alpha_costs_avx2(const std::vector<std::pai
 #pragma GCC unroll 4
       for (int k = 0; k < kLanes / 8 + 1; ++k) {
         const __m256i r = _mm256_abs_epi32(_mm256_sub_epi32(yv, _mm256_srai_epi32(t, 4)));
-        acc[2 * k] = _mm256_add_pd(acc[2 * k], _mm256_mask_i32gather_pd(zero, table, _mm256_castsi256_si128(r), all, 8));
+        acc[2 * k] =
+            _mm256_add_pd(acc[2 * k], _mm256_mask_i32gather_pd(zero, table, _mm256_castsi256_si128(r), all, 8));
         if (2 * k + 1 < kLanes / 4)
-          acc[2 * k + 1] = _mm256_add_pd(
-              acc[2 * k + 1], _mm256_mask_i32gather_pd(zero, table, _mm256_extracti128_si256(r, 1), all, 8));
+          acc[2 * k + 1] = _mm256_add_pd(acc[2 * k + 1],
+                                         _mm256_mask_i32gather_pd(zero, table, _mm256_extracti128_si256(r, 1), all, 8));
         t = _mm256_add_epi32(t, step);
       }
       continue;
@@ -1743,24 +1743,29 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
   for (uint32_t v = 0; v < n; ++v) {
     if (on_surface[v]) continue;
     uint64_t best = UINT64_MAX;
+    // The cells dz = -r .. r of a column (dx, dy) are consecutive keys: one
+    // search, then the column's run of keys (any order of the candidates
+    // gives the same nearest, then smallest id). Below cell 0 on an axis
+    // there is none (the key would wrap).
+    const int z0 = static_cast<int>(q[3 * size_t{v} + 2] >> shift);
     for (int r = 1; r <= 2 && best == UINT64_MAX; ++r)
       for (int dx = -r; dx <= r; ++dx)
-        for (int dy = -r; dy <= r; ++dy)
-          for (int dz = -r; dz <= r; ++dz) {
-            uint64_t key = cell(v, dx, dy, dz);
-            auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, uint32_t{0}));
-            for (; it != cells.end() && it->first == key; ++it) {
-              uint64_t d = 0;
-              for (int a = 0; a < 3; ++a) {
-                int64_t e = int64_t{q[3 * size_t{v} + a]} - q[3 * size_t{it->second} + a];
-                d += static_cast<uint64_t>(e * e);
-              }
-              if (d < best || (d == best && it->second < anchor[v])) {
-                best = d;
-                anchor[v] = it->second;
-              }
+        for (int dy = -r; dy <= r; ++dy) {
+          const uint64_t last = cell(v, dx, dy, r);
+          const uint64_t first = cell(v, dx, dy, std::max(-r, -z0));
+          auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(first, uint32_t{0}));
+          for (; it != cells.end() && it->first <= last; ++it) {
+            uint64_t d = 0;
+            for (int a = 0; a < 3; ++a) {
+              int64_t e = int64_t{q[3 * size_t{v} + a]} - q[3 * size_t{it->second} + a];
+              d += static_cast<uint64_t>(e * e);
+            }
+            if (d < best || (d == best && it->second < anchor[v])) {
+              best = d;
+              anchor[v] = it->second;
             }
           }
+        }
   }
   return anchor;
 }

@@ -144,7 +144,8 @@ void RansEncoder::build() {
   }
   slot_.assign(count_.size() * kRansSymbols, 0);
   for (size_t c = 0; c < count_.size(); ++c)
-    for (size_t s = 0; s < freq_[c].size(); ++s) slot_[c * kRansSymbols + s] = uint32_t{start_[c][s]} << 16 | freq_[c][s];
+    for (size_t s = 0; s < freq_[c].size(); ++s)
+      slot_[c * kRansSymbols + s] = uint32_t{start_[c][s]} << 16 | freq_[c][s];
 }
 
 // FORMAT.md §8.5.12: per context a used flag; per used context the symbol
