@@ -110,21 +110,27 @@ void RansEncoder::build() {
   std::vector<size_t> group_of(count_.size(), 0);
   std::vector<Counts> group;
   std::vector<uint64_t> group_total;
+  double back_bits = 0, back_table = 0;  // the last group's entropy_bits and table_bits (kept, not recomputed)
   for (size_t c = 0; c < count_.size(); ++c) {
     if (total_[c] == 0) continue;
+    const double own_bits = entropy_bits(count_[c]), own_table = table_bits(count_[c]);
     if (!group.empty()) {
       Counts merged = group.back();
       for (int s = 0; s < kRansSymbols; ++s) merged[static_cast<size_t>(s)] += count_[c][static_cast<size_t>(s)];
-      const double apart =
-          entropy_bits(group.back()) + table_bits(group.back()) + entropy_bits(count_[c]) + table_bits(count_[c]);
-      if (entropy_bits(merged) + table_bits(merged) + 1 < apart) {
+      const double apart = back_bits + back_table + own_bits + own_table;
+      const double merged_bits = entropy_bits(merged), merged_table = table_bits(merged);
+      if (merged_bits + merged_table + 1 < apart) {
         group.back() = merged;
         group_total.back() += total_[c];
         group_of[c] = group.size() - 1;
         share_[c] = 1;
+        back_bits = merged_bits;
+        back_table = merged_table;
         continue;
       }
     }
+    back_bits = own_bits;
+    back_table = own_table;
     group.push_back(count_[c]);
     group_total.push_back(total_[c]);
     group_of[c] = group.size() - 1;
