@@ -84,8 +84,9 @@ struct OwnView {
   GeometryLayout layout;
 };
 
-OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref) {
-  OwnView w;
+// The view's marks and grid indices (own_view without the layout).
+void own_points(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                OwnView& w) {
   const size_t n = ce.vertex_order.size();
   w.mark.assign(n, kNone);
   if (!is_ref.empty())
@@ -102,6 +103,11 @@ OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qi
       k += 3;
     }
   w.q.resize(k);
+}
+
+OwnView own_view(const ConnectivityEncoding& ce, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref) {
+  OwnView w;
+  own_points(ce, qin, is_ref, w);
   w.layout = is_ref.empty() ? ce.layout : own_layout(ce.layout, w.mark);
   return w;
 }
@@ -212,6 +218,13 @@ Status anchor_step(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
       // or sort_by_anchor found it: the second pass would code the same
       // streams, so only hand the anchors to the geometry coder.
       for (uint32_t v = 0; v < ce.layout.vertex_count; ++v) ce.layout.anchor[v] = by_input[ce.vertex_order[v]];
+      if (is_ref.empty()) {
+        // Only vertices on no triangle moved: the view's layout is ce's
+        // (no copy of its corners) with these anchors.
+        own_points(ce, qin, is_ref, view);
+        view.layout.anchor = ce.layout.anchor;
+        return Status::Ok();
+      }
     } else {
       ce = ConnectivityEncoding();
       hints.anchor = &by_input;

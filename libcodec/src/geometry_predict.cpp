@@ -43,6 +43,10 @@
 #if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
 #define TSM_FIT_SSE2 1
 #include <emmintrin.h>
+#if defined(__x86_64__) && defined(__GNUC__)
+#define TSM_FIT_AVX2 1  // chosen at run time (fit_alpha)
+#include <immintrin.h>
+#endif
 #endif
 
 #include "byte_io.hpp"
@@ -1366,11 +1370,59 @@ struct AlphaCosts {
 #endif
 };
 
+constexpr int64_t kAlphaTable = 4096;  // fit_alpha's table of log2(1 + r), r < 4096
+
+#ifdef TSM_FIT_AVX2
+// fit_alpha's sums with AVX2 (where the processor has it): as AlphaCosts
+// with 8 residuals and 4 sums a step and the small terms gathered from the
+// table 4 at a time; every lane adds the same terms in the same order, so
+// the sums are AlphaCosts' to the bit. `term_of(d, y, term)` gives a
+// sample's terms outside the table.
+template <class Terms>
+__attribute__((target("avx2"))) void alpha_costs_avx2(const std::vector<std::pair<int64_t, int64_t>>& samples,
+                                                      size_t stride, const double* table, Terms term_of, double* cost) {
+  constexpr int kLanes = AlphaCosts::kLanes;
+  __m256d acc[kLanes / 4];
+  for (__m256d& x : acc) x = _mm256_setzero_pd();
+  for (size_t i = 0; i < samples.size(); i += stride) {
+    const int64_t d = samples[i].first, y = samples[i].second;
+    const int64_t r_last = y - floor_shift((kLanes - 1) * d + 8, 4);
+    if (y > -kAlphaTable && y < kAlphaTable && r_last > -kAlphaTable && r_last < kAlphaTable) {
+      // |d| < 2^13 here: 32 bits hold a16 d. Lanes 28-31 are computed but
+      // not read.
+      const int32_t d32 = static_cast<int32_t>(d);
+      __m256i t =
+          _mm256_setr_epi32(8, 8 + d32, 8 + 2 * d32, 8 + 3 * d32, 8 + 4 * d32, 8 + 5 * d32, 8 + 6 * d32, 8 + 7 * d32);
+      const __m256i step = _mm256_set1_epi32(8 * d32), yv = _mm256_set1_epi32(static_cast<int32_t>(y));
+      // (The masked gather: the plain one starts from an undefined vector,
+      // which GCC 12 warns about.)
+      const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), zero = _mm256_setzero_pd();
+#pragma GCC unroll 4
+      for (int k = 0; k < kLanes / 8 + 1; ++k) {
+        const __m256i r = _mm256_abs_epi32(_mm256_sub_epi32(yv, _mm256_srai_epi32(t, 4)));
+        acc[2 * k] =
+            _mm256_add_pd(acc[2 * k], _mm256_mask_i32gather_pd(zero, table, _mm256_castsi256_si128(r), all, 8));
+        if (2 * k + 1 < kLanes / 4)
+          acc[2 * k + 1] = _mm256_add_pd(acc[2 * k + 1],
+                                         _mm256_mask_i32gather_pd(zero, table, _mm256_extracti128_si256(r, 1), all, 8));
+        t = _mm256_add_epi32(t, step);
+      }
+      continue;
+    }
+    double term[kLanes];
+    term_of(d, y, term);
+    for (int j = 0; j < kLanes / 4; ++j) acc[j] = _mm256_add_pd(acc[j], _mm256_loadu_pd(term + 4 * j));
+  }
+  for (int j = 0; j < kLanes / 4; ++j) _mm256_storeu_pd(cost + 4 * j, acc[j]);
+}
+#endif
+
 }  // namespace
 
 // The weight (of 16ths, 0 .. 1.5) that minimizes an estimate of the coded
-// size, sum log2(1 + |residual|), over a sample of the coordinates.
-int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
+// size, sum log2(1 + |residual|), over a sample of the coordinates. `wide`:
+// AVX2 where the processor has it (the same sums; false for tests).
+int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples, bool wide = true) {
   if (samples.empty()) return kAlphaOne;
   // log2(1 + r) for small r from a table (the same values, 5x faster).
   static const std::vector<double> small_log = [] {
@@ -1386,25 +1438,38 @@ int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples) {
   // table at a16 = 0 and at the last lane it is at every lane, and those
   // samples (nearly all) go through fast_terms.
   constexpr int kWeights = 25;  // a16 = 0 .. 24
-  constexpr int64_t kTable = 4096;
-  AlphaCosts costs;
-  for (size_t i = 0; i < samples.size(); i += stride) {
-    const int64_t d = samples[i].first, y = samples[i].second;
-    const int64_t r_last = y - floor_shift((AlphaCosts::kLanes - 1) * d + 8, 4);
-    if (y > -kTable && y < kTable && r_last > -kTable && r_last < kTable) {
-      costs.add_small(small_log.data(), static_cast<int32_t>(d), static_cast<int32_t>(y));
-      continue;
-    }
-    double term[AlphaCosts::kLanes];
+  auto term_of = [&](int64_t d, int64_t y, double* term) {
     for (int a16 = 0; a16 < AlphaCosts::kLanes; ++a16) {
       const int64_t r = y - floor_shift(a16 * d + 8, 4);
       const int64_t m = r < 0 ? -r : r;
-      term[a16] = m < kTable ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
+      term[a16] = m < kAlphaTable ? small_log[static_cast<size_t>(m)] : std::log2(1.0 + static_cast<double>(m));
     }
-    costs.add(term);
-  }
+  };
   double cost[AlphaCosts::kLanes];
-  costs.get(cost);
+  bool summed = false;
+#ifdef TSM_FIT_AVX2
+  if (wide && __builtin_cpu_supports("avx2")) {
+    alpha_costs_avx2(samples, stride, small_log.data(), term_of, cost);
+    summed = true;
+  }
+#else
+  (void)wide;
+#endif
+  if (!summed) {
+    AlphaCosts costs;
+    for (size_t i = 0; i < samples.size(); i += stride) {
+      const int64_t d = samples[i].first, y = samples[i].second;
+      const int64_t r_last = y - floor_shift((AlphaCosts::kLanes - 1) * d + 8, 4);
+      if (y > -kAlphaTable && y < kAlphaTable && r_last > -kAlphaTable && r_last < kAlphaTable) {
+        costs.add_small(small_log.data(), static_cast<int32_t>(d), static_cast<int32_t>(y));
+        continue;
+      }
+      double term[AlphaCosts::kLanes];
+      term_of(d, y, term);
+      costs.add(term);
+    }
+    costs.get(cost);
+  }
   int best = 0;
   for (int a16 = 1; a16 < kWeights; ++a16)
     if (cost[a16] < cost[best]) best = a16;
@@ -1608,6 +1673,42 @@ std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32
   return encode_geometry_with(g, q, bits, pred, K, lattice, weights, tangent, mix, top, tables, nullptr);
 }
 
+namespace {
+
+constexpr uint32_t kFewOffSurface = 8;
+
+// find_anchors for one vertex v off the surface, by a scan of the surface
+// vertices: the nearest whose cell (2^shift steps a side) is at most one
+// cell from v's on every axis, else at most two; kNone if none is.
+uint32_t nearest_in_cells(const std::vector<uint32_t>& q, const std::vector<uint8_t>& on_surface, uint32_t v,
+                          int shift) {
+  const uint32_t* p = &q[3 * size_t{v}];
+  const int64_t c[3] = {p[0] >> shift, p[1] >> shift, p[2] >> shift};
+  uint64_t best[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};  // per cell distance 1, 2
+  uint32_t at[3] = {kNone, kNone, kNone};
+  for (uint32_t u = 0; u < on_surface.size(); ++u) {
+    if (!on_surface[u]) continue;
+    const uint32_t* o = &q[3 * size_t{u}];
+    int64_t cells = 0;
+    uint64_t d = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t k = (o[a] >> shift) - c[a];
+      cells = std::max(cells, k < 0 ? -k : k);
+      const int64_t e = int64_t{p[a]} - o[a];
+      d += static_cast<uint64_t>(e * e);
+    }
+    if (cells > 2) continue;
+    for (int64_t r = std::max<int64_t>(cells, 1); r <= 2; ++r)
+      if (d < best[r]) {  // (ids ascending: the first of equal distances stays)
+        best[r] = d;
+        at[r] = u;
+      }
+  }
+  return at[1] != kNone ? at[1] : at[2];
+}
+
+}  // namespace
+
 std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits) {
   const uint32_t n = g.vertex_count;
   std::vector<uint32_t> anchor(n, kNone);
@@ -1626,6 +1727,14 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
     return (static_cast<uint64_t>(c[0] + 4) << 42) ^ (static_cast<uint64_t>(c[1] + 4) << 21) ^
            static_cast<uint64_t>(c[2] + 4);
   };
+  // A few vertices off the surface (a scan's stray points): each compared
+  // with every surface vertex, the same nearest (by squared distance, then
+  // id) within one cell, else two, without sorting the cells.
+  if (n - surface <= kFewOffSurface) {
+    for (uint32_t v = 0; v < n; ++v)
+      if (!on_surface[v]) anchor[v] = nearest_in_cells(q, on_surface, v, shift);
+    return anchor;
+  }
   std::vector<std::pair<uint64_t, uint32_t>> cells;
   cells.reserve(surface);
   for (uint32_t v = 0; v < n; ++v)
@@ -1634,24 +1743,29 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
   for (uint32_t v = 0; v < n; ++v) {
     if (on_surface[v]) continue;
     uint64_t best = UINT64_MAX;
+    // The cells dz = -r .. r of a column (dx, dy) are consecutive keys: one
+    // search, then the column's run of keys (any order of the candidates
+    // gives the same nearest, then smallest id). Below cell 0 on an axis
+    // there is none (the key would wrap).
+    const int z0 = static_cast<int>(q[3 * size_t{v} + 2] >> shift);
     for (int r = 1; r <= 2 && best == UINT64_MAX; ++r)
       for (int dx = -r; dx <= r; ++dx)
-        for (int dy = -r; dy <= r; ++dy)
-          for (int dz = -r; dz <= r; ++dz) {
-            uint64_t key = cell(v, dx, dy, dz);
-            auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, uint32_t{0}));
-            for (; it != cells.end() && it->first == key; ++it) {
-              uint64_t d = 0;
-              for (int a = 0; a < 3; ++a) {
-                int64_t e = int64_t{q[3 * size_t{v} + a]} - q[3 * size_t{it->second} + a];
-                d += static_cast<uint64_t>(e * e);
-              }
-              if (d < best || (d == best && it->second < anchor[v])) {
-                best = d;
-                anchor[v] = it->second;
-              }
+        for (int dy = -r; dy <= r; ++dy) {
+          const uint64_t last = cell(v, dx, dy, r);
+          const uint64_t first = cell(v, dx, dy, std::max(-r, -z0));
+          auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(first, uint32_t{0}));
+          for (; it != cells.end() && it->first <= last; ++it) {
+            uint64_t d = 0;
+            for (int a = 0; a < 3; ++a) {
+              int64_t e = int64_t{q[3 * size_t{v} + a]} - q[3 * size_t{it->second} + a];
+              d += static_cast<uint64_t>(e * e);
+            }
+            if (d < best || (d == best && it->second < anchor[v])) {
+              best = d;
+              anchor[v] = it->second;
             }
           }
+        }
   }
   return anchor;
 }

@@ -101,26 +101,36 @@ double table_bits(const Counts& c) {
 void RansEncoder::build() {
   // Contexts in order: one that codes smaller with the previous table
   // (built from both contexts' counts) than with its own shares it.
+  for (size_t c = 0; c < count_.size(); ++c) {
+    total_[c] = 0;
+    for (uint32_t n : count_[c]) total_[c] += n;
+  }
   start_.assign(count_.size(), {});
   share_.assign(count_.size(), 0);
   std::vector<size_t> group_of(count_.size(), 0);
   std::vector<Counts> group;
   std::vector<uint64_t> group_total;
+  double back_bits = 0, back_table = 0;  // the last group's entropy_bits and table_bits (kept, not recomputed)
   for (size_t c = 0; c < count_.size(); ++c) {
     if (total_[c] == 0) continue;
+    const double own_bits = entropy_bits(count_[c]), own_table = table_bits(count_[c]);
     if (!group.empty()) {
       Counts merged = group.back();
       for (int s = 0; s < kRansSymbols; ++s) merged[static_cast<size_t>(s)] += count_[c][static_cast<size_t>(s)];
-      const double apart =
-          entropy_bits(group.back()) + table_bits(group.back()) + entropy_bits(count_[c]) + table_bits(count_[c]);
-      if (entropy_bits(merged) + table_bits(merged) + 1 < apart) {
+      const double apart = back_bits + back_table + own_bits + own_table;
+      const double merged_bits = entropy_bits(merged), merged_table = table_bits(merged);
+      if (merged_bits + merged_table + 1 < apart) {
         group.back() = merged;
         group_total.back() += total_[c];
         group_of[c] = group.size() - 1;
         share_[c] = 1;
+        back_bits = merged_bits;
+        back_table = merged_table;
         continue;
       }
     }
+    back_bits = own_bits;
+    back_table = own_table;
     group.push_back(count_[c]);
     group_total.push_back(total_[c]);
     group_of[c] = group.size() - 1;
@@ -138,6 +148,10 @@ void RansEncoder::build() {
       at += f;
     }
   }
+  slot_.assign(count_.size() * kRansSymbols, 0);
+  for (size_t c = 0; c < count_.size(); ++c)
+    for (size_t s = 0; s < freq_[c].size(); ++s)
+      slot_[c * kRansSymbols + s] = uint32_t{start_[c][s]} << 16 | freq_[c][s];
 }
 
 // FORMAT.md §8.5.12: per context a used flag; per used context the symbol
@@ -176,7 +190,7 @@ void RansEncoder::write_tables(RangeEncoder& e) const {
 
 void RansEncoder::put(BitWriter& bits, int ctx, int64_t r) {
   const RansSymbol s = rans_symbol(r);
-  coded_.push_back(static_cast<uint32_t>(ctx) << 8 | static_cast<uint32_t>(s.symbol));
+  coded_.push_back(static_cast<uint32_t>(ctx) * kRansSymbols + static_cast<uint32_t>(s.symbol));
   if (s.raw_bits) bits.put(s.raw, s.raw_bits);
 }
 
@@ -184,22 +198,25 @@ std::string RansEncoder::finish() {
   // rANS codes last in, first out: the residuals in reverse, the k-th with
   // state k mod 2; the words come out in reverse reading order.
   uint32_t x[2] = {kRansLow, kRansLow};
-  std::vector<uint16_t> words;
+  // At most one word per residual, written from the end backwards.
+  std::vector<uint16_t> words(coded_.size());
+  size_t w_at = words.size();
+  const uint32_t* slot = slot_.data();
   for (size_t k = coded_.size(); k-- > 0;) {
-    const size_t ctx = coded_[k] >> 8, s = coded_[k] & 0xFF;
-    const uint32_t f = freq_[ctx][s], st = start_[ctx][s];
+    const uint32_t fs = slot[coded_[k]], f = fs & 0xFFFF, st = fs >> 16;
     uint32_t& y = x[k & 1];
     if (uint64_t{y} >= uint64_t{f} << 20) {
-      words.push_back(static_cast<uint16_t>(y));
+      words[--w_at] = static_cast<uint16_t>(y);
       y >>= 16;
     }
     y = ((y / f) << kRansScaleBits) + (y % f) + st;
   }
   std::string out;
+  out.reserve(8 + 2 * (words.size() - w_at));
   ByteWriter w(out);
   w.u32(x[0]);
   w.u32(x[1]);
-  for (size_t k = words.size(); k-- > 0;) w.u16(words[k]);
+  for (size_t k = w_at; k < words.size(); ++k) w.u16(words[k]);
   coded_.clear();
   return out;
 }

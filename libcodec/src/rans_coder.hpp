@@ -59,19 +59,17 @@ class RansEncoder {
  public:
   explicit RansEncoder(int contexts)
       : count_(static_cast<size_t>(contexts)), total_(count_.size(), 0), freq_(count_.size()), top_(count_.size(), 0) {}
-  void count(int ctx, int64_t r) {
-    ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)];
-    ++total_[static_cast<size_t>(ctx)];
-  }
+  void count(int ctx, int64_t r) { ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(rans_symbol(r).symbol)]; }
   void build();
   void write_tables(RangeEncoder& e) const;
   void put(BitWriter& bits, int ctx, int64_t r);
   // count() and put() at once (one pass: the encoder keeps what it puts).
-  void count_and_put(BitWriter& bits, int ctx, int64_t r) {
+  // Inline: the trial codings call it for every coordinate.
+  __attribute__((always_inline)) void count_and_put(BitWriter& bits, int ctx, int64_t r) {
     const RansSymbol s = rans_symbol(r);
+    const uint32_t at = static_cast<uint32_t>(ctx) * kRansSymbols + static_cast<uint32_t>(s.symbol);
     ++count_[static_cast<size_t>(ctx)][static_cast<size_t>(s.symbol)];
-    ++total_[static_cast<size_t>(ctx)];
-    coded_.push_back(static_cast<uint32_t>(ctx) << 8 | static_cast<uint32_t>(s.symbol));
+    coded_.push_back(at);
     if (s.raw_bits) bits.put(s.raw, s.raw_bits);
   }
   // The rANS stream: the two final states (u32 each), then 16-bit words.
@@ -79,12 +77,13 @@ class RansEncoder {
 
  private:
   std::vector<std::array<uint32_t, kRansSymbols>> count_;
-  std::vector<uint64_t> total_;              // per context: residuals counted
+  std::vector<uint64_t> total_;              // per context: residuals counted (build() sums them)
   std::vector<std::vector<uint16_t>> freq_;  // per context: frequencies of symbols 0..S-1 (empty: unused)
   std::vector<std::vector<uint16_t>> start_;
   std::vector<uint8_t> share_;   // per context: 1 if it uses the previous table
   std::vector<int> top_;         // per context: its table's implied symbol
-  std::vector<uint32_t> coded_;  // ctx << 8 | symbol, in coding order
+  std::vector<uint32_t> coded_;  // ctx * kRansSymbols + symbol, in coding order
+  std::vector<uint32_t> slot_;   // per ctx * kRansSymbols + symbol: start << 16 | frequency (after build())
 };
 
 // The decoder's side: the tables read from the range coder, the two states

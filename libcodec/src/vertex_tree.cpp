@@ -250,7 +250,7 @@ VertexForest build_vertex_tree(CutMesh& m, const std::vector<uint32_t>* qpos, bo
   // root, by the edge's smaller half-edge.
   std::vector<double> mid_dist(midpoint ? nh : 0, 0.0);
   // The edge of half-edge h and its twin, keyed.
-  auto make_edge = [&](uint32_t h) -> Edge {
+  auto make_edge = [&](uint32_t h) __attribute__((always_inline))->Edge {  // (inline: once per edge)
     const uint32_t g = m.twin[h];
     const uint32_t a = m.tri[h], b = m.tri[g];
     uint64_t cls, ring;
