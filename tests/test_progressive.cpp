@@ -226,7 +226,8 @@ TEST(Progressive, RepeatedAndFinFacesWaitForTheLooseSection) {
   const tsm::Mesh sphere = jittered(icosphere(4), 0.01f, 5);
   tsm::Mesh m = double_sided(sphere);
   size_t extra = sphere.face_count();
-  for (size_t f = 0; f < sphere.face_count(); f += 9, ++extra) m.add_triangle(sphere.face(f)[0], sphere.face(f)[1], sphere.face(f)[2]);
+  for (size_t f = 0; f < sphere.face_count(); f += 9, ++extra)
+    m.add_triangle(sphere.face(f)[0], sphere.face(f)[1], sphere.face(f)[2]);
   for (size_t f = 4; f < sphere.face_count(); f += 13, ++extra) {
     const uint32_t* c = sphere.face(f);
     const uint32_t tip = static_cast<uint32_t>(m.vertex_count());

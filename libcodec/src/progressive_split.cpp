@@ -566,8 +566,8 @@ Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimit
     for (int k = 1; k < 3; ++k) {
       pick_candidates(level, c, k, cand);
       const uint64_t pick = fm->pick[k - 1].decode(dec);
-      const uint64_t x = pick > 0 ? (pick <= cand.size() ? cand[pick - 1] : vertices)
-                                  : a + 1 + uint64_t{fm->far[k - 1].decode(dec)};
+      const uint64_t x =
+          pick > 0 ? (pick <= cand.size() ? cand[pick - 1] : vertices) : a + 1 + uint64_t{fm->far[k - 1].decode(dec)};
       if (x >= vertices || x <= a || (k == 2 && x == c[1])) return corrupt("a left-out face's corner out of range");
       c[k] = static_cast<uint32_t>(x);
     }
