@@ -3248,11 +3248,14 @@ def decode_batch(payload, level, m):
 
 
 def decode_loose(payload, level):
-    """§4.8: the loose vertices, appended without faces."""
+    """§4.8: the loose vertices, appended without faces, then the faces the
+    levels left out."""
     count, p = read_varint(payload, 0, len(payload))
+    nfaces, p = read_varint(payload, p, len(payload))
     stream = payload[p:]
-    if count == 0 or count > max_decisions(len(stream)) // 3:
-        reject('loose vertex count')
+    most = max_decisions(len(stream)) // 3
+    if count + nfaces == 0 or count > most or nfaces > most or count + nfaces > most:
+        reject('loose vertex or face count')
     d = RangeDecoder(stream)
     axis = [SIntModel(3) for _ in range(3)]
     qmax = (1 << level.h['bits']) - 1
@@ -3265,6 +3268,32 @@ def decode_loose(payload, level):
         if d.truncated():
             reject('loose vertices truncated')
         level.add_point(prev)
+    first, pick, far = UIntModel(2), [UIntModel(2), UIntModel(2)], [UIntModel(2), UIntModel(2)]
+    n = len(level.q)
+    a = 0
+    for _ in range(nfaces):
+        a += first.decode(d)
+        if a >= n:
+            reject('a left-out face corner')
+        c = [a]
+        for k in (1, 2):
+            cand = set(w for f in level.vf[c[0]] for w in level.faces[f])
+            if k == 2:
+                cand |= set(w for f in level.vf[c[1]] for w in level.faces[f])
+            cand = sorted(cand - set(c))
+            x = pick[k - 1].decode(d)
+            if x > 0:
+                x = cand[x - 1] if x <= len(cand) else n
+            else:
+                x = a + 1 + far[k - 1].decode(d)
+            if x >= n or x <= a or x in c:
+                reject('a left-out face corner')
+            c.append(x)
+        if d.truncated():
+            reject('left-out faces truncated')
+        for w in c:
+            level.vf[w].append(len(level.faces))
+        level.faces.append(c)
 
 
 def apply_refinements(h, batches, loose, faces, positions):

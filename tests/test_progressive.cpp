@@ -45,7 +45,8 @@ void expect_round_trip(const tsm::Mesh& m, size_t min_batches) {
     // Vertices no face uses come after the batches (but for one on the box).
     EXPECT_LE(fi.batches.back().vertices, m.vertex_count());
     EXPECT_GE(fi.batches.back().vertices + m.unreferenced_vertex_count(), m.vertex_count());
-    EXPECT_EQ(fi.batches.back().faces, m.face_count());
+    // Faces the levels leave out (a repeat, a third at an edge) come last.
+    EXPECT_EQ(fi.batches.back().faces + fi.loose_faces, m.face_count());
     EXPECT_LT(fi.vertex_count, m.vertex_count());
   }
 }
@@ -217,6 +218,35 @@ TEST(Progressive, BordersCoarsenAndHolesStay) {
   EXPECT_GE(levels, 3u);
   // The borders are coarsened too (they stayed whole in the base before).
   EXPECT_LT(base_border * 3, input_border);
+  expect_round_trip(m, 3);
+}
+
+TEST(Progressive, RepeatedAndFinFacesWaitForTheLooseSection) {
+  // A sphere whose faces are all there twice (once reversed: a zero-thickness
+  // sheet), some three times, and fins on some edges: no vertex has a fan,
+  // so without the loose section's faces the whole mesh would be the base.
+  const tsm::Mesh sphere = jittered(icosphere(4), 0.01f, 5);
+  tsm::Mesh m = double_sided(sphere);
+  size_t extra = sphere.face_count();
+  for (size_t f = 0; f < sphere.face_count(); f += 9, ++extra)
+    m.add_triangle(sphere.face(f)[0], sphere.face(f)[1], sphere.face(f)[2]);
+  for (size_t f = 4; f < sphere.face_count(); f += 13, ++extra) {
+    const uint32_t* c = sphere.face(f);
+    const uint32_t tip = static_cast<uint32_t>(m.vertex_count());
+    float p[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p[a] += 0.5f * sphere.positions[3 * size_t{c[k]} + a];
+    m.add_vertex(p[0], p[1], p[2]);  // outside the sphere, over the face
+    m.add_triangle(c[1], c[0], tip);
+  }
+  const std::string bytes = encode_progressive(m);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  ASSERT_FALSE(fi.batches.empty());
+  EXPECT_EQ(fi.loose_faces, extra);
+  EXPECT_LT(fi.vertex_count * 4, sphere.vertex_count());
+  // The levels are the sphere without its repeats and fins.
+  EXPECT_EQ(fi.batches.back().faces, sphere.face_count());
   expect_round_trip(m, 3);
 }
 

@@ -603,7 +603,7 @@ Status inspect_batches(const Header& h, const std::vector<Section>& sections, Fi
   for (const Section& s : sections) {
     if (s.id == kSectionLoose) {
       ByteReader r(s.data);
-      if (!r.varint(info.loose_vertices)) return corrupt("loose vertices: truncated");
+      if (!r.varint(info.loose_vertices) || !r.varint(info.loose_faces)) return corrupt("loose section: truncated");
     }
     if (s.id != kSectionRefinement) continue;
     BatchHeader bh;

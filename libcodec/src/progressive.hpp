@@ -2,6 +2,7 @@
 // of vertex splits (refinement sections, id 12), each batch a set of
 // independent splits coded in the decoder's vertex order.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -44,6 +45,10 @@ class LevelMesh {
   uint32_t split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist, const uint32_t q[3]);
   // Appends a vertex no face uses, at grid index q.
   void add_point(const uint32_t q[3]);
+  // Appends the triangle (a, b, c).
+  void add_triangle(uint32_t a, uint32_t b, uint32_t c);
+  // The vertices sharing a face with v, in increasing id.
+  void neighbours(uint32_t v, std::vector<uint32_t>& out) const;
   size_t vertex_count() const { return q_.size() / 3; }
   int bits() const { return h_.quantization_bits; }
   const uint32_t* q(uint32_t v) const { return &q_[3 * size_t{v}]; }
@@ -99,9 +104,12 @@ struct BatchLimits {
 // Decodes one refinement payload and applies it to `level`.
 Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
 
-// The loose section (id 13, FORMAT.md §4.8): vertices no face uses, after
-// the last batch. q: 3 grid indices per vertex (any order; coded sorted).
-std::string encode_loose(std::vector<uint32_t> q);
+// The loose section (id 13, FORMAT.md §4.8), after the last batch: vertices
+// no face uses (q: 3 grid indices per vertex, coded sorted; the caller
+// gives them sorted, so they get the next ids in its order), then the
+// triangles the levels left out (level ids), applied to `level`.
+Status encode_loose(LevelMesh& level, std::vector<uint32_t> q, std::vector<std::array<uint32_t, 3>> faces,
+                    std::string& out);
 Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
 
 }  // namespace tsm

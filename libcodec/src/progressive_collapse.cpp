@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <set>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "progressive.hpp"
 #include "progressive_plan.hpp"
@@ -32,6 +34,11 @@ constexpr double kLength = 0.005;
 // The weight of a border edge's plane (through the edge, across its face)
 // per squared edge length.
 constexpr double kBorderWeight = 1.0;
+// A batch takes no collapse costing more than the one a quarter of the way
+// down its candidate list (once it has min_batch_splits): the expensive
+// collapses wait for coarser levels, so their vertices come back in early
+// batches and a short prefix of the file has the error-removing splits.
+constexpr size_t kCeilingAt = 4;
 
 void add_plane(Quadric& q, const double n[3], double d, double w) {
   const double p[4] = {n[0], n[1], n[2], d};
@@ -67,6 +74,7 @@ class Collapser {
   void rank_vertices();
   void build();
   void lock_special();
+  void lock_shared_points();
   void add_border_planes();
   bool ring(uint32_t v, std::vector<uint32_t>& out) const;
   bool keeps_fan(uint32_t w);
@@ -76,6 +84,8 @@ class Collapser {
   std::vector<Candidate> candidates();
   size_t batch(std::vector<CollapseRecord>& out);
   void write_base(CollapsePlan& plan) const;
+  bool keep_triangle(const uint32_t c[3]);
+  std::vector<uint8_t> choose_kept(const std::vector<std::array<uint32_t, 3>>& tris);
   double level_error() const;
 
   const Mesh& mesh_;
@@ -94,13 +104,89 @@ class Collapser {
   std::vector<uint32_t> ring_u_, ring_v_, ring_w_;
   std::vector<uint32_t> rank_;   // per vertex: its place in the order by grid point (then input id)
   std::vector<uint32_t> order_;  // vertices by rank
+  std::vector<std::array<uint32_t, 3>> left_out_;
+  std::unordered_map<uint64_t, uint32_t> edge_uses_;  // undirected edge -> faces kept on it
+  std::unordered_set<uint64_t> directed_;             // kept directed edges
+  std::set<std::array<uint32_t, 3>> corner_sets_;     // kept triangles' sorted corners
 };
+
+uint64_t pair_key(uint32_t a, uint32_t b) { return (uint64_t{a} << 32) | b; }
+
+// A triangle (canonical order) joins the levels unless it repeats the
+// corners of one kept before, uses an edge in a direction a kept one
+// already does, or would be the third on an edge: those are coded after
+// the last batch, so the kept faces form fans where a scan's sheets touch.
+// (A kept triangle is registered on its edges here.)
+bool Collapser::keep_triangle(const uint32_t c[3]) {
+  // The encoder finds a vertex of the decoded base by its grid point: one
+  // sharing its point with another stays with all its faces.
+  const bool forced = dup_[c[0]] || dup_[c[1]] || dup_[c[2]];
+  std::array<uint32_t, 3> s = {c[0], c[1], c[2]};
+  std::sort(s.begin(), s.end());
+  if (!forced && corner_sets_.count(s)) return false;
+  for (int k = 0; k < 3 && !forced; ++k) {
+    const uint32_t a = c[k], b = c[(k + 1) % 3];
+    if (directed_.count(pair_key(a, b))) return false;
+    auto it = edge_uses_.find(pair_key(std::min(a, b), std::max(a, b)));
+    if (it != edge_uses_.end() && it->second >= 2) return false;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t a = c[k], b = c[(k + 1) % 3];
+    directed_.insert(pair_key(a, b));
+    ++edge_uses_[pair_key(std::min(a, b), std::max(a, b))];
+  }
+  corner_sets_.insert(s);
+  return true;
+}
 
 // The plan depends only on the mesh as the decoder gives it back (grid
 // points and faces, whatever the vertex and face order and the corners'
 // rotation), so that decoding a progressive file and encoding it again
 // gives the same bytes: vertices are ranked by grid point, triangles are
 // taken rotated to their least-ranked corner, in the order of their ranks.
+// Which triangles (canonical corner ranks, sorted) join the levels, by
+// keep_triangle in a breadth-first order over shared edges from the first,
+// so one orientation spreads over a sheet whose faces are all there twice;
+// triangles with an edge no other triangle has (fins) come after the rest.
+std::vector<uint8_t> Collapser::choose_kept(const std::vector<std::array<uint32_t, 3>>& tris) {
+  const size_t n = tris.size();
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * n);
+  for (uint32_t t = 0; t < n; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
+      edges.emplace_back(pair_key(std::min(a, b), std::max(a, b)), t);
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint8_t> open(n, 0);  // has an edge no other triangle has
+  for (size_t i = 0; i < edges.size(); ++i) {
+    const bool alone = (i == 0 || edges[i - 1].first != edges[i].first) &&
+                       (i + 1 == edges.size() || edges[i + 1].first != edges[i].first);
+    if (alone) open[edges[i].second] = 1;
+  }
+  std::vector<uint8_t> seen(n, 0), kept(n, 0);
+  std::vector<uint32_t> queue;
+  for (int pass = 0; pass < 2; ++pass)
+    for (uint32_t seed = 0; seed < n; ++seed) {
+      if (seen[seed] || open[seed] != pass) continue;
+      queue.assign(1, seed);
+      seen[seed] = 1;
+      for (size_t head = 0; head < queue.size(); ++head) {
+        const uint32_t t = queue[head];
+        const uint32_t c[3] = {order_[tris[t][0]], order_[tris[t][1]], order_[tris[t][2]]};
+        kept[t] = keep_triangle(c) ? 1 : 0;
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
+          const uint64_t key = pair_key(std::min(a, b), std::max(a, b));
+          auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, uint32_t{0}));
+          for (; it != edges.end() && it->first == key; ++it)
+            if (!seen[it->second] && open[it->second] == pass) seen[it->second] = 1, queue.push_back(it->second);
+        }
+      }
+    }
+  return kept;
+}
+
 void Collapser::rank_vertices() {
   const size_t n = mesh_.vertex_count();
   order_.resize(n);
@@ -127,6 +213,7 @@ void Collapser::build() {
   removed_.assign(n, 0);
   merged_into_.assign(n, 0);
   quadric_.assign(n, Quadric{});
+  lock_shared_points();
   std::vector<std::array<uint32_t, 3>> tris;  // canonical corner ranks
   std::vector<std::pair<std::vector<uint32_t>, uint32_t>> others;
   for (size_t f = 0; f < mesh_.face_count(); ++f) {
@@ -149,8 +236,14 @@ void Collapser::build() {
   std::sort(others.begin(), others.end());
   for (const auto& o : others) other_faces_.push_back(o.second);
   std::sort(tris.begin(), tris.end());
-  for (const auto& r : tris) {
+  const std::vector<uint8_t> kept = choose_kept(tris);
+  for (size_t i = 0; i < tris.size(); ++i) {
+    const auto& r = tris[i];
     const uint32_t c[3] = {order_[r[0]], order_[r[1]], order_[r[2]]};
+    if (!kept[i]) {
+      left_out_.push_back({c[0], c[1], c[2]});
+      continue;
+    }
     const uint32_t t = static_cast<uint32_t>(tri_.size());
     tri_.push_back({c[0], c[1], c[2]});
     for (int k = 0; k < 3; ++k) vf_[c[k]].push_back(t);
@@ -214,7 +307,7 @@ void Collapser::add_border_planes() {
 // first in grid-point order at the least and the greatest grid index of
 // each axis; the positions are on the grid, so the base mesh has the
 // input's box, hence its grid).
-void Collapser::lock_special() {
+void Collapser::lock_shared_points() {
   const size_t n = mesh_.vertex_count();
   std::unordered_map<uint64_t, uint32_t> seen;
   seen.reserve(n);
@@ -225,6 +318,10 @@ void Collapser::lock_special() {
     auto [it, fresh] = seen.emplace(key, i);
     if (!fresh) locked_[i] = locked_[it->second] = dup_[i] = dup_[it->second] = 1;
   }
+}
+
+void Collapser::lock_special() {
+  const size_t n = mesh_.vertex_count();
   for (int a = 0; a < 3 && n; ++a) {
     uint32_t lo = order_[0], hi = order_[0];
     for (uint32_t i : order_) {
@@ -373,13 +470,16 @@ std::vector<Candidate> Collapser::candidates() {
 }
 
 // One batch: the cheapest collapses whose faces no other collapse of the
-// batch touches, at most a third of the vertices (+50% on refinement).
+// batch touches, at most a third of the vertices (+50% on refinement),
+// none above the ceiling (kCeilingAt).
 size_t Collapser::batch(std::vector<CollapseRecord>& out) {
   ++batch_no_;
   const size_t limit = vertices_left_ / 3;
   CollapseRecord rec;
-  for (const Candidate& c : candidates()) {
-    if (out.size() >= limit) break;
+  const std::vector<Candidate> all = candidates();
+  const double ceiling = all.empty() ? 0 : all[all.size() / kCeilingAt].cost;
+  for (const Candidate& c : all) {
+    if (out.size() >= limit || (c.cost > ceiling && out.size() >= options_.min_batch_splits)) break;
     if (removed_[c.u] || removed_[c.v]) continue;
     bool free = true;
     for (uint32_t w : {c.u, c.v})
@@ -417,6 +517,13 @@ void Collapser::write_base(CollapsePlan& plan) const {
   }
   for (size_t t = 0; t < tri_.size(); ++t)
     if (alive_[t]) base.add_triangle(plan.base_id[tri_[t][0]], plan.base_id[tri_[t][1]], plan.base_id[tri_[t][2]]);
+  plan.left_out.clear();
+  for (const auto& c : left_out_) {
+    if (plan.batches.empty())
+      base.add_triangle(plan.base_id[c[0]], plan.base_id[c[1]], plan.base_id[c[2]]);
+    else
+      plan.left_out.push_back(c);
+  }
   base.metadata = mesh_.metadata;
 }
 

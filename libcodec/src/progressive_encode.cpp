@@ -113,11 +113,23 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
     append_raw_section(out, kSectionRefinement, write_batch(bh, stream));
     before = bh.error_after;
   }
-  if (!plan.loose.empty()) {
+  if (!plan.loose.empty() || !plan.left_out.empty()) {
+    // The loose vertices take the next ids in grid order (the plan lists
+    // them so), then the left-out triangles use the level's ids.
     std::vector<uint32_t> lq;
-    for (uint32_t i : plan.loose)
+    for (uint32_t i : plan.loose) {
+      id[i] = static_cast<uint32_t>(level.vertex_count() + lq.size() / 3);
       for (int a = 0; a < 3; ++a) lq.push_back(q[3 * size_t{i} + a]);
-    append_raw_section(out, kSectionLoose, encode_loose(std::move(lq)));
+    }
+    std::vector<std::array<uint32_t, 3>> faces;
+    for (const auto& c : plan.left_out) {
+      faces.push_back({id[c[0]], id[c[1]], id[c[2]]});
+      for (uint32_t x : faces.back())
+        if (x == kNotInBase) return Status(ErrorCode::internal, "progressive: a left-out face off the levels");
+    }
+    std::string payload;
+    TSM_RETURN_IF_ERROR(encode_loose(level, std::move(lq), std::move(faces), payload));
+    append_raw_section(out, kSectionLoose, payload);
   }
   append_end_marker(out);
   return Status::Ok();

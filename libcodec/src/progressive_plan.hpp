@@ -1,6 +1,7 @@
 // Internal: the encoder's side of progressive files (FORMAT.md §4.8): the
 // collapses that turn the input into the base mesh, in batches.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +34,11 @@ struct CollapsePlan {
   // Vertices no face uses, left out of the base when there are batches (the
   // loose section codes them after the last; FORMAT.md §4.8).
   std::vector<uint32_t> loose;
+  // Triangles left out of the levels (input ids): a repeat of another's
+  // corners, or a third face at an edge (or a second in one direction);
+  // the loose section codes them after the last batch (FORMAT.md §4.8), so
+  // the faces the collapses see form fans where the input's sheets touch.
+  std::vector<std::array<uint32_t, 3>> left_out;
 };
 
 // q: the input's grid indices, 3 per vertex.

@@ -264,6 +264,23 @@ void LevelMesh::add_point(const uint32_t q[3]) {
   vf_.emplace_back();
 }
 
+void LevelMesh::add_triangle(uint32_t a, uint32_t b, uint32_t c) {
+  const uint32_t f = static_cast<uint32_t>(mesh_->face_count());
+  mesh_->add_triangle(a, b, c);
+  for (uint32_t w : {a, b, c}) vf_[w].push_back(f);
+}
+
+void LevelMesh::neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+  out.clear();
+  for (uint32_t f : vf_[v]) {
+    const uint32_t* c = mesh_->face(f);
+    for (uint32_t k = 0; k < mesh_->face_size(f); ++k)
+      if (c[k] != v) out.push_back(c[k]);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
 uint32_t LevelMesh::split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
                           const uint32_t q[3]) {
   const uint32_t u = static_cast<uint32_t>(vertex_count());
@@ -445,35 +462,83 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
   return Status::Ok();
 }
 
-std::string encode_loose(std::vector<uint32_t> q) {
+// The left-out triangles' models (fresh per section): the first corner as
+// a step from the previous face's, the others as a pick among the first
+// corner's neighbours (the second's too, for the third), 0 = not there,
+// then the difference from the first corner.
+struct LooseFaceModels {
+  UIntModelT<2> first, pick[2], far[2];
+};
+
+// The pick candidates of corner k (1, 2) of a triangle whose earlier
+// corners are c[0 .. k-1]: the neighbours of those corners, in increasing
+// id, without the corners themselves.
+void pick_candidates(const LevelMesh& level, const uint32_t* c, int k, std::vector<uint32_t>& out) {
+  std::vector<uint32_t> more;
+  level.neighbours(c[0], out);
+  if (k == 2) {
+    level.neighbours(c[1], more);
+    out.insert(out.end(), more.begin(), more.end());
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+  out.erase(std::remove_if(out.begin(), out.end(), [&](uint32_t x) { return x == c[0] || (k == 2 && x == c[1]); }),
+            out.end());
+}
+
+Status encode_loose(LevelMesh& level, std::vector<uint32_t> q, std::vector<std::array<uint32_t, 3>> faces,
+                    std::string& out) {
   const size_t n = q.size() / 3;
   std::vector<std::array<uint32_t, 3>> points(n);
   for (size_t i = 0; i < n; ++i) points[i] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
-  std::sort(points.begin(), points.end());
+  if (!std::is_sorted(points.begin(), points.end()))
+    return Status(ErrorCode::internal, "progressive: loose vertices out of order");
   auto m = std::make_unique<SIntModelT<3>[]>(3);
   RangeEncoder e;
   uint32_t prev[3] = {0, 0, 0};
-  for (const auto& p : points)
+  for (const auto& p : points) {
     for (int a = 0; a < 3; ++a) {
       m[a].encode(e, static_cast<int32_t>(int64_t{p[a]} - int64_t{prev[a]}));
       prev[a] = p[a];
     }
-  std::string out;
+    level.add_point(p.data());
+  }
+  for (auto& f : faces) std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+  std::sort(faces.begin(), faces.end());
+  auto fm = std::make_unique<LooseFaceModels>();
+  std::vector<uint32_t> cand;
+  uint32_t previous = 0;
+  for (const auto& f : faces) {
+    fm->first.encode(e, f[0] - previous);
+    previous = f[0];
+    for (int k = 1; k < 3; ++k) {
+      pick_candidates(level, f.data(), k, cand);
+      const auto it = std::lower_bound(cand.begin(), cand.end(), f[k]);
+      const bool found = it != cand.end() && *it == f[k];
+      fm->pick[k - 1].encode(e, found ? static_cast<uint32_t>(it - cand.begin()) + 1 : 0);
+      if (!found) fm->far[k - 1].encode(e, f[k] - f[0] - 1);
+    }
+    level.add_triangle(f[0], f[1], f[2]);
+  }
   ByteWriter w(out);
   w.varint(n);
+  w.varint(faces.size());
   w.bytes(e.finish());
-  return out;
+  return Status::Ok();
 }
 
 Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits) {
   ByteReader r(payload);
-  uint64_t n = 0;
-  if (!r.varint(n)) return corrupt("loose vertices: truncated");
+  uint64_t n = 0, faces = 0;
+  if (!r.varint(n) || !r.varint(faces)) return corrupt("loose section: truncated");
   std::string_view stream;
   r.bytes(r.remaining(), stream);
-  if (n == 0 || n > max_decisions(stream.size()) / 3) return corrupt("loose vertex count out of range");
-  if (limits.max_vertices && level.vertex_count() + n > limits.max_vertices)
-    return Status(ErrorCode::limit_exceeded, "loose vertices: the mesh would exceed the decoder's limits");
+  if (n + faces == 0 || n > max_decisions(stream.size()) / 3 || faces > max_decisions(stream.size()) / 3 ||
+      n + faces > max_decisions(stream.size()) / 3)
+    return corrupt("loose vertex or face count out of range");
+  if ((limits.max_vertices && level.vertex_count() + n > limits.max_vertices) ||
+      (limits.max_faces && level.mesh().face_count() + faces > limits.max_faces))
+    return Status(ErrorCode::limit_exceeded, "loose section: the mesh would exceed the decoder's limits");
   auto m = std::make_unique<SIntModelT<3>[]>(3);
   RangeDecoder dec(stream);
   const int64_t qmax = (int64_t{1} << level.bits()) - 1;
@@ -487,6 +552,27 @@ Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimit
     }
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the loose vertices' stream ends early");
     level.add_point(q);
+  }
+  auto fm = std::make_unique<LooseFaceModels>();
+  std::vector<uint32_t> cand;
+  const uint64_t vertices = level.vertex_count();
+  uint64_t previous = 0;
+  for (uint64_t i = 0; i < faces; ++i) {
+    uint32_t c[3];
+    const uint64_t a = previous + fm->first.decode(dec);
+    if (a >= vertices) return corrupt("a left-out face's corner out of range");
+    c[0] = static_cast<uint32_t>(a);
+    previous = a;
+    for (int k = 1; k < 3; ++k) {
+      pick_candidates(level, c, k, cand);
+      const uint64_t pick = fm->pick[k - 1].decode(dec);
+      const uint64_t x =
+          pick > 0 ? (pick <= cand.size() ? cand[pick - 1] : vertices) : a + 1 + uint64_t{fm->far[k - 1].decode(dec)};
+      if (x >= vertices || x <= a || (k == 2 && x == c[1])) return corrupt("a left-out face's corner out of range");
+      c[k] = static_cast<uint32_t>(x);
+    }
+    if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the left-out faces' stream ends early");
+    level.add_triangle(c[0], c[1], c[2]);
   }
   return Status::Ok();
 }

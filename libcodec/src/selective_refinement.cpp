@@ -19,6 +19,7 @@ namespace tsm {
 namespace {
 
 constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr uint32_t kLeftOut = kNone - 1;  // a face of the loose section
 
 Status refused(const std::string& message) { return Status(ErrorCode::invalid_argument, message); }
 
@@ -53,6 +54,8 @@ Status ProgressiveHierarchy::build(std::string_view bytes, const DecodeOptions& 
     return refused("not a progressive file: it has no refinement batches (encode it with tsm encode --progressive)");
   full_ = dec.take_mesh();
   made_by_.resize(full_.vertex_count(), kNone);  // the loose section's vertices: in every state
+  // The loose section's faces: where all their corners are.
+  face_made_by_.resize(full_.face_count(), kLeftOut);
   applied_.assign(splits_.size(), 1);
   applied_count_ = split_count();
   dirty_ = true;
@@ -194,8 +197,14 @@ void ProgressiveHierarchy::rebuild() {
   }
   std::vector<uint32_t> corners;
   for (size_t f = 0; f < full_.face_count(); ++f) {
-    if (face_made_by_[f] != kNone && !applied_[face_made_by_[f]]) continue;
     const uint32_t* c = full_.face(f);
+    if (face_made_by_[f] == kLeftOut) {
+      bool all = true;
+      for (uint32_t k = 0; k < full_.face_size(f); ++k) all = all && active_ancestor(c[k]) == c[k];
+      if (!all) continue;
+    } else if (face_made_by_[f] != kNone && !applied_[face_made_by_[f]]) {
+      continue;
+    }
     corners.assign(c, c + full_.face_size(f));
     for (uint32_t& x : corners) x = id[active_ancestor(x)];
     current_.add_face(corners.data(), corners.size());

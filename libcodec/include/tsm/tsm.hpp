@@ -206,6 +206,7 @@ struct FileInfo {
   std::vector<Batch> batches;
   double base_error = 0;
   uint64_t loose_vertices = 0;  // the loose section's: vertices no face uses, after the batches
+  uint64_t loose_faces = 0;     // the loose section's: triangles the levels leave out
   // Geometry (from decoding the geometry stream): "parallelograms", "spread",
   // "gate", "fan", "ancestors" (with K) or "raw", followed by "+tangent" (tangent
   // step), "+mix" (residual mixing), "+top" (lattice planes from the top),
