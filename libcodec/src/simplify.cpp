@@ -843,7 +843,13 @@ bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth,
   if (depth >= kMaxCheckDepth) return false;
   const Vec3 m[3] = {(p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5, (p[2] + p[0]) * 0.5};
   Near nm[3];
-  for (int k = 0; k < 3; ++k) nm[k] = exact_bound(m[k], n[k].ref);
+  // A midpoint farther than E from the original (its exact distance) is a
+  // point of the triangle no bound can prove: refused now rather than after
+  // cutting the parts around it down to the last depth.
+  for (int k = 0; k < 3; ++k) {
+    nm[k] = exact_bound(m[k], n[k].ref);
+    if (!(nm[k].b <= e)) return false;
+  }
   const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
              c3[3] = {m[0], m[1], m[2]};
   Near n0[3] = {n[0], nm[0], nm[2]}, n1[3] = {nm[0], n[1], nm[1]}, n2[3] = {nm[2], nm[1], n[2]},
