@@ -166,6 +166,7 @@ class Simplifier {
   struct Near {
     double b;
     int64_t ref;
+    bool exact = false;  // b is the distance to the original itself (through the BVH)
   };
   bool within_original(uint32_t t, double& err);
   Near ring_bound(Vec3 p);
@@ -745,7 +746,7 @@ Simplifier::Near Simplifier::exact_bound(Vec3 p, int64_t hint) {
   if (!c.has_exact) {
     double d2;
     const int64_t t = bvh_.nearest(p, d2, hint);
-    c.exact = {std::sqrt(d2), t};
+    c.exact = {std::sqrt(d2), t, true};
     c.has_exact = true;
   }
   return c.exact;
@@ -811,9 +812,11 @@ bool Simplifier::within_original(uint32_t tri, double& err) {
 }
 
 // p: corners, n: their bounds (the new triangle's corners through the
-// ring, cut points through the BVH). A part the bounds do not prove is
-// tried with the distances to the original at its corners, then cut in
-// four; err gets the largest bound of the parts proved.
+// ring, cut points through a corner of the part cut: its bound plus the
+// distance to it, the distance being 1-Lipschitz). A part those bounds do
+// not prove is tried with the distances to the original at its corners
+// (through the BVH), then cut in four; err gets the largest bound of the
+// parts proved.
 bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth, double& err) {
   const double e = std::sqrt(e2_);
   double b = leaf_bound(p, n);
@@ -821,16 +824,14 @@ bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth,
     err = std::max(err, b);
     return true;
   }
-  // Corners bounded through the ring: their distances to the original.
-  int64_t hint = -1;
-  bool ring = false;
-  for (int k = 0; k < 3; ++k) {
-    if (n[k].ref >= 0) hint = n[k].ref;
-    ring = ring || n[k].ref < 0;
-  }
-  if (ring) {
+  if (!n[0].exact || !n[1].exact || !n[2].exact) {
+    int64_t hint = -1;
+    for (int k = 0; k < 3; ++k)
+      if (n[k].ref >= 0) hint = n[k].ref;
+    // A corner farther than E from the original is a point no bound can
+    // prove: refused at once.
     for (int k = 0; k < 3; ++k) {
-      if (n[k].ref < 0) n[k] = exact_bound(p[k], hint);
+      if (!n[k].exact) n[k] = exact_bound(p[k], hint);
       if (!(n[k].b <= e)) return false;
       hint = n[k].ref;
     }
@@ -843,12 +844,11 @@ bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth,
   if (depth >= kMaxCheckDepth) return false;
   const Vec3 m[3] = {(p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5, (p[2] + p[0]) * 0.5};
   Near nm[3];
-  // A midpoint farther than E from the original (its exact distance) is a
-  // point of the triangle no bound can prove: refused now rather than after
-  // cutting the parts around it down to the last depth.
   for (int k = 0; k < 3; ++k) {
-    nm[k] = exact_bound(m[k], n[k].ref);
-    if (!(nm[k].b <= e)) return false;
+    const Near& a = n[k];
+    const Near& c = n[(k + 1) % 3];
+    const Near& near = a.b <= c.b ? a : c;
+    nm[k] = {near.b + geom::length(p[(k + 1) % 3] - p[k]) * 0.5, near.ref, false};
   }
   const Vec3 c0[3] = {p[0], m[0], m[2]}, c1[3] = {m[0], p[1], m[1]}, c2[3] = {m[2], m[1], p[2]},
              c3[3] = {m[0], m[1], m[2]};
