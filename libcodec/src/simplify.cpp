@@ -93,16 +93,70 @@ constexpr uint32_t kMaxCheckDepth = 5;  // a new triangle is cut at most this ma
 // kLocked: the vertex never moves or goes; kKeep: it may move but never goes.
 constexpr uint8_t kLocked = 1, kBoundary = 2, kRemoved = 4, kKeep = 8;
 
+// An edge to try, 16 bytes (four to a cache line in the heap). `stamps`:
+// the sum of its ends' change counters when queued (each only grows, so
+// the sum is unchanged only when neither end changed).
 struct Candidate {
-  double cost;
+  float cost;
   uint32_t u, v;
-  uint32_t stamp_u, stamp_v;
-  // A min-heap, ties by the edge: the order depends only on the entries, not
-  // on how the heap was built (it is rebuilt without its stale entries).
-  bool operator<(const Candidate& o) const {
-    if (cost != o.cost) return cost > o.cost;
-    return u != o.u ? u > o.u : v > o.v;
+  uint32_t stamps;
+};
+
+// Cheaper first, ties by the edge: the order depends only on the entries,
+// not on how the heap was built (it is rebuilt without its stale entries).
+bool comes_before(const Candidate& a, const Candidate& b) {
+  if (a.cost != b.cost) return a.cost < b.cost;
+  return a.u != b.u ? a.u < b.u : a.v < b.v;
+}
+
+// A 4-ary min-heap: half the levels of a binary one, the children of a
+// node side by side.
+class CandidateHeap {
+ public:
+  bool empty() const { return a_.empty(); }
+  size_t size() const { return a_.size(); }
+  void push(const Candidate& c) {
+    size_t i = a_.size();
+    a_.push_back(c);
+    while (i > 0) {
+      const size_t parent = (i - 1) / 4;
+      if (!comes_before(c, a_[parent])) break;
+      a_[i] = a_[parent];
+      i = parent;
+    }
+    a_[i] = c;
   }
+  Candidate pop() {
+    const Candidate top = a_[0];
+    const Candidate last = a_.back();
+    a_.pop_back();
+    if (!a_.empty()) sift_down(0, last);
+    return top;
+  }
+  // Keeps the entries `keep` accepts, then restores the heap order.
+  template <typename Keep>
+  void filter(Keep keep) {
+    a_.erase(std::remove_if(a_.begin(), a_.end(), [&](const Candidate& c) { return !keep(c); }), a_.end());
+    for (size_t i = a_.size() / 4 + 1; i-- > 0;)
+      if (i < a_.size()) sift_down(i, a_[i]);
+  }
+
+ private:
+  void sift_down(size_t i, const Candidate c) {
+    const size_t n = a_.size();
+    for (;;) {
+      const size_t first = 4 * i + 1;
+      if (first >= n) break;
+      size_t best = first;
+      for (size_t k = first + 1; k < std::min(first + 4, n); ++k)
+        if (comes_before(a_[k], a_[best])) best = k;
+      if (!comes_before(a_[best], c)) break;
+      a_[i] = a_[best];
+      i = best;
+    }
+    a_[i] = c;
+  }
+  std::vector<Candidate> a_;
 };
 
 class Simplifier {
@@ -207,13 +261,10 @@ class Simplifier {
   // The candidates, a binary heap (std::push_heap order). Entries of edges
   // whose ends changed since are stale: skipped when they come up, and
   // dropped all at once when they outnumber the live edges.
-  std::vector<Candidate> heap_;
-  void push(const Candidate& c) {
-    heap_.push_back(c);
-    std::push_heap(heap_.begin(), heap_.end());
-  }
+  CandidateHeap heap_;
+  void push(const Candidate& c) { heap_.push(c); }
   bool stale(const Candidate& c) const {
-    return ((flags_[c.u] | flags_[c.v]) & kRemoved) || stamp_[c.u] != c.stamp_u || stamp_[c.v] != c.stamp_v;
+    return ((flags_[c.u] | flags_[c.v]) & kRemoved) || stamp_[c.u] + stamp_[c.v] != c.stamps;
   }
   void drop_stale();
 
@@ -482,7 +533,7 @@ bool Simplifier::candidate_for(uint32_t u, uint32_t v, Candidate& c) {
   double best = std::numeric_limits<double>::infinity();
   bool any = false;
   for (const Place& p : placements(u, v, q)) best = std::min(best, p.cost), any = true;
-  c = {std::max(best, 0.0), u, v, stamp_[u], stamp_[v]};
+  c = {static_cast<float>(std::max(best, 0.0)), u, v, stamp_[u] + stamp_[v]};
   return any;
 }
 
@@ -1114,8 +1165,7 @@ void Simplifier::write(Mesh& out) const {
 // The heap without its stale entries (a smaller heap: fewer cache misses on
 // every pop; the pop order, cost then edge, is the same).
 void Simplifier::drop_stale() {
-  heap_.erase(std::remove_if(heap_.begin(), heap_.end(), [&](const Candidate& c) { return stale(c); }), heap_.end());
-  std::make_heap(heap_.begin(), heap_.end());
+  heap_.filter([&](const Candidate& c) { return !stale(c); });
 }
 
 Status Simplifier::run(Mesh& out, SimplifyReport& report) {
@@ -1136,9 +1186,7 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
       drop_stale();
       pops_since_drop = 0;
     }
-    std::pop_heap(heap_.begin(), heap_.end());
-    const Candidate c = heap_.back();
-    heap_.pop_back();
+    const Candidate c = heap_.pop();
     if (stale(c)) continue;
     if (!try_collapse(c.u, c.v)) {
       ++rejected_;
