@@ -308,7 +308,9 @@ class Simplifier {
   std::vector<double> tri_err_;
   std::vector<uint32_t> ring_;        // the triangles around the edge tried, before the collapse
   std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
-  std::vector<uint32_t> orig_mark_;   // per original triangle: orig_mark_gen_ when in local_orig_
+  std::vector<uint8_t> local_tried_;  // per new_tris_ entry: small enough to be within E of one of them
+  double longest_orig_edge_ = 0;
+  std::vector<uint32_t> orig_mark_;  // per original triangle: orig_mark_gen_ when in local_orig_
   uint32_t orig_mark_gen_ = 0;
   bool near_local_original(uint32_t t, double& err);
   // Bounds of the points met in one try_collapse (corners and cut points
@@ -382,6 +384,9 @@ void Simplifier::build() {
   orig_mark_.assign(tri_.size(), 0);
   tri_pieces_.assign(tri_.size(), {});
   tri_mark_.assign(tri_.size(), 0);
+  for (size_t t = 0; t < orig_.size(); ++t)
+    longest_orig_edge_ =
+        std::max(longest_orig_edge_, longest_edge(orig_.corner(t, 0), orig_.corner(t, 1), orig_.corner(t, 2)));
   piece_delta_.assign(tri_.size(), 0.0);
   piece_orig_.resize(tri_.size());
   for (uint32_t t = 0; t < tri_.size(); ++t) {
@@ -934,19 +939,32 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
   }
   if (!bounded_) return true;
   // First the original triangles whose pieces the changed triangles hold:
-  // a new triangle within E of one of them needs no search.
+  // a new triangle within E of one of them needs no search. One longer than
+  // 2 E + the longest original edge cannot be (corners within E of one
+  // triangle are at most that far apart): not tried that way.
+  const double e = std::sqrt(e2_), reach = (2 * e + longest_orig_edge_) * (1 + 1e-9);
+  new_err_.resize(new_tris_.size());
+  local_tried_.assign(new_tris_.size(), 0);
+  bool any_local = false;
+  for (size_t i = 0; i < new_tris_.size(); ++i) {
+    const uint32_t t = new_tris_[i];
+    local_tried_[i] = longest_edge(new_corner(t, 0), new_corner(t, 1), new_corner(t, 2)) <= reach;
+    any_local = any_local || local_tried_[i];
+  }
   local_orig_.clear();
   ++orig_mark_gen_;
-  for (size_t i = 0; i < changed_.size() && local_orig_.size() < 64; ++i)
+  for (size_t i = 0; any_local && i < changed_.size() && local_orig_.size() < 64; ++i)
     for (uint32_t pi : tri_pieces_[changed_[i]]) {
       const uint32_t o = piece_orig_[pi];
-      if (orig_mark_[o] == orig_mark_gen_ || local_orig_.size() >= 64) continue;
+      if (orig_mark_[o] == orig_mark_gen_) continue;
+      if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
       local_orig_.push_back(o);
     }
-  new_err_.resize(new_tris_.size());
   for (size_t i = 0; i < new_tris_.size(); ++i)
-    if (!near_local_original(new_tris_[i], new_err_[i]) && !within_original(new_tris_[i], new_err_[i])) return false;
+    if (!(local_tried_[i] && near_local_original(new_tris_[i], new_err_[i])) &&
+        !within_original(new_tris_[i], new_err_[i]))
+      return false;
   return assign_pieces(changed_);
 }
 
