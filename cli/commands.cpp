@@ -691,7 +691,20 @@ FileResult info_one(const std::string& input) {
                    static_cast<ull>(values), a.coding.c_str(), a.bits, a.tables ? "true" : "false",
                    static_cast<ull>(a.coded_bytes), per_vertex(a.coded_bytes));
   }
-  r.json += "], \"metadata\": [";
+  if (!fi.batches.empty()) {
+    r.json += strf("], \"progressive\": {\"base_vertices\": %llu, \"base_faces\": %llu, \"base_error\": %.9g, "
+                   "\"loose_vertices\": %llu, \"loose_faces\": %llu, \"batches\": [",
+                   static_cast<ull>(fi.vertex_count), static_cast<ull>(fi.face_count), fi.base_error,
+                   static_cast<ull>(fi.loose_vertices), static_cast<ull>(fi.loose_faces));
+    for (size_t k = 0; k < fi.batches.size(); ++k) {
+      const FileInfo::Batch& b = fi.batches[k];
+      r.json += strf("%s{\"bytes\": %llu, \"vertices\": %llu, \"faces\": %llu, \"error\": %.9g}", k ? ", " : "",
+                     static_cast<ull>(b.bytes), static_cast<ull>(b.vertices), static_cast<ull>(b.faces), b.error);
+    }
+    r.json += "]}, \"metadata\": [";
+  } else {
+    r.json += "], \"metadata\": [";
+  }
   for (size_t k = 0; k < mesh.metadata.size(); ++k)
     r.json += strf("%s{\"key\": \"%s\", \"bytes\": %llu}", k ? ", " : "",
                    json_escape(mesh.metadata[k].key).c_str(), static_cast<ull>(mesh.metadata[k].value.size()));
@@ -771,6 +784,9 @@ FileResult info_one(const std::string& input) {
       t += strf("  %8zu %12s %12s %12s %12.6g\n", k, thousands(b.bytes).c_str(), thousands(b.vertices).c_str(),
                 thousands(b.faces).c_str(), b.error);
     }
+    if (fi.loose_vertices || fi.loose_faces)
+      t += strf("  after the last batch: %s vertices no face uses, %s triangles the levels leave out\n",
+                thousands(fi.loose_vertices).c_str(), thousands(fi.loose_faces).c_str());
   }
   t += strf("  %-18s %-6s %12s %12s", "section", "codec", "stored", "raw");
   for (const SectionInfo& si : fi.sections)

@@ -1315,6 +1315,10 @@ TEST_F(Cli, ProgressiveEncodePartialDecodeAndInfo) {
   Result r = tsm("info " + q("p.tsm"));
   EXPECT_EQ(r.code, 0);
   EXPECT_TRUE(tsm_test::contains(r.out, "refinement batches"));
+  Result j = tsm("info " + q("p.tsm") + " --json");
+  EXPECT_EQ(j.code, 0);
+  EXPECT_TRUE(tsm_test::contains(j.out, "\"progressive\": {\"base_vertices\": "));
+  EXPECT_TRUE(tsm_test::contains(j.out, "\"batches\": [{\"bytes\": "));
   const std::string bytes = slurp(file("p.tsm"));
   spit(file("cut.tsm"), bytes.substr(0, bytes.size() * 6 / 10));
   EXPECT_NE(tsm("decode " + q("cut.tsm") + " -o " + q("whole.ply")).code, 0);

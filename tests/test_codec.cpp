@@ -163,6 +163,28 @@ TEST(Codec, CanonicalWhenAShorterAxisNearlyReachesTheExtent) {
   EXPECT_EQ(checked, 36);
 }
 
+// A minimum of -0 (a position coordinate, a texture coordinate) decodes
+// as +0 (origin + 0 x step): the encoder takes +0 as the origin, so the
+// decoded mesh re-encodes to the same bytes.
+TEST(Codec, CanonicalWithNegativeZeroMinimum) {
+  Mesh m = tsm_test::icosphere(1);
+  for (size_t i = 0; i < m.positions.size(); ++i)
+    m.positions[i] = m.positions[i] <= 0 ? -0.0f : m.positions[i];  // every minimum a -0
+  tsm::Attribute uv;
+  uv.name = "texcoord";
+  uv.kind = tsm::AttributeKind::texcoord;
+  uv.components = 2;
+  for (size_t v = 0; v < m.vertex_count(); ++v)
+    uv.values.insert(uv.values.end(), {v % 3 ? 0.25f * static_cast<float>(v % 5) : -0.0f, 0.5f});
+  m.attributes = {uv};
+  for (int level : {0, 6}) {
+    const std::string bytes = encode_ok(m, 12, level);
+    Mesh back;
+    ASSERT_TRUE(tsm::decode(bytes, back).ok());
+    EXPECT_TRUE(encode_ok(back, 12, level) == bytes) << "level " << level;
+  }
+}
+
 TEST(Codec, RoundTripAwkwardCoordinates) {
   // Extents that are not exact in float, far from the origin, tiny and huge.
   std::vector<Named> cases;

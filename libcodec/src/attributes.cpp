@@ -1235,7 +1235,7 @@ std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const Attribute
         mx[c] = std::max(mx[c], a.values[i]);
       }
       for (uint32_t c = 0; c < a.components; ++c) {
-        h.origin[c] = mn[c];
+        h.origin[c] = mn[c] + 0.0f;  // a -0 minimum as +0, as it decodes (canonical re-encoding)
         h.extent = std::max(h.extent, static_cast<double>(mx[c]) - static_cast<double>(mn[c]));
       }
     }

@@ -1349,7 +1349,10 @@ Status encode_sections(const Mesh& mesh, const EncodeOptions& options_in, std::o
   h.quantization_bits = static_cast<uint8_t>(options.quantization_bits);
   h.level = static_cast<uint8_t>(options.level);
   BoundingBox box = options.lossless ? finite_box(mesh) : bounding_box(mesh);
-  for (int a = 0; a < 3; ++a) h.origin[a] = box.min[a];
+  // On a grid a -0 minimum decodes as +0 (origin + 0 x step): +0 as the
+  // origin, so a decoded mesh re-encodes to the same bytes (a lossless file
+  // keeps -0 itself).
+  for (int a = 0; a < 3; ++a) h.origin[a] = options.lossless ? box.min[a] : box.min[a] + 0.0f;
   h.extent = box.largest_extent();
   if (!std::isfinite(h.extent))
     return Status(ErrorCode::invalid_argument, "mesh extent overflows a float; scale the mesh down");

@@ -12,7 +12,9 @@ Grid Grid::for_mesh(const Mesh& mesh, int bits) {
   g.bits = bits;
   if (bits <= 0) return g;
   BoundingBox box = bounding_box(mesh);
-  for (int a = 0; a < 3; ++a) g.origin[a] = box.min[a];
+  // + 0.0 makes a -0 minimum +0: the decoder gives back +0 for it (origin
+  // + 0 x step), so a decoded file re-encodes to the same bytes.
+  for (int a = 0; a < 3; ++a) g.origin[a] = box.min[a] + 0.0;
   double extent = box.largest_extent();
   double cells = std::ldexp(1.0, bits) - 1.0;
   g.step = extent > 0 && std::isfinite(extent) ? extent / cells : 0.0;
