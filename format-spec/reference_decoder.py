@@ -1955,15 +1955,7 @@ def geometry_normals(faces, rank, q, bits, weights=0):
         k = len(f)
         if k < 3 or any(rank[c] == NONE for c in f):
             continue
-        p0 = q[rank[f[0]]]
-        nx = ny = nz = 0.0
-        for i in range(1, k - 1):
-            p1, p2 = q[rank[f[i]]], q[rank[f[i + 1]]]
-            a0, a1, a2 = float(p1[0] - p0[0]), float(p1[1] - p0[1]), float(p1[2] - p0[2])
-            b0, b1, b2 = float(p2[0] - p0[0]), float(p2[1] - p0[1]), float(p2[2] - p0[2])
-            nx += a1 * b2 - a2 * b1
-            ny += a2 * b0 - a0 * b2
-            nz += a0 * b1 - a1 * b0
+        nx, ny, nz = fan_vector(f, rank, q)
         length = math.sqrt((nx * nx + ny * ny) + nz * nz)
         for i, c in enumerate(f):
             w = 1.0

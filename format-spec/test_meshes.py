@@ -451,6 +451,19 @@ def uv_surfaces():
     return V, F, UV
 
 
+def write_normal_ply(path, V, N, F):
+    """An ascii PLY of positions V, vertex normals N and faces F."""
+    with open(path, 'w') as f:
+        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
+        f.write('property float x\nproperty float y\nproperty float z\n')
+        f.write('property float nx\nproperty float ny\nproperty float nz\n')
+        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
+        for (x, y, z), (a, b, c) in zip(V, N):
+            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
+        for fa in F:
+            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+
+
 def flat_ply(path):
     """A sphere and a box, flat-shaded as glTF has it: every face has vertices
     of its own carrying its normal (nx ny nz), plus a few slivers (r, r, o) on
@@ -484,15 +497,7 @@ def flat_ply(path):
         F.append([fa[0], fa[0], fa[1]])
     V.append(V[0])
     N.append((0.0, 0.0, 1.0))
-    with open(path, 'w') as f:
-        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
-        f.write('property float x\nproperty float y\nproperty float z\n')
-        f.write('property float nx\nproperty float ny\nproperty float nz\n')
-        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
-        for (x, y, z), (a, b, c) in zip(V, N):
-            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
-        for fa in F:
-            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+    write_normal_ply(path, V, N, F)
 
 
 def cad_part():
@@ -544,15 +549,7 @@ def cad_ply(path):
     normals and by the edges that link them, its normals predicted from the
     geometry with every stray class (§8.12)."""
     V, N, F = cad_part()
-    with open(path, 'w') as f:
-        f.write('ply\nformat ascii 1.0\nelement vertex %d\n' % len(V))
-        f.write('property float x\nproperty float y\nproperty float z\n')
-        f.write('property float nx\nproperty float ny\nproperty float nz\n')
-        f.write('element face %d\nproperty list uchar int vertex_indices\nend_header\n' % len(F))
-        for (x, y, z), (a, b, c) in zip(V, N):
-            f.write('%.6f %.6f %.6f %.6f %.6f %.6f\n' % (x, y, z, a, b, c))
-        for fa in F:
-            f.write('%d %s\n' % (len(fa), ' '.join(map(str, fa))))
+    write_normal_ply(path, V, N, F)
 
 
 def cad_obj(path):
