@@ -4,6 +4,7 @@
 // holds everything for web/test/bench.mjs.
 import { loadTsm } from '/dist/tsm.js';
 import { loadDraco } from './draco.js';
+import { dracoDecode } from './draco-decode.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
@@ -21,33 +22,6 @@ const result = (window.benchResult = { state: 'running', reps: REPS, throttle: T
 
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
 const fetchBytes = async (url) => new Uint8Array(await (await fetch(url)).arrayBuffer());
-
-// As three.js's DRACOLoader: decode, then positions and indices out through
-// the heap with one copy each.
-function dracoDecode(draco, bytes) {
-  const decoder = new draco.Decoder();
-  const mesh = new draco.Mesh();
-  try {
-    const status = decoder.DecodeArrayToMesh(bytes, bytes.byteLength, mesh);
-    if (!status.ok() || mesh.ptr === 0) throw new Error('draco: ' + status.error_msg());
-    const faces = mesh.num_faces(), points = mesh.num_points();
-    const nIdx = faces * 3;
-    let ptr = draco._malloc(nIdx * 4);
-    decoder.GetTrianglesUInt32Array(mesh, nIdx * 4, ptr);
-    const indices = new Uint32Array(draco.HEAPU32.buffer, ptr, nIdx).slice();
-    draco._free(ptr);
-    const attr = decoder.GetAttribute(mesh, decoder.GetAttributeId(mesh, draco.POSITION));
-    const n = points * 3;
-    ptr = draco._malloc(n * 4);
-    decoder.GetAttributeDataArrayForAllPoints(mesh, attr, draco.DT_FLOAT32, n * 4, ptr);
-    const positions = new Float32Array(draco.HEAPF32.buffer, ptr, n).slice();
-    draco._free(ptr);
-    return { positions, indices, vertexCount: points, faceCount: faces };
-  } finally {
-    draco.destroy(mesh);
-    draco.destroy(decoder);
-  }
-}
 
 function table(title, head, rows) {
   const h = document.createElement('h2');

@@ -7,6 +7,7 @@
 import { loadTsm } from '/dist/tsm.js';
 import { MeshoptDecoder } from '/meshopt/meshopt_decoder.mjs';
 import { loadDraco } from './draco.js';
+import { dracoDecode } from './draco-decode.js';
 
 const params = new URLSearchParams(location.search);
 const REPS = Number(params.get('reps') || 15);
@@ -61,33 +62,6 @@ function meshoptJobs(g) {
   });
 }
 
-// As three.js's DRACOLoader: decode, then indices and every listed attribute out through the heap, one copy each.
-function dracoDecode(draco, job) {
-  const decoder = new draco.Decoder();
-  const mesh = new draco.Mesh();
-  try {
-    const status = decoder.DecodeArrayToMesh(job.bytes, job.bytes.byteLength, mesh);
-    if (!status.ok() || mesh.ptr === 0) throw new Error('draco: ' + status.error_msg());
-    const n = mesh.num_faces() * 3;
-    let ptr = draco._malloc(n * 4);
-    decoder.GetTrianglesUInt32Array(mesh, n * 4, ptr);
-    const out = [new Uint32Array(draco.HEAPU32.buffer, ptr, n).slice()];
-    draco._free(ptr);
-    for (const id of job.ids) {
-      const attr = decoder.GetAttributeByUniqueId(mesh, id);
-      const k = mesh.num_points() * attr.num_components();
-      ptr = draco._malloc(k * 4);
-      decoder.GetAttributeDataArrayForAllPoints(mesh, attr, draco.DT_FLOAT32, k * 4, ptr);
-      out.push(new Float32Array(draco.HEAPF32.buffer, ptr, k).slice());
-      draco._free(ptr);
-    }
-    return { vertices: mesh.num_points(), triangles: n / 3 };
-  } finally {
-    draco.destroy(mesh);
-    draco.destroy(decoder);
-  }
-}
-
 function table(head, rows) {
   const t = document.createElement('table');
   t.innerHTML = '<tr>' + head.map((x) => `<th>${x}</th>`).join('') + '</tr>' +
@@ -102,7 +76,7 @@ async function main() {
   await MeshoptDecoder.ready;
   const codecs = {
     tsm: { jobs: tsmJobs, run: (j) => { const m = tsm.decode(j); return { vertices: m.vertexCount, triangles: m.faceCount }; } },
-    draco: { jobs: dracoJobs, run: (j) => dracoDecode(draco, j) },
+    draco: { jobs: dracoJobs, run: (j) => { const m = dracoDecode(draco, j.bytes, j.ids); return { vertices: m.vertexCount, triangles: m.faceCount }; } },
     meshopt: {
       jobs: meshoptJobs,
       run: (j) => {

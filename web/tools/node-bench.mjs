@@ -1,7 +1,7 @@
 // Decode times under Node (V8, the engine of Chromium): tsm's wasm decoder
 // (build/web) beside draco3d's, in one process, taking turns; the same calls
-// as web/demo/bench.js and gltf-bench.js (the decode and the copies of the
-// output arrays out of the heap), medians and the fastest sample (steadier
+// as web/demo/bench.js and gltf-bench.js (web/demo/draco-decode.js: the decode
+// and the copies of the output arrays out of the heap), medians and the fastest sample (steadier
 // on a loaded machine). Files: build/web/data/NAME.tsm and
 // .drc (web/prepare-data.sh) and the glTF bench's .glb files
 // (build/web/data/gltf-bench/, web/test/gltf-bench.mjs).
@@ -11,6 +11,7 @@ import path from 'node:path';
 import zlib from 'node:zlib';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 import { createRequire } from 'node:module';
+import { dracoDecode } from '../demo/draco-decode.js';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const root = path.resolve(here, '../..');
@@ -28,35 +29,6 @@ const tsm = await loadTsm({ wasmBinary: fs.readFileSync(path.join(dist, 'tsm_dec
 const draco = await DracoDecoderModule({ wasmBinary: fs.readFileSync(path.join(dracoDir, 'draco_decoder.wasm')) });
 
 const median = (a) => { const s = [...a].sort((x, y) => x - y); const n = s.length; return n % 2 ? s[n >> 1] : (s[n / 2 - 1] + s[n / 2]) / 2; };
-
-// As three.js's DRACOLoader (and web/demo/bench.js): decode, indices and every
-// listed attribute (all of them when none listed) out through the heap, one copy each.
-function dracoDecode(job) {
-  const decoder = new draco.Decoder();
-  const mesh = new draco.Mesh();
-  try {
-    const status = decoder.DecodeArrayToMesh(job.bytes, job.bytes.byteLength, mesh);
-    if (!status.ok() || mesh.ptr === 0) throw new Error('draco: ' + status.error_msg());
-    const n = mesh.num_faces() * 3;
-    let ptr = draco._malloc(n * 4);
-    decoder.GetTrianglesUInt32Array(mesh, n * 4, ptr);
-    new Uint32Array(draco.HEAPU32.buffer, ptr, n).slice();
-    draco._free(ptr);
-    const attrs = job.ids ? job.ids.map((id) => decoder.GetAttributeByUniqueId(mesh, id))
-      : [decoder.GetAttribute(mesh, decoder.GetAttributeId(mesh, draco.POSITION))];
-    for (const attr of attrs) {
-      const k = mesh.num_points() * attr.num_components();
-      ptr = draco._malloc(k * 4);
-      decoder.GetAttributeDataArrayForAllPoints(mesh, attr, draco.DT_FLOAT32, k * 4, ptr);
-      new Float32Array(draco.HEAPF32.buffer, ptr, k).slice();
-      draco._free(ptr);
-    }
-    return mesh.num_points();
-  } finally {
-    draco.destroy(mesh);
-    draco.destroy(decoder);
-  }
-}
 
 function readGlb(file) {
   const bytes = new Uint8Array(fs.readFileSync(file));
@@ -94,7 +66,7 @@ for (const c of cases) {
   // Each sample repeats the decode `inner` times (about 20 ms of tsm decoding) so small files time well.
   const time = (f, inner) => { const t0 = performance.now(); for (let i = 0; i < inner; ++i) f(); return (performance.now() - t0) / inner; };
   const decT = () => { for (const b of c.tsm) tsm.decode(b); };
-  const decD = () => { for (const j of c.draco) dracoDecode(j); };
+  const decD = () => { for (const j of c.draco) dracoDecode(draco, j.bytes, j.ids); };
   for (let i = 0; i < 3; ++i) { decT(); decD(); }
   const inner = Math.max(1, Math.ceil(20 / Math.max(0.01, time(decT, 1))));
   const ts = [], ds = [];
