@@ -22,7 +22,7 @@
 # Seeds are generated into build/fuzz/seeds/TARGET/ by fuzz_seeds (never
 # committed); inputs the fuzzer finds go to build/fuzz/corpus/TARGET/ and are
 # kept for the next run; full logs in build/fuzz/logs/. Runs at nice 19, one
-# target at a time, builds with -j1 (set FUZZ_JOBS to change that).
+# target at a time and builds with -j1 (FUZZ_JOBS=N: N targets at once, -jN).
 set -euo pipefail
 
 usage() { echo "usage: fuzz/run.sh SECONDS|--smoke [fuzz_decode|fuzz_read_mesh|fuzz_roundtrip|fuzz_gltf_transcode]..." >&2; exit 2; }
@@ -44,7 +44,7 @@ smoke_runs() {
     fuzz_gltf_transcode) echo 1000 ;;
   esac
 }
-all=(fuzz_decode fuzz_read_mesh fuzz_roundtrip fuzz_gltf_transcode)
+all=(fuzz_roundtrip fuzz_decode fuzz_read_mesh fuzz_gltf_transcode)  # longest first
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 for t in "${targets[@]}"; do
@@ -85,12 +85,12 @@ bin=build/asan/fuzz
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-failed=()
-for t in "${targets[@]}"; do
-  corpus=$build/corpus/$t
-  artifacts=$build/artifacts/$t
-  log=$build/logs/$t.log
-  extra=()
+# One target: its run, then its result lines in $build/logs/$t.result
+# (printed in the targets' order once all have run); returns non-zero on a
+# finding.
+run_target() {
+  local t=$1 corpus=$build/corpus/$1 artifacts=$build/artifacts/$1 log=$build/logs/$1.log
+  local extra=() start rc=0 took execs units artifact kind
   if [ "$smoke" = 1 ]; then
     corpus=$build/smoke-corpus/$t
     rm -rf "$corpus"
@@ -99,7 +99,6 @@ for t in "${targets[@]}"; do
   mkdir -p "$corpus" "$artifacts"
   [ -f "fuzz/$t.dict" ] && extra+=("-dict=fuzz/$t.dict")
   start=$(date +%s)
-  rc=0
   # -malloc_limit_mb: no input of a few kilobytes justifies a 512 MB block.
   nice -n 19 "$bin/$t" -max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -malloc_limit_mb=512 \
     -print_final_stats=1 -artifact_prefix="$artifacts/" "${extra[@]}" "$corpus" "$build/seeds/$t" \
@@ -107,18 +106,38 @@ for t in "${targets[@]}"; do
   took=$(($(date +%s) - start))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   if [ -z "$execs" ]; then  # a crash ends the run before the final stats
-    execs=$(grep -o '^#[0-9]*' "$log" | tail -n 1 | tr -d '#')
+    execs=$(grep -o '^#[0-9]*' "$log" | tail -n 1 | tr -d '#' || true)
   fi
   units=$(find "$corpus" -type f | wc -l)
   if [ "$rc" -eq 0 ]; then
-    echo "fuzz: $t: ok, ${execs:-?} executions in ${took} s, corpus $units inputs"
-  else
-    artifact=$(sed -n "s/.*Test unit written to \(.*\)$/\1/p" "$log" | tail -n 1)
-    kind=$(grep -m1 -oE 'ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|LeakSanitizer|libFuzzer): [a-z-]+[^ ]*|runtime error: .*' "$log" || true)
+    echo "fuzz: $t: ok, ${execs:-?} executions in ${took} s, corpus $units inputs" >"$build/logs/$t.result"
+    return 0
+  fi
+  artifact=$(sed -n "s/.*Test unit written to \(.*\)$/\1/p" "$log" | tail -n 1)
+  kind=$(grep -m1 -oE 'ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|LeakSanitizer|libFuzzer): [a-z-]+[^ ]*|runtime error: .*' "$log" || true)
+  {
     echo "fuzz: $t: FAILED (exit $rc) after ${execs:-?} executions in ${took} s: ${kind:-see the log}"
     echo "fuzz: $t: reproducer: ${artifact:-none written}   (rerun: $bin/$t ${artifact:-FILE})"
     echo "fuzz: $t: log: $log; its end:"
     tail -n 40 "$log" | sed 's/^/    /'
+  } >"$build/logs/$t.result"
+  return 1
+}
+
+# FUZZ_JOBS targets at a time (each libFuzzer run is one process on one core).
+for t in "${targets[@]}"; do
+  rm -f "$build/logs/$t.result"
+  while [ "$(jobs -rp | wc -l)" -ge "${FUZZ_JOBS:-1}" ]; do sleep 1; done
+  run_target "$t" &
+done
+wait
+failed=()
+for t in "${targets[@]}"; do
+  if [ -f "$build/logs/$t.result" ]; then
+    cat "$build/logs/$t.result"
+    grep -q "^fuzz: $t: ok," "$build/logs/$t.result" || failed+=("$t")
+  else
+    echo "fuzz: $t: FAILED: no result (log: $build/logs/$t.log)"
     failed+=("$t")
   fi
 done

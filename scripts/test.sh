@@ -12,16 +12,33 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-bash scripts/setup.sh
 jobs=$(nproc)
+# Each phase's wall time, printed at the end (CI's budget is ~20 minutes).
+start=$(date +%s)
+last=$start
+times=()
+phase() {
+  local now
+  now=$(date +%s)
+  [ -z "${current:-}" ] || times+=("$current: $((now - last)) s")
+  current=${1%% (*}
+  current=${current%%:*}
+  last=$now
+  [ "$1" = end ] || echo "== $1"
+}
+phase setup
+bash scripts/setup.sh
 for preset in release asan; do
-  echo "== $preset build"
+  phase "$preset build"
   cmake --preset "$preset" >/dev/null
   cmake --build --preset "$preset" -j "$jobs"
-  echo "== $preset tests"
+  phase "$preset tests"
   ctest --preset "$preset" -j "$jobs"
 done
-echo "== fuzz smoke run (fixed executions and seed per target)"
+phase "fuzz smoke run (fixed executions and seed per target, $jobs at a time)"
 FUZZ_JOBS=$jobs bash fuzz/run.sh --smoke
-echo "== browser test: the WebAssembly decoder in headless Chromium (web/test.sh; it says plainly when it skips, and fails instead in CI)"
+phase "browser test: the WebAssembly decoder in headless Chromium (web/test.sh; it says plainly when it skips, and fails instead in CI)"
 bash web/test.sh
+phase end
+echo "== all passed in $(($(date +%s) - start)) s:"
+printf '   %s\n' "${times[@]}"

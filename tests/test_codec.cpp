@@ -93,6 +93,7 @@ TEST(Codec, RoundTripEveryFamily) {
   for (const Named& n : families()) {
     for (int q : {1, 8, 14, 30}) {
       for (int level : {0, 9}) {
+        if (tsm_test::sanitized_skip(q == 1 || q == 14, level == 9)) continue;
         SCOPED_TRACE(std::string(n.name) + " q=" + std::to_string(q) + " level=" + std::to_string(level));
         std::string bytes;
         tsm::Status s = tsm::encode(n.mesh, tsm::EncodeOptions{q, level}, bytes);
@@ -288,7 +289,10 @@ TEST(Codec, EmptyAndPointSetOnly) {
 }
 
 TEST(Codec, Deterministic) {
-  for (const Named& n : families()) {
+  const std::vector<Named> all = families();
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (tsm_test::sanitized_skip(i, 0)) continue;
+    const Named& n = all[i];
     std::string a = encode_ok(n.mesh, 11, 9);
     Mesh copy = n.mesh;
     std::string b = encode_ok(copy, 11, 9);

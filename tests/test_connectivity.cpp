@@ -133,9 +133,12 @@ std::vector<std::pair<std::string, Mesh>> root_search_meshes(bool small) {
 // its rules tie and are left out.
 TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
   const std::vector<std::pair<std::string, Mesh>> meshes = root_search_meshes(false);
-  size_t smaller = 0;
-  for (const auto& [what, m] : meshes)
+  size_t smaller = 0, cases = 0;
+  for (size_t i = 0; i < meshes.size(); ++i)
     for (int q : {8, 12}) {
+      if (tsm_test::sanitized_skip(i, q == 12)) continue;
+      const auto& [what, m] = meshes[i];
+      ++cases;
       const std::string l6 = encode_at(m, q, 6), l7 = encode_at(m, q, 7), l9 = encode_at(m, q, 9);
       EXPECT_LE(l7.size(), l6.size()) << what << " q " << q;
       EXPECT_LE(l9.size(), l7.size()) << what << " q " << q;
@@ -149,8 +152,8 @@ TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
         EXPECT_TRUE(encode_at(back, q, level) == bytes) << what << " level " << level << ": re-encoding differs";
       }
     }
-  // The search finds something on most of them.
-  EXPECT_GE(smaller, 5u);
+  // The search finds something on at least half of them.
+  EXPECT_GE(2 * smaller, cases);
 }
 
 // A mesh of at most 1,024 faces coded whole gets level 9's root search from
@@ -158,9 +161,11 @@ TEST(Connectivity, RootsOfExtremePositionAtHighLevels) {
 // re-encodes to the same bytes. Not in segments (encode time).
 TEST(Connectivity, SmallPartsSearchRootsAtTheDefaultLevel) {
   const std::vector<std::pair<std::string, Mesh>> meshes = root_search_meshes(true);
-  for (const auto& [what, m] : meshes) {
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const auto& [what, m] = meshes[i];
     ASSERT_LE(m.face_count(), 1024u) << what;
     for (int q : {8, 12}) {
+      if (tsm_test::sanitized_skip(i, q == 12)) continue;
       const std::string l6 = encode_at(m, q, 6);
       // Levels 3-6 run the same geometry trials, and on these meshes level
       // 7-9's further trials find nothing: the same size (the header's level
@@ -473,10 +478,10 @@ TEST(Connectivity, CorpusRoundTrips) {
     expect_round_trip(m, entry.path().filename().string(), 14);
   }
   // The low-resolution dragons are non-manifold (split and stitched):
-  // re-encoding them is canonical too. The two largest scans only in the
-  // plain build (under the sanitizers they take minutes and add no new code).
-  std::vector<const char*> scans = {"bun_zipper.ply", "dragon_vrip_res4.ply"};
-  if (!tsm_test::kSanitized) scans.insert(scans.end(), {"dragon_vrip_res3.ply", "dragon_vrip_res2.ply"});
+  // re-encoding them is canonical too. The larger scans only in the plain
+  // build (under the sanitizers they take minutes and add no new code).
+  std::vector<const char*> scans = {"dragon_vrip_res4.ply"};
+  if (!tsm_test::kSanitized) scans.insert(scans.end(), {"bun_zipper.ply", "dragon_vrip_res3.ply", "dragon_vrip_res2.ply"});
   for (const char* name : scans) {
     Mesh m;
     ASSERT_TRUE(read_mesh(corpus_file(name), m).ok()) << name;

@@ -461,8 +461,10 @@ TEST(Geometry, StrayVerticesPredictedFromTheSurface) {
 TEST(Geometry, EveryLevelRoundTripsAndIsCanonical) {
   const Mesh meshes[] = {voxel_sphere(3, 0.05f), sphere_with_strays(2, 20), tsm_test::genus_surface(3),
                          tsm_test::grid_with_holes(9, 2)};
-  for (const Mesh& m : meshes)
+  for (size_t i = 0; i < std::size(meshes); ++i)
     for (int level : {0, 3, 6, 9}) {
+      if (tsm_test::sanitized_skip(i, static_cast<size_t>(level))) continue;
+      const Mesh& m = meshes[i];
       std::string bytes = encode(m, 12, level);
       expect_round_trip(m, bytes, 12, "level " + std::to_string(level));
     }

@@ -108,7 +108,9 @@ TEST(Segments, RoundTripOfEveryFamilyInSmallSegments) {
   // segment's coders map and poison their models afresh, which took minutes.
   const int small = tsm_test::kSanitized ? 2 : 3;
   expect_segmented_round_trip(icosphere(small), 7, "icosphere / 7");
-  for (int g = 1; g <= 5; ++g) expect_segmented_round_trip(genus_surface(g, 3), 100, "genus " + std::to_string(g));
+  for (int g = 1; g <= 5; ++g)
+    if (!tsm_test::sanitized_skip(static_cast<size_t>(g), 1))  // genus 1, 3, 5 there
+      expect_segmented_round_trip(genus_surface(g, 3), 100, "genus " + std::to_string(g));
   expect_segmented_round_trip(grid_with_holes(30, 12), 150, "grid with holes");
   expect_segmented_round_trip(fan(40, true), 5, "closed fan");
   expect_segmented_round_trip(strip(100), 16, "strip");

@@ -26,6 +26,13 @@ inline constexpr bool kSanitized = false;
 // build, a quarter under the sanitizers, which run about ten times slower and
 // look for memory errors that the first quarter reaches as well.
 inline constexpr int property_runs(int full) { return kSanitized ? (full + 3) / 4 : full; }
+// Sweeps over similar cases (meshes x levels x quantizations): every case in
+// the plain build; under the sanitizers the cases (a, b) with a + b even, a
+// checkerboard that still runs every mesh, level and quantization once.
+inline constexpr bool sanitized_skip(size_t a, size_t b) { return kSanitized && (a + b) % 2 == 1; }
+// The step of a sweep that damages every k-th byte: k in the plain build,
+// 4k under the sanitizers.
+inline constexpr size_t sweep_stride(size_t k) { return kSanitized ? 4 * k : k; }
 
 // ../shared/corpus beside the project (TSM_CORPUS env overrides it).
 inline std::string corpus_dir() {
