@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -31,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "mesh_gen.hpp"
@@ -732,6 +734,38 @@ TEST(GltfExtension, SharedStreamNamingOtherAccessorsIsRefused) {
             p["extensions"]["TSM_mesh_compression"]["attributes"]["_ID"];
   st = transcode(make_glb(c.doc, c.bin), false, false, out);
   EXPECT_TRUE(contains(st.message(), "does not fit")) << st.message();
+}
+
+// `tsm bench DIR` benches the glTF files in a folder and below it (as for
+// /usr/share/assimp/models/glTF2), and a document whose nodes form a cycle
+// (invalid glTF; Draco's reader, run in the bench's process, recursed on it
+// until the stack overflowed) is measured without taking the bench down.
+TEST(GltfExtension, BenchTakesAFolderOfAssets) {
+  const fs::path dir = fs::temp_directory_path() / ("tsm_gltf_bench_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "sub");
+  ASSERT_TRUE(tsm::write_mesh((dir / "sub" / "ball.glb").string(), tsm_test::icosphere(2)).ok());
+  {
+    std::ofstream(dir / "cycle.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+                                      << R"("nodes":[{"children":[1]},{"children":[0]}]})";
+  }
+  { std::ofstream(dir / "notes.txt") << "not a mesh"; }
+  const std::string cmd =
+      std::string("'") + TSM_CLI_PATH + "' bench '" + dir.string() + "' --runs 1 -q 8 --json --quiet 2>/dev/null";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string out;
+  char buf[4096];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  const int status = ::pclose(p);
+  ASSERT_TRUE(WIFEXITED(status)) << "the bench crashed: " << out;
+  const json doc = json::parse(out, nullptr, false);
+  ASSERT_TRUE(doc.is_object()) << out;
+  std::vector<std::string> names;
+  for (const json& row : doc["assets"]) names.push_back(row["asset"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"cycle.gltf", "ball.glb"})) << out;
+  ASSERT_EQ(doc["assets"].size(), 2u);
+  EXPECT_TRUE(doc["assets"][1]["tsm"]["ok"].get<bool>()) << out;
+  fs::remove_all(dir);
 }
 
 TEST(GltfExtension, ExternalFilesStayInTheFolder) {
