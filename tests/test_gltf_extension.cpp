@@ -734,6 +734,20 @@ TEST(GltfExtension, SharedStreamNamingOtherAccessorsIsRefused) {
             p["extensions"]["TSM_mesh_compression"]["attributes"]["_ID"];
   st = transcode(make_glb(c.doc, c.bin), false, false, out);
   EXPECT_TRUE(contains(st.message(), "does not fit")) << st.message();
+  // Random damage to the JSON and the streams: an answer every time, with a
+  // message when it is a refusal, never an internal error.
+  uint32_t rng = 12345;
+  auto next = [&rng] {
+    rng = rng * 1664525u + 1013904223u;
+    return rng >> 8;
+  };
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string damaged = packed;
+    for (int k = 0; k < 1 + trial % 4; ++k) damaged[20 + next() % (damaged.size() - 20)] = static_cast<char>(next());
+    st = transcode(damaged, false, false, out);
+    EXPECT_TRUE(st.ok() || !st.message().empty()) << trial;
+    EXPECT_NE(st.code(), tsm::ErrorCode::internal) << trial << ": " << st.message();
+  }
 }
 
 // `tsm bench DIR` benches the glTF files in a folder and below it (as for
