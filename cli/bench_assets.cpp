@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -197,6 +198,58 @@ const ojson& member(const ojson& o, const char* key) {
   const auto it = o.find(key);
   return it == o.end() ? none : *it;
 }
+
+bool gltf_has_node_cycle(const std::string& path) {
+  std::string text;
+  if (!is_gltf_path(path) || !slurp(path, text)) return false;
+  const std::string glb = glb_json(text);
+  const ojson doc = ojson::parse(glb.empty() ? text : glb, nullptr, false);
+  const ojson& nodes = member(doc, "nodes");
+  if (!nodes.is_array()) return false;
+  // Depth-first from every node, without recursion: 0 unseen, 1 on the path, 2 done.
+  std::vector<int> state(nodes.size(), 0);
+  for (size_t root = 0; root < nodes.size(); ++root) {
+    if (state[root] != 0) continue;
+    std::vector<std::pair<size_t, size_t>> path_stack = {{root, 0}};  // node, next child
+    state[root] = 1;
+    while (!path_stack.empty()) {
+      auto& [node, next] = path_stack.back();
+      const ojson& children = member(nodes[node], "children");
+      if (!children.is_array() || next >= children.size()) {
+        state[node] = 2;
+        path_stack.pop_back();
+        continue;
+      }
+      const ojson& c = children[next++];
+      if (!c.is_number_unsigned() || c.get<size_t>() >= nodes.size()) continue;
+      const size_t child = c.get<size_t>();
+      if (state[child] == 1) return true;
+      if (state[child] == 0) {
+        state[child] = 1;
+        path_stack.emplace_back(child, 0);
+      }
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> with_folders_expanded(const std::vector<std::string>& paths) {
+  std::vector<std::string> out;
+  for (const std::string& p : paths) {
+    std::error_code ec;
+    if (!fs::is_directory(p, ec)) {
+      out.push_back(p);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (const auto& e : fs::recursive_directory_iterator(p, ec))
+      if (e.is_regular_file() && is_gltf_path(e.path().string())) found.push_back(e.path().string());
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
+  }
+  return out;
+}
+
 
 size_t glb_geometry_bytes(const std::string& glb) {
   const ojson doc = ojson::parse(glb_json(glb), nullptr, false);

@@ -29,6 +29,16 @@ struct AssetRow {
 // A .glb or .gltf by its name.
 bool is_gltf_path(const std::string& path);
 
+// True for a .gltf / .glb whose nodes' children form a cycle (invalid
+// glTF, e.g. assimp-testmodels' RecursiveNodes.gltf): Draco's glTF reader,
+// run in this process, recurses on it until the stack overflows.
+bool gltf_has_node_cycle(const std::string& path);
+
+// The bench's inputs with each folder replaced by the .gltf / .glb files in
+// it and below it, sorted (a collection such as Debian's assimp-testmodels,
+// /usr/share/assimp/models/glTF2); files as they are.
+std::vector<std::string> with_folders_expanded(const std::vector<std::string>& paths);
+
 // Bytes of the buffer views a GLB's mesh primitives use: their accessors'
 // views, the views of TSM_mesh_compression and KHR_draco_mesh_compression,
 // and for views compressed with EXT/KHR_meshopt_compression the compressed

@@ -23,6 +23,9 @@ PACKAGES=(
   # EXT_meshopt_compression glTF input (libio); gltfpack makes meshopt glTF
   # for the transcoding tests and the glTF size table
   libdraco-dev draco gltfpack
+  # test data beyond the corpus (optional): real glTF, OBJ and other models
+  # for `tsm bench /usr/share/assimp/models/glTF2` (shared meshes, morph targets)
+  assimp-testmodels
   # comparison/oracles: CGAL's bounded-error Hausdorff distance checks `tsm
   # compare` and `tsm simplify` (tests/cgal, bench); meshoptimizer's simplifier
   # is the simplification benchmark's reference (header-only / optional)

@@ -679,6 +679,10 @@ TEST(GltfMalformed, BadReferencesAndRanges) {
   expect_error(with(R"("scene": 0)", R"("scene": 5)"), {"scene 5 is the default scene, but there are 1 scenes"});
   expect_error(with(R"("indices": 1}]})", R"("indices": 1, "mode": 9}]})"), {"unknown primitive mode 9"});
   expect_error(with(R"("version": "2.0")", R"("version": "1.0")"), {"only glTF 2.0 is read"});
+  // A primitives object where glTF has an array (assimp-testmodels' wrongTypes/badArray.gltf).
+  expect_error(with(R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1}])",
+                    R"("primitives": {"x": {"attributes": {"POSITION": 0}, "indices": 1}})"),
+               {"'meshes[0].primitives' is not an array"});
   expect_error(with(R"("byteLength": 48})", R"("byteLength": 48, "byteStride": 8})"), {"byteStride 8, less than the 12-byte element"});
   // Out-of-range vertex index: index 2 names vertex 9 of 4.
   {

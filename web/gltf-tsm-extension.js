@@ -2,7 +2,9 @@
 // whose vertex attributes and indices are one .tsm stream in a bufferView
 // (format-spec/gltf/TSM_mesh_compression.md): POSITION is the stream's
 // positions, each semantic of the extension's `attributes` the decoded
-// attribute of that number; vertex i of the stream is vertex i of the primitive.
+// attribute of that number, each of its `targets` a morph target's
+// displacements (grid units times `targetSteps`); vertex i of the stream is
+// vertex i of the primitive.
 //
 //   import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 //   import { GLTFTsmExtension } from '@tsm-codec/decoder/three';
@@ -89,6 +91,7 @@ export class GLTFTsmExtension {
       const attribute = toAttribute(values, components, type, vertexCount, accessor, semantic);
       cache.add(`accessor:${accessorIndex}`, Promise.resolve(attribute));
     }
+    this.primeTargets(primitive, ext, mesh, view);
     if (primitive.indices !== undefined) {
       const accessor = parser.json.accessors[checkIndex(primitive.indices, parser.json.accessors, 'accessor')];
       this.claim(primitive.indices, view);
@@ -100,6 +103,30 @@ export class GLTFTsmExtension {
       cache.add(`accessor:${primitive.indices}`, Promise.resolve(new BufferAttribute(
         Type === Uint32Array ? mesh.indices : Type.from(mesh.indices), 1)));
     }
+  }
+
+  // Morph targets in the stream (the extension's `targets`): each listed
+  // semantic's i32 grid units times its step in `targetSteps`, as floats.
+  primeTargets(primitive, ext, mesh, view) {
+    const parser = this.parser;
+    const vertexCount = mesh.positions.length / 3;
+    (ext.targets || []).forEach((map, t) => {
+      for (const [semantic, id] of Object.entries(map)) {
+        const name = `target ${t} ${semantic}`;
+        const accessorIndex = primitive.targets && primitive.targets[t] ? primitive.targets[t][semantic] : undefined;
+        if (accessorIndex === undefined) throw new Error(`${EXTENSION_NAME}: ${name} is compressed but the primitive has no such accessor`);
+        const step = ext.targetSteps ? ext.targetSteps[semantic] : undefined;
+        if (!(step > 0) || !Number.isFinite(step)) throw new Error(`${EXTENSION_NAME}: targetSteps.${semantic} is not a positive number`);
+        const accessor = parser.json.accessors[checkIndex(accessorIndex, parser.json.accessors, 'accessor')];
+        this.claim(accessorIndex, view);
+        const a = mesh.attributes[checkIndex(id, mesh.attributes, `stream attribute (${name})`)];
+        const units = perVertex(a, mesh.indices, vertexCount, name);
+        const values = new Float32Array(units.length);
+        for (let i = 0; i < units.length; ++i) values[i] = units[i] * step;
+        parser.cache.add(`accessor:${accessorIndex}`,
+          Promise.resolve(toAttribute(values, a.components, 'f32', vertexCount, accessor, name)));
+      }
+    });
   }
 
   // An accessor takes its values from one stream only.

@@ -2,7 +2,8 @@
 // document into ordinary accessors and buffer views, so the rest of the
 // transcoder sees a plain glTF. Handles
 //   - TSM_mesh_compression (format-spec/gltf/TSM_mesh_compression.md): the
-//     primitive's tsm stream decoded by the codec;
+//     primitive's tsm stream decoded by the codec, morph targets included; a
+//     stream several primitives name (with the same accessors) once;
 //   - KHR_draco_mesh_compression: the primitive's Draco stream decoded by
 //     Draco's decoder (Debian libdraco-dev, when the build found it);
 //   - EXT_meshopt_compression / KHR_meshopt_compression: compressed buffer
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -208,6 +210,50 @@ Status decode_meshopt(Document& doc) {
   return Status::Ok();
 }
 
+// The morph targets a stream holds (the extension's "targets" and
+// "targetSteps"): FLOAT VEC3 accessors, each the stream's i32 vertex
+// attribute times its semantic's step.
+Status decode_targets(Document& doc, const ojson& prim, const ojson& ext, const Mesh& mesh, const std::string& ew) {
+  if (!ext.contains("targets")) return Status::Ok();
+  const ojson& targets = ext["targets"];
+  const size_t have = prim.contains("targets") && prim["targets"].is_array() ? prim["targets"].size() : 0;
+  if (!targets.is_array() || targets.size() != have)
+    return doc.error(ew + ".targets is not an array of one object per morph target of the primitive (" +
+                     std::to_string(have) + ")");
+  if (!ext.contains("targetSteps") || !ext["targetSteps"].is_object())
+    return doc.error(ew + " has targets but no targetSteps object");
+  for (size_t t = 0; t < have; ++t) {
+    const std::string tw = ew + ".targets[" + std::to_string(t) + "]";
+    if (!targets[t].is_object()) return doc.error(tw + " is not an object");
+    for (auto it = targets[t].begin(); it != targets[t].end(); ++it) {
+      const std::string aw = tw + "." + it.key();
+      if (!it.value().is_number_unsigned() || it.value().get<uint64_t>() >= mesh.attributes.size())
+        return doc.error(aw + " is not an index below the stream's " + std::to_string(mesh.attributes.size()) +
+                         " attributes");
+      const Attribute& att = mesh.attributes[it.value().get<size_t>()];
+      const ojson& steps = ext["targetSteps"];
+      const double step = steps.contains(it.key()) && steps[it.key()].is_number() ? steps[it.key()].get<double>() : 0;
+      if (!(step > 0) || !std::isfinite(step))
+        return doc.error(ew + ".targetSteps." + it.key() + " is not a positive number");
+      int64_t acc = -1;
+      TSM_RETURN_IF_ERROR(doc.index_of(prim["targets"][t], it.key().c_str(), doc.count_of("accessors"),
+                                       "targets[" + std::to_string(t) + "]", acc));
+      if (acc < 0) return doc.error(aw + ": the primitive's morph target has no " + it.key());
+      int ct = 0;
+      uint32_t comps = 0;
+      TSM_RETURN_IF_ERROR(accessor_shape(doc, static_cast<size_t>(acc), ct, comps));
+      if (att.domain != AttributeDomain::vertex || att.type != AttributeType::i32 || att.components != comps ||
+          att.value_count() != mesh.vertex_count() || ct != kFloat)
+        return doc.error(aw + ": stream attribute '" + att.name + "' does not fit accessors[" + std::to_string(acc) +
+                         "] (an i32 vertex attribute of the accessor's components; a FLOAT accessor)");
+      std::vector<double> raw(att.values.size());
+      for (size_t i = 0; i < raw.size(); ++i) raw[i] = target_delta(att.values[i], step);
+      TSM_RETURN_IF_ERROR(fill_accessor(doc, static_cast<size_t>(acc), raw, comps, kArrayBuffer));
+    }
+  }
+  return Status::Ok();
+}
+
 // Writes a decoded tsm mesh into the primitive's accessors.
 Status decode_tsm(Document& doc, ojson& prim, const std::string& where) {
   const ojson& ext = prim["extensions"]["TSM_mesh_compression"];
@@ -249,14 +295,58 @@ Status decode_tsm(Document& doc, ojson& prim, const std::string& where) {
     TSM_RETURN_IF_ERROR(
         fill_accessor(doc, acc, std::vector<double>(att.values.begin(), att.values.end()), comps, kArrayBuffer));
   }
+  TSM_RETURN_IF_ERROR(decode_targets(doc, prim, ext, mesh, ew));
   // Accessors outside the stream must have the stream's vertex count.
-  for (auto it = prim["attributes"].begin(); it != prim["attributes"].end(); ++it) {
-    if (!it.value().is_number_unsigned() || it.value().get<uint64_t>() >= doc.count_of("accessors")) continue;
-    const ojson& a = doc.json["accessors"][it.value().get<size_t>()];
-    if (a.value("count", uint64_t(0)) != n)
-      return doc.error(where + ": accessor of " + it.key() + " has count " + std::to_string(a.value("count", 0)) +
-                       ", the tsm stream " + std::to_string(n) + " vertices");
+  std::vector<std::pair<std::string, const ojson*>> maps = {{"", &prim["attributes"]}};
+  if (prim.contains("targets") && prim["targets"].is_array())
+    for (size_t t = 0; t < prim["targets"].size(); ++t)
+      if (prim["targets"][t].is_object()) maps.emplace_back("targets[" + std::to_string(t) + "].", &prim["targets"][t]);
+  for (const auto& [prefix, map] : maps)
+    for (auto it = map->begin(); it != map->end(); ++it) {
+      if (!it.value().is_number_unsigned() || it.value().get<uint64_t>() >= doc.count_of("accessors")) continue;
+      const ojson& a = doc.json["accessors"][it.value().get<size_t>()];
+      if (a.value("count", uint64_t(0)) != n)
+        return doc.error(where + ": accessor of " + prefix + it.key() + " has count " +
+                         std::to_string(a.value("count", 0)) + ", the tsm stream " + std::to_string(n) + " vertices");
+    }
+  prim["extensions"].erase("TSM_mesh_compression");
+  if (prim["extensions"].empty()) prim.erase("extensions");
+  return Status::Ok();
+}
+
+// A stream already decoded for an earlier primitive: where, and what its
+// primitive named (sharing_key of the primitive and of the extension).
+struct SharedStream {
+  std::string where;
+  std::string key;
+};
+
+std::string stream_key(const ojson& prim) {
+  const ojson& ext = prim["extensions"]["TSM_mesh_compression"];
+  ojson e = ojson::object();
+  for (const char* k : {"attributes", "targets", "targetSteps"})
+    if (ext.is_object() && ext.contains(k)) e[k] = ext[k];
+  return sharing_key(prim) + nlohmann::json::parse(e.dump()).dump();
+}
+
+// Decodes the primitive's stream, or, when an earlier primitive named the
+// same buffer view, checks that it names the same accessors (they hold the
+// decoded data already) and refuses the file otherwise.
+Status decode_or_share(Document& doc, ojson& prim, const std::string& where, std::map<int64_t, SharedStream>& streams) {
+  const std::string ew = where + ".extensions.TSM_mesh_compression";
+  int64_t view = -1;
+  TSM_RETURN_IF_ERROR(
+      doc.index_of(prim["extensions"]["TSM_mesh_compression"], "bufferView", doc.count_of("bufferViews"), ew, view));
+  const std::string key = stream_key(prim);
+  const auto first = streams.find(view);
+  if (first == streams.end()) {
+    streams[view] = SharedStream{where, key};
+    return decode_tsm(doc, prim, where);
   }
+  if (first->second.key != key)
+    return doc.error(ew + ": bufferView " + std::to_string(view) + " is the stream of " + first->second.where +
+                     ", which names other accessors (a stream is shared only by primitives with the same indices, "
+                     "attributes and targets): the file is corrupt; re-encode it from its source");
   prim["extensions"].erase("TSM_mesh_compression");
   if (prim["extensions"].empty()) prim.erase("extensions");
   return Status::Ok();
@@ -311,6 +401,7 @@ void set_min_max(ojson& a, const std::vector<double>& raw, uint32_t components) 
 Status decompress_document(Document& doc) {
   TSM_RETURN_IF_ERROR(decode_meshopt(doc));
   bool draco = false, tsm = false;
+  std::map<int64_t, SharedStream> streams;
   for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
     ojson& mesh = doc.json["meshes"][m];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
@@ -321,7 +412,7 @@ Status decompress_document(Document& doc) {
       if (!prim.contains("attributes") || !prim["attributes"].is_object())
         return doc.error(where + " has no attributes object");
       if (prim["extensions"].contains("TSM_mesh_compression")) {
-        TSM_RETURN_IF_ERROR(decode_tsm(doc, prim, where));
+        TSM_RETURN_IF_ERROR(decode_or_share(doc, prim, where, streams));
         tsm = true;
       }
       if (prim.contains("extensions") && prim["extensions"].contains("KHR_draco_mesh_compression")) {

@@ -2,11 +2,14 @@
 // each triangle primitive of a plain glTF document becomes one tsm stream in
 // a buffer view. The encoder decodes its own stream and writes the
 // primitive's accessors from the decoded mesh (count, type, min / max; with
-// --fallback their data too), so that accessors and stream agree. Attributes
-// the stream does not hold exactly enough (float custom attributes, morph
-// targets) are written as ordinary accessors in the
-// decoded vertex order, which a second encoding with a vertex-number
-// attribute tells (checked to give the same mesh).
+// --fallback their data too), so that accessors and stream agree. Morph
+// targets' float POSITION / NORMAL / TANGENT displacements go into the stream
+// as integers on a power-of-two grid (zero stays exactly zero). Attributes
+// the stream does not hold exactly enough (float custom attributes) are
+// written as ordinary accessors in the decoded vertex order, which a second
+// encoding with a vertex-number attribute tells (checked to give the same
+// mesh). Primitives naming the same accessors (indices, attributes, targets)
+// share one stream and its accessors, as they shared the input's.
 // Also the top-level transcoder: load, decode compressed input, compress (or
 // not: tsm decode), embed or copy images, save.
 #include <algorithm>
@@ -15,6 +18,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +34,12 @@ namespace {
 constexpr int kPrimitiveTriangles = 4;
 // Vertex numbers travel as float values of an i32 attribute: exact below 2^24.
 constexpr size_t kMaxNumberedVertices = size_t(1) << 24;
+// The codec's limit on a stream's attributes (targets past it stay ordinary accessors).
+constexpr size_t kMaxStreamAttributes = 64;
+// A morph target's grid units: integers exact as floats (2^24), and steps
+// that keep units x step a normal float.
+constexpr double kMaxTargetUnits = 16777216.0;
+constexpr int kMinTargetStepExponent = -100;
 
 // One attribute (or morph target) of the primitive being compressed.
 struct Slot {
@@ -38,6 +48,7 @@ struct Slot {
   size_t accessor = 0;
   AccessorData data;
   int stream = -1;  // index in the stream's attributes; -1: an ordinary accessor
+  double step = 0;  // a morph target in the stream: its values are the stream's integers x step
   // The accessor the stream's values fill.
   int out_type = kFloat;
   bool out_normalized = false;
@@ -113,6 +124,36 @@ bool stream_attribute(const std::string& sem, const AccessorData& d, Attribute& 
   else if (!(sem == "TANGENT" && d.components == 4))
     return false;
   att.values = d.values();
+  return true;
+}
+
+// The grid of a morph target's displacements (TSM_mesh_compression.md,
+// "targets"): a power of two, so that units x step is exactly a float and a
+// zero displacement stays zero. POSITION: the largest power of two not above
+// the position grid's step (the precision of the positions); NORMAL and
+// TANGENT: 2^-normal bits. 0: the semantic stays an ordinary accessor.
+double target_step(const std::string& sem, const Mesh& mesh, const EncodeOptions& o) {
+  if (sem == "NORMAL" || sem == "TANGENT") return std::ldexp(1.0, -o.attribute_bits.normal);
+  if (sem != "POSITION" || o.lossless) return 0;
+  const double step = Grid::for_mesh(mesh, o.quantization_bits).step;
+  if (!(step > 0) || std::ilogb(step) < kMinTargetStepExponent) return 0;
+  return std::ldexp(1.0, std::ilogb(step));
+}
+
+// A float VEC3 morph target as a stream attribute: its values in grid units,
+// coded exactly (i32). False when it is not one or a value is off the range.
+bool stream_target(const Slot& s, double step, Attribute& att) {
+  if (!(step > 0) || s.data.component_type != kFloat || s.data.components != 3) return false;
+  att = Attribute();
+  att.name = s.semantic.substr(0, 1) + std::to_string(s.target);  // P0, N0, T0 (informative only)
+  att.type = AttributeType::i32;
+  att.components = 3;
+  att.values.resize(s.data.raw.size());
+  for (size_t i = 0; i < att.values.size(); ++i) {
+    const double units = std::nearbyint(s.data.raw[i] / step) + 0.0;  // -0 as 0
+    if (!(std::fabs(units) <= kMaxTargetUnits)) return false;
+    att.values[i] = static_cast<float>(units);
+  }
   return true;
 }
 
@@ -340,10 +381,20 @@ Status Compressor::primitive(ojson& prim, const std::string& where) {
   mesh.indices = idx;
   bool outside = false;
   for (Slot& s : slots) {
-    if (s.target >= 0) outside = true;
-    if (s.target >= 0 || s.semantic == "POSITION") continue;
+    if (s.target < 0 && s.semantic == "POSITION") continue;
     Attribute att;
-    if (stream_attribute(s.semantic, s.data, att, s.out_type, s.out_normalized)) {
+    if (s.target >= 0) {
+      s.step = target_step(s.semantic, mesh, options.encode);
+      if (mesh.attributes.size() < kMaxStreamAttributes && stream_target(s, s.step, att)) {
+        s.stream = static_cast<int>(mesh.attributes.size());
+        mesh.attributes.push_back(std::move(att));
+      } else {
+        outside = true;
+      }
+      continue;
+    }
+    if (mesh.attributes.size() < kMaxStreamAttributes &&
+        stream_attribute(s.semantic, s.data, att, s.out_type, s.out_normalized)) {
       s.stream = static_cast<int>(mesh.attributes.size());
       mesh.attributes.push_back(std::move(att));
     } else {
@@ -388,6 +439,9 @@ Status Compressor::write(ojson& prim, std::vector<Slot>& slots, const Mesh& deco
   write_accessor(doc, acc, ct, false, 1, std::vector<double>(decoded.indices.begin(), decoded.indices.end()), data,
                  false, kElementArrayBuffer);
   ojson ext_attributes = ojson::object();
+  ojson ext_targets = ojson::array(), steps = ojson::object();
+  if (prim.contains("targets") && prim["targets"].is_array())
+    for (size_t t = 0; t < prim["targets"].size(); ++t) ext_targets.push_back(ojson::object());
   for (Slot& s : slots) {
     ojson& holder = s.target < 0 ? prim["attributes"] : prim["targets"][static_cast<size_t>(s.target)];
     const bool had_min_max = doc.json["accessors"][s.accessor].contains("min") || s.semantic == "POSITION";
@@ -396,6 +450,13 @@ Status Compressor::write(ojson& prim, std::vector<Slot>& slots, const Mesh& deco
     if (s.semantic == "POSITION" && s.target < 0) {
       write_accessor(doc, acc, kFloat, false, 3,
                      std::vector<double>(decoded.positions.begin(), decoded.positions.end()), data, true, kArrayBuffer);
+    } else if (s.stream >= 0 && s.target >= 0) {
+      const Attribute& att = decoded.attributes[static_cast<size_t>(s.stream)];
+      std::vector<double> values(att.values.size());
+      for (size_t i = 0; i < values.size(); ++i) values[i] = target_delta(att.values[i], s.step);
+      write_accessor(doc, acc, kFloat, false, 3, values, data, had_min_max, kArrayBuffer);
+      ext_targets[static_cast<size_t>(s.target)][s.semantic] = s.stream;
+      steps[s.semantic] = s.step;
     } else if (s.stream >= 0) {
       const Attribute& att = decoded.attributes[static_cast<size_t>(s.stream)];
       write_accessor(doc, acc, s.out_type, s.out_normalized, s.data.components,
@@ -413,6 +474,10 @@ Status Compressor::write(ojson& prim, std::vector<Slot>& slots, const Mesh& deco
   ojson ext = ojson::object();
   ext["bufferView"] = add_buffer_view(doc, std::move(stream), 0, 0);
   ext["attributes"] = ext_attributes;
+  if (!steps.empty()) {
+    ext["targets"] = ext_targets;
+    ext["targetSteps"] = steps;
+  }
   if (!prim.contains("extensions") || !prim["extensions"].is_object()) prim["extensions"] = ojson::object();
   prim["extensions"]["TSM_mesh_compression"] = ext;
   return Status::Ok();
@@ -451,15 +516,89 @@ Status embed_images(Document& doc, GltfTranscodeReport& report) {
 
 }  // namespace
 
+std::string sharing_key(const ojson& prim) {
+  if (!prim.is_object()) return {};
+  nlohmann::json key = nlohmann::json::object();  // sorted members
+  for (const char* k : {"attributes", "indices", "targets"})
+    if (prim.contains(k)) key[k] = nlohmann::json::parse(prim[k].dump());
+  key["mode"] =
+      prim.contains("mode") ? nlohmann::json::parse(prim["mode"].dump()) : nlohmann::json(kPrimitiveTriangles);
+  return key.dump();
+}
+
+namespace {
+
+// The accessors a primitive names (attributes, indices, targets), each as
+// often as accessor_references counts it.
+std::vector<size_t> named_accessors(const ojson& prim) {
+  std::vector<size_t> out;
+  auto one = [&](const ojson& v) {
+    if (v.is_number_unsigned()) out.push_back(v.get<size_t>());
+  };
+  auto values = [&](const ojson& obj) {
+    if (obj.is_object())
+      for (const auto& kv : obj.items()) one(kv.value());
+  };
+  if (prim.contains("attributes")) values(prim["attributes"]);
+  if (prim.contains("indices")) one(prim["indices"]);
+  if (prim.contains("targets") && prim["targets"].is_array())
+    for (const ojson& t : prim["targets"]) values(t);
+  return out;
+}
+
+// Primitives repeating an earlier one's accessors will name the first one's
+// output: the references they add are taken off, so that the first one's
+// accessors count once for the whole group.
+void count_groups_once(Document& doc, std::vector<int>& refs) {
+  std::map<std::string, int> seen;
+  for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
+    const ojson& mesh = doc.json["meshes"][m];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (const ojson& prim : mesh["primitives"]) {
+      const std::string key = sharing_key(prim);
+      if (!key.empty() && seen[key]++ > 0)
+        for (size_t a : named_accessors(prim))
+          if (a < refs.size()) --refs[a];
+    }
+  }
+}
+
+// A primitive with the same accessors as `first` (already done): names
+// first's stream and accessors, or stays uncompressed as first did.
+void share_primitive(ojson& prim, const ojson& first, GltfTranscodeReport& report) {
+  if (!first.contains("extensions") || !first["extensions"].contains("TSM_mesh_compression")) {
+    ++report.primitives_kept;
+    return;
+  }
+  for (const char* k : {"attributes", "indices", "targets"})
+    if (first.contains(k)) prim[k] = first[k];
+  if (!prim.contains("extensions") || !prim["extensions"].is_object()) prim["extensions"] = ojson::object();
+  prim["extensions"]["TSM_mesh_compression"] = first["extensions"]["TSM_mesh_compression"];
+  ++report.primitives_compressed;
+  ++report.primitives_shared;
+}
+
+}  // namespace
+
 Status compress_document(Document& doc, const GltfTranscodeOptions& options, GltfTranscodeReport& report) {
   Compressor c{doc, options, report, accessor_references(doc), size_t(1) << 20};
   for (const std::string& b : doc.buffers) c.budget += 64 * b.size();
+  count_groups_once(doc, c.refs);
+  std::map<std::string, ojson> done;  // sharing key -> the first such primitive, as written
   for (size_t m = 0; m < doc.count_of("meshes"); ++m) {
     ojson& mesh = doc.json["meshes"][m];
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
-    for (size_t p = 0; p < mesh["primitives"].size(); ++p)
-      TSM_RETURN_IF_ERROR(c.primitive(mesh["primitives"][p],
-                                      "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]"));
+    for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+      ojson& prim = mesh["primitives"][p];
+      const std::string key = sharing_key(prim);
+      const auto first = done.find(key);
+      if (!key.empty() && first != done.end()) {
+        share_primitive(prim, first->second, report);
+        continue;
+      }
+      TSM_RETURN_IF_ERROR(c.primitive(prim, "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]"));
+      if (!key.empty()) done.emplace(key, prim);
+    }
   }
   if (report.primitives_compressed > 0) use_extension(doc.json, "TSM_mesh_compression", !options.fallback);
   return Status::Ok();

@@ -1516,9 +1516,9 @@ class GltfReader {
 
   // ----- pass-through: the document without the geometry -----
 
-  // The JSON array `key` of `doc`, which must have the `n` elements tinygltf
-  // read (absent when n is 0).
-  Status json_array(ojson& doc, const char* key, size_t n, ojson*& arr) const {
+  // The JSON array `key` of `doc` (`where` in messages, default `key`), which
+  // must have the `n` elements tinygltf read (absent when n is 0).
+  Status json_array(ojson& doc, const char* key, size_t n, ojson*& arr, const std::string& where = "") const {
     arr = nullptr;
     auto it = doc.find(key);
     if (it == doc.end()) {
@@ -1526,6 +1526,9 @@ class GltfReader {
     } else if (it->is_array() && it->size() == n) {
       arr = &*it;
       return Status::Ok();
+    } else if (!it->is_array()) {
+      return error("'" + (where.empty() ? std::string(key) : where) +
+                   "' is not an array, as glTF requires: fix the file or export it again");
     }
     return error(std::string("the JSON's '") + key + "' does not match what tinygltf read (" + std::to_string(n) +
                  " elements)");
@@ -1547,7 +1550,8 @@ class GltfReader {
     TSM_RETURN_IF_ERROR(json_array(doc, "meshes", model_.meshes.size(), meshes));
     for (size_t m = 0; m < model_.meshes.size(); ++m) {
       ojson* prims;
-      TSM_RETURN_IF_ERROR(json_array((*meshes)[m], "primitives", model_.meshes[m].primitives.size(), prims));
+      TSM_RETURN_IF_ERROR(json_array((*meshes)[m], "primitives", model_.meshes[m].primitives.size(), prims,
+                                     "meshes[" + std::to_string(m) + "].primitives"));
     }
 
     // Accessors something other than the primitives read uses keep their bytes.

@@ -24,8 +24,11 @@ struct GltfTranscodeOptions {
 
 struct GltfTranscodeReport {
   size_t primitives_compressed = 0;
-  size_t primitives_kept = 0;          // not triangles, or not compressible (see notes)
-  size_t vertices = 0, triangles = 0;  // of the compressed primitives
+  size_t primitives_kept = 0;  // not triangles, or not compressible (see notes)
+  // Of the compressed ones: primitives naming an earlier one's accessors,
+  // which name its stream (coded once) and its accessors.
+  size_t primitives_shared = 0;
+  size_t vertices = 0, triangles = 0;  // of the compressed primitives (a shared stream once)
   size_t stream_bytes = 0;             // sum of the tsm streams
   std::string notes;
   void add_note(const std::string& note) {
