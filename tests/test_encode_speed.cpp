@@ -5,7 +5,9 @@
 // find_anchors, whose scan for a few vertices off the surface must pick
 // the anchor its sorted cells pick; find_lattice, whose counted values must
 // give the planes sorted values give; the tangent step's samples, which a
-// coding pass without the step gathers as fit_betas' own pass would.
+// coding pass without the step gathers as fit_betas' own pass would; the
+// cut's order of components that share vertices, which a decoded mesh must
+// give again (one canonical round, not two).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -272,6 +274,62 @@ TEST(EncoderSpeed, TangentSamplesGatheredOnTheFirstPass) {
         ++sets;
       }
   EXPECT_EQ(sets, 8);
+}
+
+// A sphere with holes, and components that share vertices with it (no
+// edges: those pair by position) listed before it, so that in the input
+// their copies of the shared vertices come first: tetrahedra on one or two
+// sphere vertices and new ones, and double-sided triangles on three sphere
+// vertices only (every vertex an earlier component's). Coding the decoded
+// mesh must give back the same faces: the fixed point after one round.
+TEST(EncoderSpeed, SharedVertexComponentsSettleInOneRound) {
+  const tsm::Mesh sphere = tsm_test::icosphere(2);
+  tsm::Mesh m;
+  m.positions = sphere.positions;
+  const uint32_t nv = static_cast<uint32_t>(sphere.vertex_count());
+  auto add = [&](std::initializer_list<uint32_t> c) { m.add_face(std::data(c), c.size()); };
+  auto fresh = [&](float x) {
+    for (int a = 0; a < 3; ++a) m.positions.push_back(x + 0.1f * static_cast<float>(a));
+    return static_cast<uint32_t>(m.vertex_count() - 1);
+  };
+  // Sphere vertices far apart (no edge between any two of them).
+  const uint32_t far[] = {3, 17, 29, 40, 11, 36};
+  for (int k = 0; k < 3; ++k) {  // tetrahedra on sphere vertex far[k] (and far[k + 3] for k = 0)
+    const uint32_t a = far[k], b = fresh(2.0f + static_cast<float>(k)), c = fresh(3.0f + static_cast<float>(k)),
+                   d = k == 0 ? far[3] : fresh(4.0f + static_cast<float>(k));
+    add({a, b, c});
+    add({a, c, d});
+    add({a, d, b});
+    add({b, d, c});
+  }
+  add({far[4], far[5], far[1]});  // double-sided, on sphere vertices only
+  add({far[4], far[1], far[5]});
+  for (uint32_t f = 0; f < sphere.face_count(); ++f)
+    if (f % 9 != 4) m.add_face(sphere.face(f), 3);  // holes
+  for (uint32_t i = 0; i + 1 < 6; ++i)
+    for (uint32_t j = i + 1; j < 6; ++j)
+      for (uint32_t f = 0; f < sphere.face_count(); ++f) {
+        const uint32_t* c = sphere.face(f);
+        int hits = 0;
+        for (int e = 0; e < 3; ++e) hits += c[e] == far[i] || c[e] == far[j];
+        ASSERT_LT(hits, 2) << "sphere vertices " << far[i] << " and " << far[j] << " share an edge";
+      }
+  ASSERT_GT(m.vertex_count(), nv);
+  tsm::Mesh decoded[2];
+  const tsm::Mesh* coded = &m;
+  for (tsm::Mesh& d : decoded) {
+    tsm::ConnectivityEncoding ce;
+    ASSERT_TRUE(tsm::encode_connectivity(*coded, ce).ok());
+    EXPECT_GT(ce.stats.stitches, 0u);
+    tsm::GeometryLayout scratch;
+    ASSERT_TRUE(tsm::decode_connectivity(ce.streams, coded->vertex_count(), coded->face_count(), coded->corner_count(),
+                                         d, scratch)
+                    .ok());
+    d.positions.assign(m.positions.size(), 0.0f);
+    coded = &d;
+  }
+  EXPECT_EQ(decoded[1].indices, decoded[0].indices);
+  EXPECT_EQ(decoded[1].face_offsets, decoded[0].face_offsets);
 }
 
 }  // namespace
