@@ -3,10 +3,15 @@
 // the samples in order picks, whatever the samples (inside the log table,
 // across its end, far outside it, more than its sampling stride);
 // find_anchors, whose scan for a few vertices off the surface must pick
-// the anchor its sorted cells pick.
+// the anchor its sorted cells pick; find_lattice, whose counted values must
+// give the planes sorted values give; the tangent step's samples, which a
+// coding pass without the step gathers as fit_betas' own pass would; the
+// cut's order of components that share vertices, which a decoded mesh must
+// give again (one canonical round, not two).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -15,10 +20,15 @@
 
 #include "connectivity.hpp"
 #include "geometry_predict.hpp"
+#include "mesh_gen.hpp"
 
 namespace tsm {
 int32_t fit_alpha(const std::vector<std::pair<int64_t, int64_t>>& samples, bool wide);
-}
+void tangent_samples_both_ways(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                               const Lattice& lattice, const int32_t weights[3],
+                               std::array<std::vector<std::pair<int64_t, int64_t>>, 2>& own,
+                               std::array<std::vector<std::pair<int64_t, int64_t>>, 2>& gathered);
+}  // namespace tsm
 
 namespace {
 
@@ -167,6 +177,159 @@ TEST(EncoderSpeed, FindAnchorsPicksTheNearestWithinTwoCells) {
       checked += std::count_if(want.begin(), want.end(), [](uint32_t a) { return a != tsm::kNone; }) > 0;
     }
   EXPECT_EQ(checked, 15);
+}
+
+// find_lattice as first written: per axis the values sorted, counted by
+// runs, the planes those used at least median + 6 sqrt(median) + 4 times,
+// dropped when they hold under a third of the coordinates or number more
+// than one per eight vertices.
+tsm::Lattice plain_lattice(const std::vector<uint32_t>& q, uint32_t n) {
+  tsm::Lattice out;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<uint32_t> vals(n);
+    for (uint32_t v = 0; v < n; ++v) vals[v] = q[3 * size_t{v} + a];
+    std::sort(vals.begin(), vals.end());
+    std::vector<std::pair<uint32_t, uint32_t>> runs;
+    for (size_t i = 0, j; i < vals.size(); i = j) {
+      for (j = i; j < vals.size() && vals[j] == vals[i];) ++j;
+      runs.push_back({vals[i], static_cast<uint32_t>(j - i)});
+    }
+    if (runs.empty()) continue;
+    std::vector<uint32_t> counts;
+    for (auto [value, count] : runs) counts.push_back(count);
+    std::sort(counts.begin(), counts.end());
+    const double median = counts[counts.size() / 2];
+    size_t covered = 0;
+    for (auto [value, count] : runs)
+      if (count >= median + 6.0 * std::sqrt(median) + 4.0) out.values[a].push_back(value), covered += count;
+    if (3 * covered < n || 8 * out.values[a].size() > n) out.values[a].clear();
+  }
+  return out;
+}
+
+// Scan-like coordinates with a few planes that many vertices share, over
+// ranges below and above 8 values per vertex (find_lattice counts the
+// former in a table and sorts the latter).
+TEST(EncoderSpeed, FindLatticeCountsAsItSorts) {
+  std::mt19937_64 rng(372);
+  int with_planes = 0, cases = 0;
+  for (uint32_t n : {1u, 40u, 3000u})
+    for (uint32_t range : {4u, 1000u, 30000u, 1u << 22})
+      for (int planes : {0, 3, 20}) {
+        std::uniform_int_distribution<uint32_t> coord(0, range - 1), pick(0, 2);
+        std::vector<uint32_t> plane_at(static_cast<size_t>(planes));
+        for (uint32_t& x : plane_at) x = coord(rng);
+        std::vector<uint32_t> q(3 * size_t{n});
+        for (size_t i = 0; i < q.size(); ++i)
+          q[i] = planes && i % 3 != 1 && pick(rng) ? plane_at[coord(rng) % plane_at.size()] : coord(rng);
+        const tsm::Lattice got = tsm::find_lattice(q, n), want = plain_lattice(q, n);
+        for (int a = 0; a < 3; ++a) EXPECT_EQ(got.values[a], want.values[a]) << "n " << n << " range " << range;
+        with_planes += !want.values[0].empty();
+        ++cases;
+      }
+  EXPECT_EQ(cases, 36);
+  EXPECT_GE(with_planes, 4);
+}
+
+// The tangent step's samples on a jittered sphere with holes cut in it
+// and points off it (some with an anchor, tangent set 1): as gathered by
+// the first coding pass, and by fit_betas' own pass with the step on, for
+// the parallelogram and spread predictors, with and without planes.
+TEST(EncoderSpeed, TangentSamplesGatheredOnTheFirstPass) {
+  tsm::Mesh m = tsm_test::jittered(tsm_test::icosphere(4), 0.02f, 5);
+  // Holes: every 7th face dropped.
+  tsm::Mesh cut;
+  cut.positions = m.positions;
+  for (uint32_t f = 0; f < m.face_count(); ++f)
+    if (f % 7 != 3) cut.add_face(m.face(f), 3);
+  const uint32_t surface = static_cast<uint32_t>(cut.vertex_count());
+  for (uint32_t k = 0; k < 6; ++k)  // points off the surface, near vertex 11 k
+    for (int a = 0; a < 3; ++a) cut.positions.push_back(m.positions[3 * size_t{11 * k} + a] * 1.05f);
+  const int bits = 12;
+  std::vector<uint32_t> qin(cut.positions.size());
+  for (size_t i = 0; i < qin.size(); ++i)
+    qin[i] = static_cast<uint32_t>(std::lround((cut.positions[i] + 1.2) / 2.4 * ((1 << bits) - 1)));
+  tsm::ConnectivityEncoding ce;
+  ASSERT_TRUE(tsm::encode_connectivity(cut, ce).ok());
+  tsm::GeometryLayout& g = ce.layout;
+  std::vector<uint32_t> q(3 * size_t{g.vertex_count}), out_of(cut.vertex_count());
+  for (uint32_t v = 0; v < g.vertex_count; ++v) {
+    out_of[ce.vertex_order[v]] = v;
+    for (int a = 0; a < 3; ++a) q[3 * size_t{v} + a] = qin[3 * size_t{ce.vertex_order[v]} + a];
+  }
+  for (uint32_t k = 0; k < 6; k += 2) g.anchor[out_of[surface + k]] = out_of[11 * k];  // half of them anchored
+  tsm::Lattice planes;
+  planes.values[1] = {100, 2000, 4000};
+  const int32_t weights[2][3] = {{4096, 4096, 4096}, {2600, 3100, 2900}};
+  int sets = 0;
+  for (tsm::Predictor pred : {tsm::Predictor::parallelograms, tsm::Predictor::spread})
+    for (const tsm::Lattice& lattice : {tsm::Lattice(), planes})
+      for (const auto& w : weights) {
+        std::array<std::vector<std::pair<int64_t, int64_t>>, 2> own, gathered;
+        tsm::tangent_samples_both_ways(g, q, bits, pred, lattice, w, own, gathered);
+        EXPECT_EQ(own[0], gathered[0]);
+        EXPECT_EQ(own[1], gathered[1]);
+        EXPECT_GT(own[0].size(), 500u);
+        EXPECT_GE(own[1].size(), 1u);
+        ++sets;
+      }
+  EXPECT_EQ(sets, 8);
+}
+
+// A sphere with holes, and components that share vertices with it (no
+// edges: those pair by position) listed before it, so that in the input
+// their copies of the shared vertices come first: tetrahedra on one or two
+// sphere vertices and new ones, and double-sided triangles on three sphere
+// vertices only (every vertex an earlier component's). Coding the decoded
+// mesh must give back the same faces: the fixed point after one round.
+TEST(EncoderSpeed, SharedVertexComponentsSettleInOneRound) {
+  const tsm::Mesh sphere = tsm_test::icosphere(2);
+  tsm::Mesh m;
+  m.positions = sphere.positions;
+  const uint32_t nv = static_cast<uint32_t>(sphere.vertex_count());
+  auto add = [&](std::initializer_list<uint32_t> c) { m.add_face(std::data(c), c.size()); };
+  auto fresh = [&](float x) {
+    for (int a = 0; a < 3; ++a) m.positions.push_back(x + 0.1f * static_cast<float>(a));
+    return static_cast<uint32_t>(m.vertex_count() - 1);
+  };
+  // Sphere vertices far apart (no edge between any two of them).
+  const uint32_t far[] = {3, 17, 29, 40, 11, 36};
+  for (int k = 0; k < 3; ++k) {  // tetrahedra on sphere vertex far[k] (and far[k + 3] for k = 0)
+    const uint32_t a = far[k], b = fresh(2.0f + static_cast<float>(k)), c = fresh(3.0f + static_cast<float>(k)),
+                   d = k == 0 ? far[3] : fresh(4.0f + static_cast<float>(k));
+    add({a, b, c});
+    add({a, c, d});
+    add({a, d, b});
+    add({b, d, c});
+  }
+  add({far[4], far[5], far[1]});  // double-sided, on sphere vertices only
+  add({far[4], far[1], far[5]});
+  for (uint32_t f = 0; f < sphere.face_count(); ++f)
+    if (f % 9 != 4) m.add_face(sphere.face(f), 3);  // holes
+  for (uint32_t i = 0; i + 1 < 6; ++i)
+    for (uint32_t j = i + 1; j < 6; ++j)
+      for (uint32_t f = 0; f < sphere.face_count(); ++f) {
+        const uint32_t* c = sphere.face(f);
+        int hits = 0;
+        for (int e = 0; e < 3; ++e) hits += c[e] == far[i] || c[e] == far[j];
+        ASSERT_LT(hits, 2) << "sphere vertices " << far[i] << " and " << far[j] << " share an edge";
+      }
+  ASSERT_GT(m.vertex_count(), nv);
+  tsm::Mesh decoded[2];
+  const tsm::Mesh* coded = &m;
+  for (tsm::Mesh& d : decoded) {
+    tsm::ConnectivityEncoding ce;
+    ASSERT_TRUE(tsm::encode_connectivity(*coded, ce).ok());
+    EXPECT_GT(ce.stats.stitches, 0u);
+    tsm::GeometryLayout scratch;
+    ASSERT_TRUE(tsm::decode_connectivity(ce.streams, coded->vertex_count(), coded->face_count(), coded->corner_count(),
+                                         d, scratch)
+                    .ok());
+    d.positions.assign(m.positions.size(), 0.0f);
+    coded = &d;
+  }
+  EXPECT_EQ(decoded[1].indices, decoded[0].indices);
+  EXPECT_EQ(decoded[1].face_offsets, decoded[0].face_offsets);
 }
 
 }  // namespace

@@ -253,8 +253,10 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 // stitched back: there the decoded order lets the cut find another copy of
 // a split vertex first. So a part with stitches is coded as its decoded
 // self would be: decode the streams, code that mesh, and repeat until
-// decoding gives back the faces coded, corner for corner (the corpus's
-// stitched meshes reach it after at most one round, the dragons included).
+// decoding gives back the faces coded, corner for corner (the cut orders
+// components that share vertices as the decoder numbers them, so the
+// decoded mesh usually is that point: dragon res2 after one round, res3 and
+// res4 after two, where edges of four uses pair otherwise).
 // At that point output vertex v may simply be the coded mesh's vertex v,
 // whatever order the coder chose: the decoded faces name the same ids at
 // the same corners. That matters for a symmetric mesh (the Moebius strip),
@@ -268,7 +270,7 @@ Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, con
 // Others settle only after many rounds (a random tangle of 325 faces on 16
 // vertices: 20), and a part cut off before it settles re-encodes to other
 // bytes. So small parts get up to 256 rounds, larger ones as many as 2^20
-// faces' coding allows, at least 16 (the corpus's stitched meshes: 1).
+// faces' coding allows, at least 16 (the corpus's stitched meshes: 1-2).
 int canonical_rounds(size_t faces) {
   return static_cast<int>(std::clamp<size_t>((size_t{1} << 20) / (faces + 1), 16, 256));
 }

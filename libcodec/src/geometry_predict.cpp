@@ -311,6 +311,10 @@ struct Coder {
   std::vector<std::pair<int64_t, int64_t>> tan_samples[2];  // encoder's fit: (correction at weight 1, x - p)
   bool collect = false;
   std::vector<std::pair<int64_t, int64_t>> samples[3];  // encoder's fit: (P - N, x - N) per coordinate
+  // Encoder: a coding pass without the tangent step also gathers the
+  // tangent samples (tan_samples) that a collect pass with it would, for
+  // fit_betas (tangent_sample below).
+  bool tangent_samples = false;
   std::vector<uint32_t> nearest[3];  // per axis, per grid value: nearest plane (when qmax < 2^18)
 
   // Nearest plane to a grid value (the lower one on a tie).
@@ -351,6 +355,25 @@ struct Coder {
   bool plain() const {
     return !tangent && !mix && !spread_ctx && lattice.values[0].empty() && lattice.values[1].empty() &&
            lattice.values[2].empty();
+  }
+  // Encoder, after vertex v is coded without the tangent step: the sample
+  // vertex() collects with the tangent step on the axis nearest `normal`
+  // (null: none), from the same prediction and coordinates (the sample
+  // reads neither the residual contexts, the lattice nor the weight beta).
+  void tangent_sample(const std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], const int64_t* normal,
+                      int tan_set) {
+    if (!normal) return;
+    int kn = 0;
+    for (int a = 1; a < 3; ++a)
+      if (std::abs(normal[a]) > std::abs(normal[kn])) kn = a;
+    if (normal[kn] == 0) return;
+    const int o0 = kn == 0 ? 1 : 0, o1 = kn == 2 ? 1 : 2;
+    int64_t res[3];
+    for (int a = 0; a < 3; ++a)
+      res[a] = int64_t{q[3 * static_cast<size_t>(v) + a]} - std::clamp<int64_t>(pred[a], 0, qmax);
+    const int64_t sgn = normal[kn] < 0 ? -1 : 1;
+    const int64_t num = -sgn * (normal[o0] * res[o0] + normal[o1] * res[o1]);
+    tan_samples[tan_set].push_back({div_round(num, sgn * normal[kn]), res[kn]});
   }
   template <bool kPlain = false, bool kLattice = true, class Sink>
   bool vertex(Sink& s, std::vector<uint32_t>& q, uint32_t v, const int64_t pred[3], int cls, int activity,
@@ -665,14 +688,24 @@ struct SurfaceCoder {
         for (int a = 0; a < 3; ++a) c.samples[cls - 2].push_back({d[a], static_cast<int64_t>(at(v)[a]) - n[a]});
     const int64_t* normal = nullptr;
     NormalSum ns;
-    if (!kPlain && c.tangent && npara > 0) {
+    auto find_normal = [&] {
       if (npair <= kPairs) {
         for (int i = 0; i < npair; ++i) ns.add(at(pu[i]), at(pw[i]), pred);
       } else {  // a wide fan: walk it again
         walk([&](uint32_t h) { add_normal_triangle(ns, h, pred); });
       }
-      normal = ns.finish();
-    }
+      return ns.finish();
+    };
+    if (!kPlain && c.tangent && npara > 0) normal = find_normal();
+    if constexpr (Sink::kEncoder)
+      if (c.tangent_samples && !c.tangent && npara > 0) {  // (the tangent step off: normal is null)
+        const int64_t* sample_normal = find_normal();  // (before v is decoded, as on a pass with the step)
+        if (!point<kPlain>(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
+                           !kPlain && c.spread_ctx && npara >= 2 ? spread : nullptr))
+          return false;
+        c.tangent_sample(q, v, pred, sample_normal, 0);
+        return true;
+      }
     return point<kPlain>(v, pred, cls, nnb ? (actsum + nnb / 2) / nnb : last_act,
                          !kPlain && c.spread_ctx && npara >= 2 ? spread : nullptr, normal);
   }
@@ -710,12 +743,16 @@ struct SurfaceCoder {
       // The tangent step about the anchor's first fan (every corner but
       // virtual ones is decoded by now).
       NormalSum ns;
-      if (c.tangent && anchor != kNone) {
+      bool sample = false;
+      if constexpr (Sink::kEncoder) sample = c.tangent_samples && !c.tangent;
+      if ((c.tangent || sample) && anchor != kNone) {
         const uint32_t h0 = first_half_edges()[anchor];  // kNone: an anchor on no triangle (only in a forged file)
         if (h0 != kNone)
           fan(h0, [&](uint32_t h) { add_normal_triangle(ns, h, pred); });
       }
-      if (!point(v, pred, 0, last_act, nullptr, ns.finish(), 1)) return false;
+      const int64_t* normal = ns.finish();
+      if (!point(v, pred, 0, last_act, nullptr, sample ? nullptr : normal, 1)) return false;
+      if (sample) c.tangent_sample(q, v, pred, normal, 1);
       if ((v & 4095) == 0 && s.truncated()) return false;
     }
     return true;
@@ -1587,10 +1624,18 @@ bool covers(const Lattice& lattice, const std::vector<uint32_t>& q, uint32_t ver
   return true;
 }
 
-// encode_geometry_as with the greedy order shared between passes (null: found on each).
+// fit_betas' samples (Coder::tan_samples) as a coding pass without the
+// tangent step gathers them.
+using TangentSamples = std::array<std::vector<std::pair<int64_t, int64_t>>, 2>;
+
+// encode_geometry_as with the greedy order shared between passes (null:
+// found on each). tangent_out: where a pass of a surface predictor without
+// the tangent step leaves the samples fit_betas would collect for its
+// predictor and weights (null: none gathered).
 std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
                                  int K, const Lattice& lattice, const int32_t* weights, const int32_t* tangent,
-                                 bool mix, bool top, bool tables, GreedyOrder* order) {
+                                 bool mix, bool top, bool tables, GreedyOrder* order,
+                                 TangentSamples* tangent_out = nullptr) {
   if (pred == Predictor::raw) {
     const bool all_on = covers(lattice, q, g.vertex_count);
     return encode_geometry_raw(g, q, bits, all_on ? lattice : Lattice(), top && all_on);
@@ -1636,6 +1681,7 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
     c.planes_from_top = top;
     code_lattice(s, c);
     c.build_nearest();
+    c.tangent_samples = tangent_out && !tangent && surface_predictor(pred);
     std::vector<uint32_t> own;
     std::vector<uint32_t>& work = order ? order->work(q) : (own = q);
     if (pred == Predictor::ancestors)
@@ -1644,6 +1690,8 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
       code_greedy(g, c, s, work, order);
     else
       code_march_order(g, pred == Predictor::fan, c, s, work);
+    if (c.tangent_samples)
+      for (int i = 0; i < 2; ++i) (*tangent_out)[i] = std::move(c.tan_samples[i]);
   };
   if (!tables) {
     EncodeSink s;
@@ -1665,6 +1713,28 @@ std::string encode_geometry_with(const GeometryLayout& g, const std::vector<uint
     tail.bytes(part);
   }
   return head + s.e.finish();
+}
+
+// Tests (test_encode_speed.cpp): fit_betas' samples for a greedy
+// predictor `pred` with the given weights and lattice, from its own pass
+// (`own`), and as the first coding pass of encode_geometry gathers them
+// (`gathered`: the parallelogram predictor, no lattice, after a pass that
+// keeps the walks).
+void tangent_samples_both_ways(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred,
+                               const Lattice& lattice, const int32_t weights[3], TangentSamples& own,
+                               TangentSamples& gathered) {
+  Coder fit(g.vertex_count, bits, false);
+  fit.tangent = true;
+  fit.lattice = lattice;
+  fit.build_nearest();
+  std::copy(weights, weights + 3, fit.alpha);
+  collect_pass(g, q, pred, fit, nullptr);
+  for (int i = 0; i < 2; ++i) own[i] = fit.tan_samples[i];
+  GreedyOrder order;
+  int32_t lsq[3], est[3];
+  fit_alphas(g, q, bits, Predictor::parallelograms, lsq, est, &order);
+  encode_geometry_with(g, q, bits, Predictor::parallelograms, 0, Lattice(), weights, nullptr, false, false, true,
+                       &order, &gathered);
 }
 
 std::string encode_geometry_as(const GeometryLayout& g, const std::vector<uint32_t>& q, int bits, Predictor pred, int K,
@@ -1773,16 +1843,25 @@ std::vector<uint32_t> find_anchors(const GeometryLayout& g, const std::vector<ui
 Lattice find_lattice(const std::vector<uint32_t>& q, uint32_t n) {
   Lattice out;
   std::vector<uint32_t> vals(n), counts;
-  std::vector<std::pair<uint32_t, uint32_t>> runs;  // value, count
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // value, count, by value
   for (int a = 0; a < 3; ++a) {
-    for (uint32_t v = 0; v < n; ++v) vals[v] = q[3 * static_cast<size_t>(v) + a];
-    std::sort(vals.begin(), vals.end());
+    uint32_t top = 0;
+    for (uint32_t v = 0; v < n; ++v) top = std::max(top, vals[v] = q[3 * static_cast<size_t>(v) + a]);
     runs.clear();
-    for (size_t i = 0; i < vals.size();) {
-      size_t j = i;
-      while (j < vals.size() && vals[j] == vals[i]) ++j;
-      runs.push_back({vals[i], static_cast<uint32_t>(j - i)});
-      i = j;
+    if (n > 0 && top / 8 < n) {
+      // Values below 8 per vertex: counted in a table, not sorted.
+      counts.assign(size_t{top} + 1, 0);
+      for (uint32_t x : vals) ++counts[x];
+      for (uint32_t x = 0; x <= top; ++x)
+        if (counts[x]) runs.push_back({x, counts[x]});
+    } else {
+      std::sort(vals.begin(), vals.end());
+      for (size_t i = 0; i < vals.size();) {
+        size_t j = i;
+        while (j < vals.size() && vals[j] == vals[i]) ++j;
+        runs.push_back({vals[i], static_cast<uint32_t>(j - i)});
+        i = j;
+      }
     }
     if (runs.empty()) continue;
     counts.resize(runs.size());
@@ -1819,15 +1898,23 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   int32_t lsq[3], est[3];
   fit_alphas(g, q, bits, st.predictor, lsq, est, &order);
   const int32_t* weights = est;
-  std::string best =
-      encode_geometry_with(g, q, bits, st.predictor, 0, st.lattice, est, nullptr, false, false, tables, &order);
+  // At levels 3 and up the first pass also gathers the tangent step's
+  // samples, which hold for the spread predictor and any lattice too (the
+  // same prediction in the same order): the step's weights are fitted on
+  // them (also when the least-squares weights win, which predict nearly
+  // alike) and need no pass of their own.
+  TangentSamples est_samples;
+  TangentSamples* const gather_est = level >= 3 ? &est_samples : nullptr;
+  std::string best = encode_geometry_with(g, q, bits, st.predictor, 0, st.lattice, est, nullptr, false, false, tables,
+                                          &order, gather_est);
   // `lattice` may be st.lattice itself (the assignment below is then a
   // self-assignment, which std::vector handles).
   int32_t beta[2];
   auto consider = [&](Predictor pred, int K, const Lattice& lattice, const int32_t* w, const int32_t* tan = nullptr,
-                      bool mixed = false) {
+                      bool mixed = false, TangentSamples* tangent_out = nullptr) {
     const bool top = top_pays(lattice, bits, g.vertex_count);
-    std::string alt = encode_geometry_with(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables, &order);
+    std::string alt =
+        encode_geometry_with(g, q, bits, pred, K, lattice, w, tan, mixed, top, tables, &order, tangent_out);
     if (alt.size() >= best.size()) return false;
     best.swap(alt);
     st.predictor = pred;
@@ -1874,9 +1961,12 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   if (level >= 3) consider(Predictor::spread, 0, st.lattice, weights);
   // Averaging every parallelogram loses where some of them are poor (across
   // the rows of a latitude-longitude grid, say): the gate's alone, in march
-  // order, with its own weights.
+  // order, with its own weights. Tried where the search is adaptive (the
+  // mixing levels, small meshes): on larger meshes it won on none of the
+  // corpus's scans and assets (5-10% larger than the surface predictors)
+  // and costs a pass of its own for the weights.
   int32_t gate_lsq[3], gate_est[3];
-  if (level >= 3) {
+  if (level >= 3 && adaptive_search) {
     fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est, &order);
     consider(Predictor::gate, 0, st.lattice, gate_est);
   }
@@ -1907,7 +1997,10 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   }
   // The tangent step on whatever surface predictor won.
   if (level >= 3 && surface_predictor(st.predictor)) {
-    fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta, &order);
+    if (greedy_order(st.predictor) && weights)
+      for (int i = 0; i < 2; ++i) beta[i] = est_samples[i].empty() ? 0 : fit_alpha(est_samples[i]);
+    else
+      fit_betas(g, q, bits, st.predictor, st.lattice, weights, beta, &order);
     consider(st.predictor, 0, st.lattice, weights, beta);
   }
   // Residual mixing on whatever won: smaller, slower to decode.

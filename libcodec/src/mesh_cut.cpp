@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <memory>
 #include <numeric>
+#include <queue>
 
 #include "connectivity.hpp"
 
@@ -76,6 +77,92 @@ void root_by_position(CutMesh& m, const std::vector<uint8_t>& on_triangle, const
     m.component_root[c] = root[c].best;
     if (root[c].tie) m.root_tie = true;
   }
+}
+
+// Orders the components with triangles (the first `count`, numbered by
+// smallest vertex id, each rooted there) as the decoder numbers their
+// vertices: next the component holding the smallest input vertex that no
+// component before it has, rooted there; then those whose every vertex an
+// earlier one has, by smallest id as before. A vertex split across
+// components keeps its id in the first of them (its copy of smallest id
+// there; the ids are swapped when another copy had it). The decoder gives
+// a vertex's id to its first copy in tree order, and a decoded mesh's cut to
+// its first copy in face order, so in a decoded mesh both are the copy in
+// the first component: it orders and roots its components alike, and its
+// roots' reference edges (to the neighbour of smallest id) are the same,
+// so re-encoding it codes the same streams after one round (design notes
+// §5). Components sharing no vertex keep their order, roots and ids.
+void order_components(CutMesh& m, uint32_t count, uint32_t input_vertex_count) {
+  if (count < 2) return;
+  std::vector<uint32_t> start(size_t{count} + 1, 0), member;
+  for (uint32_t v = 0; v < m.vertex_count; ++v)
+    if (m.kind[v] != VertexKind::virtual_ && m.vertex_component[v] < count) ++start[m.vertex_component[v] + 1];
+  for (uint32_t c = 0; c < count; ++c) start[c + 1] += start[c];
+  member.resize(start[count]);
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t v = 0; v < m.vertex_count; ++v)
+      if (m.kind[v] != VertexKind::virtual_ && m.vertex_component[v] < count) member[fill[m.vertex_component[v]]++] = v;
+  }
+  // Per component: the smallest input vertex not yet taken (kNone when
+  // every vertex is taken) and its copy of smallest id there.
+  std::vector<uint8_t> taken(input_vertex_count, 0);
+  auto key = [&](uint32_t c) {
+    std::pair<uint32_t, uint32_t> k{kNone, kNone};
+    for (uint32_t i = start[c]; i < start[c + 1]; ++i) {
+      const uint32_t v = member[i], s = m.source[v];
+      if (!taken[s] && std::make_pair(s, v) < k) k = {s, v};
+    }
+    return k;
+  };
+  using Entry = std::pair<std::pair<uint32_t, uint32_t>, uint32_t>;  // key, component
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> next;
+  for (uint32_t c = 0; c < count; ++c) next.push({key(c), c});
+  std::vector<uint32_t> order, rest;                 // rest: components with every vertex taken
+  std::vector<std::pair<uint32_t, uint32_t>> swaps;  // (vertex id, its copy that takes the id)
+  order.reserve(count);
+  while (!next.empty()) {
+    const auto [k, c] = next.top();
+    next.pop();
+    const std::pair<uint32_t, uint32_t> now = key(c);
+    if (now != k) {  // a component taken since has some of its vertices
+      next.push({now, c});
+      continue;
+    }
+    if (k.first == kNone) {
+      rest.push_back(c);
+      continue;
+    }
+    order.push_back(c);
+    for (uint32_t i = start[c]; i < start[c + 1]; ++i) {  // (members by id: the first copy is the smallest)
+      const uint32_t v = member[i], s = m.source[v];
+      if (taken[s]) continue;
+      taken[s] = 1;
+      if (v != s) swaps.emplace_back(s, v);
+    }
+  }
+  std::sort(rest.begin(), rest.end());
+  order.insert(order.end(), rest.begin(), rest.end());
+  std::vector<uint32_t> id(m.vertex_count);
+  std::iota(id.begin(), id.end(), 0u);
+  for (auto [s, v] : swaps) {
+    id[s] = v;
+    id[v] = s;
+    std::swap(m.kind[s], m.kind[v]);
+    std::swap(m.vertex_component[s], m.vertex_component[v]);
+  }
+  if (!swaps.empty())
+    for (uint32_t& x : m.tri) x = id[x];
+  std::vector<uint32_t> new_of(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    const uint32_t c = order[i];
+    new_of[c] = i;
+    uint32_t root = kNone;  // its smallest id now
+    for (uint32_t j = start[c]; j < start[c + 1]; ++j) root = std::min(root, id[member[j]]);
+    m.component_root[i] = root;
+  }
+  for (uint32_t& c : m.vertex_component)
+    if (c < count) c = new_of[c];
 }
 
 bool triangles_only(const Mesh& mesh) {
@@ -342,9 +429,10 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
   }
   m.vertex_count = static_cast<uint32_t>(m.source.size());
 
-  // 4. Components: those with triangles first, ordered by their smallest
-  // vertex id (never virtual), which is the root; then the vertices on no
-  // triangle, by `isolated_key` when given (else by id).
+  // 4. Components: those with triangles first, in the order the decoder
+  // numbers their vertices (order_components; by smallest vertex id, never
+  // virtual, which is the root, when they share no vertex); then the
+  // vertices on no triangle, by `isolated_key` when given (else by id).
   UnionFind comp(m.vertex_count);
   std::vector<uint8_t> on_triangle(m.vertex_count, 0);
   for (uint32_t h = 0; h < m.tri.size(); h += 3) {  // two edges of a triangle join its three corners
@@ -366,6 +454,7 @@ CutMesh cut_mesh(PreparedInput& in, uint32_t input_vertex_count, const CutHints&
     }
     m.vertex_component[v] = m.vertex_component[r];
   }
+  order_components(m, m.component_count(), input_vertex_count);
   if (hints.root_rule > 0 && hints.qpos) root_by_position(m, on_triangle, *hints.qpos, hints.root_rule);
   // Those of one anchor by position (then id): the order then follows ids
   // only among vertices of one grid cell, so a decoded mesh (other ids)
