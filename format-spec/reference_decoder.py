@@ -2299,7 +2299,7 @@ def decode_value(d, m, walk, item, segmented=False):
             tables, bits, base = m.table
             r = table_residual(tables, bits, base + 8 * cls + 2 * c + m.last_zero[c], 'attributes')
         else:
-            r = m.res[cls][c][m.last_zero[c]].decode(d)
+            r = m.res[cls][0 if h.shared else c][m.last_zero[c]].decode(d)
         v = pred[c] + r
         if h.quant == 2:                                     # octahedral: up to one square beyond an edge
             if not -top <= v <= 2 * top:
@@ -2384,6 +2384,8 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             if h.domain != 0 and not h.per_vertex:
                 reject("attributes: %r names its siblings' values but is not coded per vertex" % h.name)
             pr &= ~0x40
+        h.shared = pr & 0x80 != 0                            # §8.12: component 0's residual models for all
+        pr &= ~0x80
         if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
