@@ -2299,7 +2299,7 @@ def decode_value(d, m, walk, item, segmented=False):
             tables, bits, base = m.table
             r = table_residual(tables, bits, base + 8 * cls + 2 * c + m.last_zero[c], 'attributes')
         else:
-            r = m.res[cls][c][m.last_zero[c]].decode(d)
+            r = m.res[cls][0 if h.shared else c][m.last_zero[c]].decode(d)
         v = pred[c] + r
         if h.quant == 2:                                     # octahedral: up to one square beyond an edge
             if not -top <= v <= 2 * top:
@@ -2384,6 +2384,8 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             if h.domain != 0 and not h.per_vertex:
                 reject("attributes: %r names its siblings' values but is not coded per vertex" % h.name)
             pr &= ~0x40
+        h.shared = pr & 0x80 != 0                            # §8.12: component 0's residual models for all
+        pr &= ~0x80
         if not predictor_allowed(h if not h.per_vertex else as_vertex(h), pr):
             reject('attributes: bad predictor')
         predictors.append(pr)
@@ -2820,8 +2822,15 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     d = RangeDecoder(stream)
     fresh = probs(4 * 3 * 6 * 3 * 2 * 2)                   # fresh[nb][before][best][second's class][4 or more][linked]
     rank = [[[[UIntModel(), UIntModel()] for _ in range(2)] for _ in range(6)] for _ in range(6)]   # [best][second][4 or more][linked]
-    copy = probs(4 * 6)                                     # copy[nb][best]
+    copy_next = probs(3 * 3 * 6)                            # [next partner][prev kind][closeness]
+    copy_prev = probs(3 * 2 * 6)                            # [prev partner][an edge to next][closeness]
+    copy_other = probs(2 * 2 * 6)                           # [an edge][more than one][closeness]
     copy_rank = UIntModel()
+    for p in faces:
+        if any(x >= points for x in p):
+            reject('split: a corner outside the points')
+    on_faces = set(x for p in faces for x in p)
+    joins = vertex_count < sum(len(p) for p in faces) + (points - len(on_faces))
     orig = []                                               # per walk vertex: the one whose values it has
     made = [[] for _ in range(points)]
     total = []                                              # per walk vertex: its faces' normals summed
@@ -2830,8 +2839,8 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
     out_faces = []
     for f in faces:
         n = len(f)
-        if any(p >= points for p in f):
-            reject('split: a corner outside the points')
+        ends_next = [0] * n                                 # per corner: across its edge to the next corner
+        ends_prev = [0] * n                                 # and from the previous: 0 none, 1 same original, 2 not
         fn = [0, 0, 0]
         if n >= 3:
             d1 = [q[f[1]][a] - q[f[0]][a] for a in range(3)]
@@ -2856,6 +2865,8 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 b = edge.get((p, f[(i + n - 1) % n]))
                 if b is not None and b[0] not in cand:
                     cand.append(b[0])
+                an = a[1] if a is not None else NONE            # the vertices across the two edges
+                bp = b[0] if b is not None else NONE
                 nb = 0 if not cand else 1 if (a is None or b is None) else 2 if len(cand) == 1 else 3
                 for w in reversed(made[p]):
                     if w not in cand:
@@ -2872,15 +2883,34 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                 second = close[order[1]] if len(cand) > 1 else 6
                 sc = 0 if second == 6 else 1 if second <= 3 else 2
                 many = 1 if len(cand) >= 4 else 0
-                before = 1 if d.bit(fresh, ((((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) * 2 + lf) else 2
+                if joins:
+                    before = 1 if d.bit(fresh, ((((nb * 3 + before) * 6 + best) * 3 + sc) * 2 + many) * 2 + lf) else 2
+                else:
+                    before = 1
                 if before == 1:
                     v[i] = len(total)
                     o = v[i]
-                    if d.bit(copy, nb * 6 + best):
-                        r = copy_rank.decode(d) if len(cand) > 1 else 0
-                        if r >= len(cand):
-                            reject('split: copy rank')
-                        o = orig[cand[r]]
+                    cn = orig[an] if an != NONE else NONE                        # the copy choice
+                    cp = orig[bp] if bp != NONE and orig[bp] != cn else NONE
+                    others = []
+                    for w in cand:
+                        if orig[w] not in (cn, cp) and orig[w] not in others:
+                            others.append(orig[w])
+                    pn = ends_prev[0] if i == n - 1 else 0                       # the other ends
+                    pp = ends_next[i - 1] if i >= 1 else 0
+                    kind = 0 if bp == NONE else 1 if an != NONE and orig[an] == orig[bp] else 2
+                    cl = lambda w: split_closeness(ref, total[w]) if w != NONE else 5
+                    if cn != NONE and d.bit(copy_next, (pn * 3 + kind) * 6 + cl(an)):
+                        o = cn
+                    elif cp != NONE and d.bit(copy_prev, (pp * 2 + (1 if cn != NONE else 0)) * 6 + cl(bp)):
+                        o = cp
+                    elif others:
+                        edged = 1 if cn != NONE or cp != NONE else 0
+                        if d.bit(copy_other, (edged * 2 + (1 if len(others) > 1 else 0)) * 6 + cl(others[0])):
+                            r = copy_rank.decode(d) if len(others) > 1 else 0
+                            if r >= len(others):
+                                reject('split: copy rank')
+                            o = others[r]
                     total.append([0, 0, 0])
                     orig.append(o)
                     made[p].append(v[i])
@@ -2889,6 +2919,8 @@ def decode_split_layout(stream, vertex_count, points, q, faces):
                     if r >= len(cand):
                         reject('split: vertex rank')
                     v[i] = cand[r]
+                ends_next[i] = 0 if an == NONE else 1 if orig[an] == orig[v[i]] else 2
+                ends_prev[i] = 0 if bp == NONE else 1 if orig[bp] == orig[v[i]] else 2
             if len(total) > vertex_count or d.truncated():
                 reject('split: too many vertices or truncated')
         for i in range(n):

@@ -50,6 +50,10 @@ constexpr size_t kRecentValues = 64;
 // where only the UV does). Up to 32 such vertices, the latest first.
 constexpr uint8_t kAttributeSiblingFlag = 0x40;
 constexpr uint32_t kSiblingVertices = 32;
+// Predictor bit 7: every component's residuals in the models of component 0
+// (res[cls][0][z]): a small attribute (a textured box, a low-poly model's
+// texture coordinates) learns one set of models instead of two to four.
+constexpr uint8_t kAttributeSharedFlag = 0x80;
 
 // Predictor bit 4: a corner attribute coded as a vertex attribute, one value
 // per own vertex, each corner using its vertex's value (an OBJ/PLY export of
@@ -172,11 +176,12 @@ struct ValueCoder {
   Coder& io;
   Models m;
   int last_zero[4] = {1, 1, 1, 1};
+  bool shared = false;  // predictor bit 7: component 0's models for every component
   bool value(const AttributeHeader& h, const int32_t* pred, int32_t* x, int cls = 0) {
     if (h.quant == AttributeQuant::octahedral) return octahedral_value(h, pred, x, cls);
     const uint32_t n = int_components(h);
     for (uint32_t c = 0; c < n; ++c) {
-      int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]),
+      int32_t r = io.residual(m.res[cls][shared ? 0 : c][last_zero[c]], table_context(cls, c, last_zero[c]),
                               static_cast<int64_t>(x[c]) - pred[c]);
       const int64_t v = static_cast<int64_t>(pred[c]) + r;
       if (!in_range(h, v)) return false;
@@ -197,7 +202,8 @@ struct ValueCoder {
     if constexpr (Coder::kEncoder) octahedral_residual(top, pred, x, want);
     int64_t v[2];
     for (uint32_t c = 0; c < 2; ++c) {
-      const int32_t r = io.residual(m.res[cls][c][last_zero[c]], table_context(cls, c, last_zero[c]), want[c]);
+      const int32_t r =
+          io.residual(m.res[cls][shared ? 0 : c][last_zero[c]], table_context(cls, c, last_zero[c]), want[c]);
       v[c] = static_cast<int64_t>(pred[c]) + r;
       if (v[c] < -top || v[c] > 2 * top) return false;
       last_zero[c] = r == 0;
@@ -506,8 +512,8 @@ struct VertexFaces {
 
 // Names the readers give (FORMAT.md §8.12): a header names one of them by
 // its index (one byte), and any other name by its length + 10 and its bytes.
-constexpr const char* kCommonNames[] = {"normal",   "texcoord",  "color",       "texcoord0",      "texcoord1",
-                                        "TANGENT",  "JOINTS_0",  "WEIGHTS_0",   "_gltf_group",    "_gltf_primitive"};
+constexpr const char* kCommonNames[] = {"normal",  "texcoord", "color",     "texcoord0",   "texcoord1",
+                                        "TANGENT", "JOINTS_0", "WEIGHTS_0", "_gltf_group", "_gltf_primitive"};
 constexpr uint64_t kCommonNameCount = sizeof(kCommonNames) / sizeof(kCommonNames[0]);
 
 // A grid's origins and top (FORMAT.md §8.12) that are multiples of 1/64
@@ -557,7 +563,8 @@ void write_header(ByteWriter& w, const AttributeHeader& h) {
     const int axis = extent_axis(h.origin, static_cast<int>(h.components), h.extent, top);
     uint32_t grid = static_cast<uint32_t>(axis);
     int8_t k = 0;
-    for (uint32_t c = 0; c < h.components; ++c) grid |= static_cast<uint32_t>(short_grid_value(h.origin[c], k)) << (2 + c);
+    for (uint32_t c = 0; c < h.components; ++c)
+      grid |= static_cast<uint32_t>(short_grid_value(h.origin[c], k)) << (2 + c);
     grid |= static_cast<uint32_t>(short_grid_value(top, k)) << kGridTopShortBit;
     w.u8(static_cast<uint8_t>(grid));
     for (uint32_t c = 0; c < h.components; ++c) write_grid_value(w, h.origin[c], grid >> (2 + c) & 1);
@@ -1333,11 +1340,13 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
   bool siblings = false;  // the attribute being coded names its siblings' values (predictor bit 6)
+  bool shared = false;    // its components share the residual models (predictor bit 7)
   auto code = [&](Enc& enc, size_t i, int predictor, bool recent) {
     const AttributeHeader h = coded_header(headers[i], in.per_vertex >> i & 1);
     const Attribute& a = part.attributes[i];
     const uint32_t n = int_components(h);
     ValueCoder<Enc> vc{enc, {}};
+    vc.shared = shared;
     const bool oct = h.quant == AttributeQuant::octahedral;
     if (oct) geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor), gnormal, ghas);
     AttributeWalk<Enc> walk{h, vc, enc, faces, rank, oct ? &gnormal : nullptr, oct ? &ghas : nullptr, in.q, &around};
@@ -1396,6 +1405,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     own_values = nullptr;
     bool recent = false;
     siblings = h.domain == AttributeDomain::vertex;
+    shared = false;
     auto adaptive_size = [&](int p, size_t& size) {
       Enc trial;
       if (!code(trial, i, p, recent)) return false;
@@ -1424,6 +1434,15 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       siblings = with >= best;
       best = std::min(best, with);
     }
+    if (int_components(h) > 1) {  // the components' shared models where they pay (predictor bit 7)
+      size_t with = 0;
+      if (best == SIZE_MAX && !adaptive_size(predictor, best))
+        return Status(ErrorCode::internal, "attributes: values out of range");
+      shared = true;
+      if (!adaptive_size(predictor, with)) return Status(ErrorCode::internal, "attributes: values out of range");
+      shared = with <= best;
+      best = std::min(best, with);
+    }
     TableResiduals residuals;
     bool tables = false;
     if (in.tables) {
@@ -1442,7 +1461,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     }
     w.u8(static_cast<uint8_t>(predictor | (tables ? kAttributeTableFlag : 0) |
                               (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0) |
-                              (siblings ? kAttributeSiblingFlag : 0)));
+                              (siblings ? kAttributeSiblingFlag : 0) | (shared ? kAttributeSharedFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
     if (tables) {
       residuals.bits = &table_bits;
@@ -1474,7 +1493,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (AttributeHeader& h : headers) TSM_RETURN_IF_ERROR(read_header(r, h));
   std::vector<int> predictor(headers.size());
   std::vector<uint8_t> tabled(headers.size(), 0);
-  uint64_t per_vertex = 0, recent = 0, siblings = 0;
+  uint64_t per_vertex = 0, recent = 0, siblings = 0, shared = 0;
   for (size_t i = 0; i < headers.size(); ++i) {
     uint8_t p = 0;
     if (!r.u8(p)) return corrupt("bad predictor");
@@ -1500,6 +1519,10 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
         return corrupt("'" + headers[i].name + "' names its siblings' values but is not coded per vertex");
       siblings |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeSiblingFlag);
+    }
+    if (p & kAttributeSharedFlag) {
+      shared |= uint64_t{1} << i;
+      p = static_cast<uint8_t>(p & ~kAttributeSharedFlag);
     }
     if (p > 4 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
@@ -1541,6 +1564,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (h.quant == AttributeQuant::octahedral)
       geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor[i]), gn, gh);
     ValueCoder<Dec> vc{dec, {}};
+    vc.shared = shared >> i & 1;
     AttributeWalk<Dec> walk{h,
                             vc,
                             dec,

@@ -87,8 +87,46 @@ struct SplitModels {
   // first linked]: two candidates as close to the face say little which it
   // is, a near one beside a far one much
   UIntModel rank[6][6][2][2];
-  Prob copy[4][6];  // a new vertex with an earlier vertex's values, [neighbours][first closeness]
+  // A new vertex with an earlier vertex's values (CopyChoice, CopyContext):
+  // the values of the original across the corner's edge to the next corner,
+  // [the other end of that edge: not known, kept its values, changed][the
+  // vertex across the edge from the previous corner: none, the same
+  // original, another][the original's closeness]; of the one across the
+  // edge from the previous corner, [its other end][an edge to the next
+  // corner][closeness]; of another of the point's, [an edge][more than
+  // one][the first one's closeness]; which.
+  Prob copy_next[3][3][6];
+  Prob copy_prev[3][2][6];
+  Prob copy_other[2][2][6];
   UIntModel copy_rank;
+};
+
+// Whether the corner's vertex has the values of the vertex across one of
+// its edges (its original's): 0 no vertex across (or not known yet), 1 the
+// same, 2 others. Across an edge inside a texture chart both ends keep
+// their values, across a seam both change: one end tells the other.
+struct FaceEnds {
+  std::vector<uint8_t> next, prev;  // per corner, across its edge to the next corner, from the previous
+  void start(uint32_t n) {
+    next.assign(n, 0);
+    prev.assign(n, 0);
+  }
+  // The other end of corner i's edge to the next corner, and of its edge
+  // from the previous one (corners after i are not known yet: 0).
+  int next_partner(uint32_t i) const { return (i + 1) % next.size() < i ? prev[(i + 1) % next.size()] : 0; }
+  int prev_partner(uint32_t i) const {
+    const uint32_t j = (i + static_cast<uint32_t>(next.size()) - 1) % static_cast<uint32_t>(next.size());
+    return j < i ? next[j] : 0;
+  }
+};
+
+// The copy choice of a new vertex (FORMAT.md §8.13): the originals it may
+// take the values of, the one across the corner's edge to the next corner
+// first, then the one across the edge from the previous corner, then the
+// point's others in candidate order, each once.
+struct CopyChoice {
+  uint32_t next = kNoVertex, prev = kNoVertex;
+  std::vector<uint32_t> others;
 };
 
 // The walk both sides make: per corner, the candidates, then (after the
@@ -171,6 +209,8 @@ class SplitWalk {
     if (a) offer(a->second);
     const EdgeMap::Ends* b = edge_.find(key(p, prev));  // across prev -> p: p -> prev
     if (b) offer(b->first);
+    across_next_ = a ? a->second : kNoVertex;
+    across_prev_ = b ? b->first : kNoVertex;
     const bool both = a && b;
     const int nb = cand_.empty() ? 0 : !both ? 1 : cand_.size() == 1 ? 2 : 3;
     for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
@@ -198,6 +238,29 @@ class SplitWalk {
     return nb;
   }
   const std::vector<uint32_t>& cand() const { return sorted_; }
+  // The vertices across the corner's edges (gather), kNoVertex where none.
+  uint32_t across_next() const { return across_next_; }
+  uint32_t across_prev() const { return across_prev_; }
+  uint32_t original(uint32_t w) const { return original_[w]; }
+  // How close vertex w's normal is to the face's (0-5, as in gather).
+  int closeness_of(uint32_t w) const { return closeness(ref_, sum_[w].x); }
+  // The corner's ends (FaceEnds) once it is vertex w.
+  void ends(FaceEnds& e, uint32_t i, uint32_t w) const {
+    auto state = [&](uint32_t x) -> uint8_t { return x == kNoVertex ? 0 : original_[x] == original_[w] ? 1 : 2; };
+    e.next[i] = state(across_next_);
+    e.prev[i] = state(across_prev_);
+  }
+  // The originals a new vertex may copy, in the order they are offered.
+  void copy_choice(CopyChoice& c) const {
+    c.next = across_next_ == kNoVertex ? kNoVertex : original_[across_next_];
+    c.prev = across_prev_ == kNoVertex || original_[across_prev_] == c.next ? kNoVertex : original_[across_prev_];
+    c.others.clear();
+    for (uint32_t w : sorted_) {
+      const uint32_t o = original_[w];
+      if (o != c.next && o != c.prev && std::find(c.others.begin(), c.others.end(), o) == c.others.end())
+        c.others.push_back(o);
+    }
+  }
   int best() const { return best_; }
   int linked() const { return linked_first_; }
   // The second candidate's closeness, 6 if there is none; in three classes
@@ -261,8 +324,90 @@ class SplitWalk {
   std::vector<int> close_, rank_key_;
   int linked_first_ = 0;
   int best_ = 5;
+  uint32_t across_next_ = kNoVertex, across_prev_ = kNoVertex;
   uint32_t next_ = 0;
 };
+
+// The contexts of a new vertex's copy choice: the other ends of the
+// corner's two edges (FaceEnds), whether the vertex across the edge from the
+// previous corner has the same original as the one across the next (0 none
+// across the previous edge, 1 the same, 2 another), and the closeness of the
+// vertex across each edge and of the first other original (5 if none).
+struct CopyContext {
+  int next_partner, prev_partner, prev_kind;
+  int next_close, prev_close, other_close;
+};
+CopyContext copy_context(const SplitWalk& walk, const FaceEnds& ends, uint32_t i, const CopyChoice& c) {
+  const uint32_t a = walk.across_next(), b = walk.across_prev();
+  const int kind = b == kNoVertex ? 0 : a != kNoVertex && walk.original(a) == walk.original(b) ? 1 : 2;
+  return {ends.next_partner(i),
+          ends.prev_partner(i),
+          kind,
+          a == kNoVertex ? 5 : walk.closeness_of(a),
+          b == kNoVertex ? 5 : walk.closeness_of(b),
+          c.others.empty() ? 5 : walk.closeness_of(c.others[0])};
+}
+
+// A new vertex's copy choice (CopyChoice), `match` telling whether it has
+// an original's values: returns that original, kNoVertex if none.
+template <class Match>
+uint32_t encode_copy(RangeEncoder& e, SplitModels& m, const CopyChoice& c, const CopyContext& x, Match match) {
+  if (c.next != kNoVertex) {
+    const bool same = match(c.next);
+    e.bit(m.copy_next[x.next_partner][x.prev_kind][x.next_close], same);
+    if (same) return c.next;
+  }
+  if (c.prev != kNoVertex) {
+    const bool same = match(c.prev);
+    e.bit(m.copy_prev[x.prev_partner][c.next != kNoVertex ? 1 : 0][x.prev_close], same);
+    if (same) return c.prev;
+  }
+  if (c.others.empty()) return kNoVertex;
+  uint32_t r = 0;
+  while (r < c.others.size() && !match(c.others[r])) ++r;
+  const bool any_edge = c.next != kNoVertex || c.prev != kNoVertex;
+  e.bit(m.copy_other[any_edge ? 1 : 0][c.others.size() > 1 ? 1 : 0][x.other_close], r < c.others.size());
+  if (r == c.others.size()) return kNoVertex;
+  if (c.others.size() > 1) m.copy_rank.encode(e, r);
+  return c.others[r];
+}
+
+// The decoder's side: false on a rank out of range.
+bool decode_copy(RangeDecoder& d, SplitModels& m, const CopyChoice& c, const CopyContext& x, uint32_t& original) {
+  original = kNoVertex;
+  if (c.next != kNoVertex && d.bit(m.copy_next[x.next_partner][x.prev_kind][x.next_close])) {
+    original = c.next;
+    return true;
+  }
+  if (c.prev != kNoVertex && d.bit(m.copy_prev[x.prev_partner][c.next != kNoVertex ? 1 : 0][x.prev_close])) {
+    original = c.prev;
+    return true;
+  }
+  if (c.others.empty()) return true;
+  const bool any_edge = c.next != kNoVertex || c.prev != kNoVertex;
+  if (!d.bit(m.copy_other[any_edge ? 1 : 0][c.others.size() > 1 ? 1 : 0][x.other_close])) return true;
+  const uint32_t r = c.others.size() > 1 ? m.copy_rank.decode(d) : 0;
+  if (r >= c.others.size()) return false;
+  original = c.others[r];
+  return true;
+}
+
+// Whether some input vertex is the vertex of two corners. Without (a
+// flat-shaded model: every corner a vertex of its own), every corner at a
+// point with vertices is a new vertex and no new-vertex bit is coded; the
+// decoder knows it from the counts: the vertices then number the corners
+// plus the points on no corner.
+bool corners_share_vertices(const std::vector<uint32_t>& corner_vertex) {
+  std::vector<uint32_t> sorted = corner_vertex;
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+}
+bool counts_say_joins(const Mesh& faces, uint32_t points, uint64_t vertex_count) {
+  std::vector<uint8_t> used(points, 0);
+  for (uint32_t p : faces.indices) used[p] = 1;
+  const uint64_t unused = static_cast<uint64_t>(std::count(used.begin(), used.end(), uint8_t{0}));
+  return vertex_count < faces.indices.size() + unused;
+}
 
 }  // namespace
 
@@ -279,11 +424,15 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
   std::vector<uint32_t> input_of;                  // walk vertex -> input vertex
   std::vector<uint32_t> corner_walk(faces.indices.size());
   std::vector<uint32_t> v;
+  FaceEnds ends;
+  CopyChoice choice;
+  const bool joins = corners_share_vertices(corner_vertex);
   for (uint32_t f = 0; f < faces.face_count(); ++f) {
     const uint32_t* c = faces.face(f);
     const uint32_t n = faces.face_size(f), base = faces.face_offsets[f];
     v.assign(n, kNoVertex);
     walk.start_face(c, n);
+    ends.start(n);
     int before = 0;
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t p = c[i], x = corner_vertex[base + i];
@@ -294,23 +443,23 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
       } else {
         walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()],
-              fresh);
+        if (joins)
+          e.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()],
+                fresh);
         if (fresh) {
-          // A copy: the values of a vertex of the point (the first such
-          // candidate).
-          const auto& cand = walk.cand();
-          uint32_t r = 0;
-          while (r < cand.size() && value_class[input_of[cand[r]]] != value_class[x]) ++r;
-          e.bit(m.copy[nb][walk.best()], r < cand.size());
-          if (r < cand.size() && cand.size() > 1) m.copy_rank.encode(e, r);
-          v[i] = walk.make(p, r < cand.size() ? cand[r] : kNoVertex);
+          // A copy: the values of an original of the point (the first such
+          // in the choice's order).
+          walk.copy_choice(choice);
+          const uint32_t o = encode_copy(e, m, choice, copy_context(walk, ends, i, choice),
+                                         [&](uint32_t w) { return value_class[input_of[w]] == value_class[x]; });
+          v[i] = walk.make(p, o);
         } else {
           const auto& cand = walk.cand();
           const uint32_t r = static_cast<uint32_t>(std::find(cand.begin(), cand.end(), it->second) - cand.begin());
           if (cand.size() > 1) m.rank[walk.best()][walk.second()][cand.size() >= 4 ? 1 : 0][walk.linked()].encode(e, r);
           v[i] = it->second;
         }
+        walk.ends(ends, i, v[i]);
       }
       before = fresh ? 1 : 2;
       if (it == walk_of.end()) {
@@ -339,13 +488,17 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
   SplitModels& m = *models;
   SplitWalk walk(points, q);
   std::vector<uint32_t> v;
+  FaceEnds ends;
+  CopyChoice choice;
+  for (uint32_t p : faces.indices)
+    if (p >= points) return corrupt("a corner outside the points");
+  const bool joins = counts_say_joins(faces, points, vertex_count);
   for (uint32_t f = 0; f < faces.face_count(); ++f) {
     uint32_t* c = faces.indices.data() + faces.face_offsets[f];
     const uint32_t n = faces.face_size(f);
     v.assign(n, kNoVertex);
-    for (uint32_t i = 0; i < n; ++i)
-      if (c[i] >= points) return corrupt("a corner outside the points");
     walk.start_face(c, n);
+    ends.start(n);
     int before = 0;
     for (uint32_t i = 0; i < n; ++i) {
       const uint32_t p = c[i];
@@ -355,18 +508,15 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
       } else {
         walk.refer(v.data(), i);
         const int nb = walk.gather(p, c[(i + 1) % n], c[(i + n - 1) % n]);
-        before =
-            d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0][walk.linked()])
-                ? 1
-                : 2;
+        before = !joins || d.bit(m.fresh[nb][before][walk.best()][walk.second_class()][walk.cand().size() >= 4 ? 1 : 0]
+                                        [walk.linked()])
+                     ? 1
+                     : 2;
         if (before == 1) {
-          const auto& cand = walk.cand();
+          walk.copy_choice(choice);
           uint32_t original = kNoVertex;
-          if (d.bit(m.copy[nb][walk.best()])) {
-            const uint32_t r = cand.size() > 1 ? m.copy_rank.decode(d) : 0;
-            if (r >= cand.size()) return corrupt("a copy's rank out of range");
-            original = cand[r];
-          }
+          if (!decode_copy(d, m, choice, copy_context(walk, ends, i, choice), original))
+            return corrupt("a copy's rank out of range");
           v[i] = walk.make(p, original);
         } else {
           const auto& cand = walk.cand();
@@ -376,6 +526,7 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
           if (r >= cand.size()) return corrupt("a vertex rank out of range");
           v[i] = cand[r];
         }
+        walk.ends(ends, i, v[i]);
       }
       if (walk.made() > vertex_count || d.overrun() > RangeDecoder::kMaxOverrun)
         return corrupt("more vertices than the header says, or the stream is truncated");
