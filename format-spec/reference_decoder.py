@@ -1928,7 +1928,10 @@ def attribute_value(h, ints):
     out = []
     for c in range(h.components):
         x = float(h.origin[c]) + float(ints[c]) * step
-        out.append(f32(min(max(x, -FLT_MAX), FLT_MAX)))
+        v = f32(min(max(x, -FLT_MAX), FLT_MAX))
+        while v - float(h.origin[c]) > h.extent:                 # §8.12: not past origin + extent
+            v = f32_below(v)
+        out.append(v)
     return out
 
 

@@ -1209,10 +1209,18 @@ bool same_description(const Attribute& a, const Attribute& b) {
          a.components == b.components;
 }
 
+// FORMAT.md §8.12: the float nearest the grid point, or the float below it
+// while it lies past origin + extent (as positions, §5): each component of
+// the decoded values then spans at most the extent, so coding them again
+// takes the same grid (a component other than the one that set the extent
+// could round up past it, and the grid grew by an ulp each round).
 float attribute_grid_value(const AttributeHeader& h, int c, int64_t x) {
-  const double v = static_cast<double>(h.origin[c]) + static_cast<double>(x) * grid_step(h);
+  const double o = static_cast<double>(h.origin[c]);
+  const double v = o + static_cast<double>(x) * grid_step(h);
   constexpr double kMax = static_cast<double>(std::numeric_limits<float>::max());
-  return static_cast<float>(v > kMax ? kMax : v < -kMax ? -kMax : v);
+  float f = static_cast<float>(v > kMax ? kMax : v < -kMax ? -kMax : v);
+  while (static_cast<double>(f) - o > h.extent) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
 }
 
 std::vector<AttributeHeader> attribute_headers(const Mesh& mesh, const AttributeBits& bits) {

@@ -105,15 +105,21 @@ void order_components(CutMesh& m, uint32_t count, uint32_t input_vertex_count) {
       if (m.kind[v] != VertexKind::virtual_ && m.vertex_component[v] < count) member[fill[m.vertex_component[v]]++] = v;
   }
   // Per component: the smallest input vertex not yet taken (kNone when
-  // every vertex is taken) and its copy of smallest id there.
+  // every vertex is taken) and its copy of smallest id there. Its members
+  // by (input vertex, id) and a cursor past the taken ones: vertices are
+  // only ever taken, so all keys together cost one pass over the members.
   std::vector<uint8_t> taken(input_vertex_count, 0);
+  std::vector<uint32_t> by_source(member);
+  std::vector<uint32_t> cursor(start.begin(), start.end() - 1);
+  for (uint32_t c = 0; c < count; ++c)
+    std::sort(by_source.begin() + start[c], by_source.begin() + start[c + 1], [&](uint32_t a, uint32_t b) {
+      return std::make_pair(m.source[a], a) < std::make_pair(m.source[b], b);
+    });
   auto key = [&](uint32_t c) {
-    std::pair<uint32_t, uint32_t> k{kNone, kNone};
-    for (uint32_t i = start[c]; i < start[c + 1]; ++i) {
-      const uint32_t v = member[i], s = m.source[v];
-      if (!taken[s] && std::make_pair(s, v) < k) k = {s, v};
-    }
-    return k;
+    uint32_t& i = cursor[c];
+    while (i < start[c + 1] && taken[m.source[by_source[i]]]) ++i;
+    if (i == start[c + 1]) return std::pair<uint32_t, uint32_t>{kNone, kNone};
+    return std::pair<uint32_t, uint32_t>{m.source[by_source[i]], by_source[i]};
   };
   using Entry = std::pair<std::pair<uint32_t, uint32_t>, uint32_t>;  // key, component
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> next;
