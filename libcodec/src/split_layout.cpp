@@ -371,7 +371,9 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
                            std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
   auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
   RangeDecoder d(stream);
-  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  // Default-initialized (not make_unique's value-initialization, which would
+  // zero every UIntModel's mantissa rows first: they are set up on first use).
+  const std::unique_ptr<SplitModels> models(new SplitModels);  // large: on the heap
   SplitModels& m = *models;
   SplitWalk walk(points, q, faces.indices.size());
   std::vector<uint32_t> v;
