@@ -373,20 +373,31 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
                       NormalWeights weights, std::vector<int32_t>& oct, std::vector<uint8_t>& has) {
   const size_t n = q.size() / 3;
   std::vector<double> sum(3 * n, 0.0);
+  // The face vectors, kept for the stray pass (has_vector: 1 where there is one).
+  std::vector<double> vectors(3 * faces.face_count());
+  std::vector<uint8_t> has_vector(faces.face_count(), 0);
+  std::vector<double> edge;  // per corner of a face: the squared length of its edge to the next
   for (size_t f = 0; f < faces.face_count(); ++f) {
-    double v[3];
+    double* v = &vectors[3 * f];
     if (!face_vector(faces, f, rank, q, v)) continue;
+    has_vector[f] = 1;
     const uint32_t k = faces.face_size(f);
     const uint32_t* c = faces.face(f);
     const double len = std::sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]);
+    if (weights == NormalWeights::angle) {
+      // Each edge's squared length once (the same either way round: the
+      // differences of grid integers are exact).
+      edge.resize(k);
+      for (uint32_t i = 0; i < k; ++i)
+        edge[i] = squared_distance(&q[3 * static_cast<size_t>(rank[c[i]])],
+                                   &q[3 * static_cast<size_t>(rank[c[(i + 1) % k]])]);
+    }
     for (uint32_t i = 0; i < k; ++i) {
       double w = 1;
       if (weights == NormalWeights::face) {
         w = len > 0 ? 1 / len : 0;
       } else if (weights == NormalWeights::angle) {
-        const uint32_t* pi = &q[3 * static_cast<size_t>(rank[c[i]])];
-        const double e = squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + 1) % k]])]) *
-                         squared_distance(pi, &q[3 * static_cast<size_t>(rank[c[(i + k - 1) % k]])]);
+        const double e = edge[i] * edge[(i + k - 1) % k];
         w = e > 0 ? 1 / std::sqrt(e) : 0;
       }
       double* s = &sum[3 * static_cast<size_t>(rank[c[i]])];
@@ -408,8 +419,8 @@ void geometry_normals(const Mesh& faces, const std::vector<uint32_t>& rank, cons
   // 99998 |v|^2 |s|^2, 10^4 dot^2 against 9998, dot > 0), else class 2; a
   // vertex takes its faces' largest.
   for (size_t f = 0; f < faces.face_count(); ++f) {
-    double v[3];
-    if (!face_vector(faces, f, rank, q, v)) continue;
+    if (!has_vector[f]) continue;
+    const double* v = &vectors[3 * f];
     const double vv = (v[0] * v[0] + v[1] * v[1]) + v[2] * v[2];
     if (vv == 0) continue;
     const uint32_t k = faces.face_size(f);
@@ -892,23 +903,27 @@ struct AttributeWalk {
     }
   }
   // Per own rank, the previous own rank with the same grid position (kNone:
-  // none); empty without positions.
+  // none); empty without positions. One pass in rank order over an open
+  // addressing table of positions, each slot holding the latest rank there.
   void earlier_at_same_position(std::vector<uint32_t>& earlier) const {
     earlier.clear();
     if (!q || q->empty()) return;
     const size_t own = q->size() / 3;
-    std::vector<uint32_t> by_q(own);
-    for (uint32_t r = 0; r < own; ++r) by_q[r] = r;
+    size_t slots = 16;
+    while (slots < 2 * own) slots *= 2;
+    const size_t mask = slots - 1;
+    std::vector<uint32_t> latest(slots, kNone);
     const uint32_t* p = q->data();
-    std::sort(by_q.begin(), by_q.end(), [p](uint32_t a, uint32_t b) {
-      for (int k = 0; k < 3; ++k)
-        if (p[3 * size_t{a} + k] != p[3 * size_t{b} + k]) return p[3 * size_t{a} + k] < p[3 * size_t{b} + k];
-      return a < b;
-    });
     earlier.assign(own, kNone);
-    for (size_t i = 1; i < own; ++i)
-      if (std::equal(p + 3 * size_t{by_q[i]}, p + 3 * size_t{by_q[i]} + 3, p + 3 * size_t{by_q[i - 1]}))
-        earlier[by_q[i]] = by_q[i - 1];
+    for (uint32_t r = 0; r < own; ++r) {
+      const uint32_t* x = p + 3 * size_t{r};
+      const uint64_t hash = (uint64_t{x[0]} * 0x9E3779B97F4A7C15ull) ^ (uint64_t{x[1]} * 0xC2B2AE3D27D4EB4Full) ^
+                            (uint64_t{x[2]} * 0x165667B19E3779F9ull);
+      size_t i = static_cast<size_t>(hash >> 32) & mask;
+      while (latest[i] != kNone && !std::equal(x, x + 3, p + 3 * size_t{latest[i]})) i = (i + 1) & mask;
+      earlier[r] = latest[i];
+      latest[i] = r;
+    }
   }
   // The siblings' step (predictor bit 6) for own rank r, which has an
   // earlier vertex at its position: whether its value is one of the

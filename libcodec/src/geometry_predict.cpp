@@ -105,13 +105,16 @@ struct Reciprocals {
 };
 inline constexpr Reciprocals kReciprocal{};
 
-#ifdef __SIZEOF_INT128__
-__extension__ typedef unsigned __int128 uint128;  // GCC and Clang (64-bit targets and wasm32)
+// wasm32 has __int128 but emulates its product with a call (__multi3),
+// slower than its native 64-bit division: there the division is used.
+#if defined(__SIZEOF_INT128__) && !defined(__wasm__)
+#define TSM_RECIPROCAL_DIV 1
+__extension__ typedef unsigned __int128 uint128;  // GCC and Clang (64-bit targets)
 #endif
 // div_round's quotient floor(num / den) for |num| < 2^40 and den <= 128,
 // without a branch on the sign: num + 2^40 den is positive and below 2^48.
 __attribute__((always_inline)) inline bool floor_div_small(int64_t num, int64_t den, int64_t& q) {
-#ifdef __SIZEOF_INT128__
+#ifdef TSM_RECIPROCAL_DIV
   constexpr int64_t kLimit = int64_t{1} << 40;
   if (den > kSmallDivisor || num >= kLimit || num <= -kLimit) return false;
   const uint64_t x = static_cast<uint64_t>(num + (den << 40));

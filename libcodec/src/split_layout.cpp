@@ -145,8 +145,14 @@ class EdgeMap {
       if (slots_[i].key == key) return &slots_[i].ends;
     }
   }
+  // Room for `n` keys without growing.
+  void reserve(size_t n) {
+    size_t size = 1024;
+    while (size < 2 * n) size *= 2;
+    if (size > slots_.size()) rehash(size);
+  }
   void set(uint64_t key, Ends ends) {
-    if (2 * (used_ + 1) > slots_.size()) grow();
+    if (2 * (used_ + 1) > slots_.size()) rehash(slots_.empty() ? 1024 : 2 * slots_.size());
     size_t i = slot_of(key);
     while (slots_[i].key != kEmpty && slots_[i].key != key) i = (i + 1) & mask_;
     if (slots_[i].key == kEmpty) ++used_;
@@ -161,9 +167,9 @@ class EdgeMap {
     Ends ends;
   };
   size_t slot_of(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
-  void grow() {
+  void rehash(size_t size) {
     std::vector<Slot> old = std::move(slots_);
-    slots_.assign(old.empty() ? 1024 : 2 * old.size(), Slot());
+    slots_.assign(size, Slot());
     mask_ = slots_.size() - 1;
     used_ = 0;
     for (const Slot& s : old)
@@ -175,7 +181,16 @@ class EdgeMap {
 
 class SplitWalk {
  public:
-  SplitWalk(uint32_t points, const std::vector<uint32_t>& q) : made_(points), q_(q) {}
+  // `corners`: how many the faces have (the edge maps are sized for them).
+  SplitWalk(uint32_t points, const std::vector<uint32_t>& q, size_t corners)
+      : first_(points, kNoVertex), last_(points, kNoVertex), count_(points, 0), q_(q) {
+    edge_.reserve(corners);
+    linked_.reserve(corners);
+    sum_.reserve(corners);
+    original_.reserve(corners);
+    later_.reserve(corners);
+    earlier_.reserve(corners);
+  }
   void start_face(const uint32_t* c, uint32_t n) {
     normal_ = n >= 3 ? face_normal(q_, c) : Normal();
     ref_ = normal_;
@@ -186,7 +201,8 @@ class SplitWalk {
   // where parts overlap or touch at a point), and the face's normal, or
   // where that is zero (a sliver flat on the grid) their summed normals.
   void refer(const uint32_t* v, uint32_t i) {
-    taken_.assign(v, v + i);
+    taken_ = v;
+    taken_count_ = i;
     if (!normal_.zero()) return;
     int64_t t[3] = {0, 0, 0};
     for (uint32_t j = 0; j < i; ++j)
@@ -202,9 +218,6 @@ class SplitWalk {
   // it is linked.
   int gather(uint32_t p, uint32_t next, uint32_t prev) {
     cand_.clear();
-    auto offer = [&](uint32_t v) {
-      if (v != kNoVertex && std::find(cand_.begin(), cand_.end(), v) == cand_.end()) cand_.push_back(v);
-    };
     const EdgeMap::Ends* a = edge_.find(key(next, p));  // the neighbour across p -> next runs next -> p
     if (a) offer(a->second);
     const EdgeMap::Ends* b = edge_.find(key(p, prev));  // across prev -> p: p -> prev
@@ -213,28 +226,26 @@ class SplitWalk {
     across_prev_ = b ? b->first : kNoVertex;
     const bool both = a && b;
     const int nb = cand_.empty() ? 0 : !both ? 1 : cand_.size() == 1 ? 2 : 3;
-    for (auto it = made_[p].rbegin(); it != made_[p].rend(); ++it) offer(*it);
-    close_.resize(cand_.size());
-    order_.resize(cand_.size());
-    rank_key_.resize(cand_.size());
-    for (size_t i = 0; i < cand_.size(); ++i) {
-      close_[i] = closeness(ref_, sum_[cand_[i]].x);
-      order_[i] = static_cast<uint32_t>(i);
+    for (uint32_t w = last_[p]; w != kNoVertex; w = earlier_[w]) offer(w);
+    const size_t k = cand_.size();
+    for (Candidate& c : cand_) {
+      c.close = closeness(ref_, sum_[c.v].x);
       bool linked = false;
-      for (uint32_t u : taken_) linked = linked || linked_.find(pair_key(u, cand_[i])) != nullptr;
-      rank_key_[i] = (linked ? 0 : 8) + close_[i];
+      for (uint32_t j = 0; j < taken_count_ && !linked; ++j) linked = linked_.find(pair_key(taken_[j], c.v)) != nullptr;
+      c.key = (linked ? 0 : 8) + c.close;
     }
     // Stable insertion sort: a point has a handful of vertices.
-    for (size_t i = 1; i < order_.size(); ++i) {
-      const uint32_t x = order_[i];
+    for (size_t i = 1; i < k; ++i) {
+      const Candidate x = cand_[i];
       size_t j = i;
-      for (; j > 0 && rank_key_[x] < rank_key_[order_[j - 1]]; --j) order_[j] = order_[j - 1];
-      order_[j] = x;
+      for (; j > 0 && x.key < cand_[j - 1].key; --j) cand_[j] = cand_[j - 1];
+      cand_[j] = x;
     }
-    sorted_.resize(cand_.size());
-    for (size_t i = 0; i < cand_.size(); ++i) sorted_[i] = cand_[order_[i]];
-    best_ = close_[order_[0]];
-    linked_first_ = rank_key_[order_[0]] < 8 ? 1 : 0;
+    sorted_.clear();
+    for (const Candidate& c : cand_) sorted_.push_back(c.v);
+    best_ = cand_[0].close;
+    second_ = k > 1 ? cand_[1].close : 6;
+    linked_first_ = cand_[0].key < 8 ? 1 : 0;
     return nb;
   }
   const std::vector<uint32_t>& cand() const { return sorted_; }
@@ -265,13 +276,20 @@ class SplitWalk {
   int linked() const { return linked_first_; }
   // The second candidate's closeness, 6 if there is none; in three classes
   // (none, 0-3, 4-5) for the new-vertex bit.
-  int second() const { return order_.size() > 1 ? close_[order_[1]] : 6; }
-  int second_class() const { return second() == 6 ? 0 : second() <= 3 ? 1 : 2; }
-  size_t vertices_at(uint32_t p) const { return made_[p].size(); }
+  int second() const { return second_; }
+  int second_class() const { return second_ == 6 ? 0 : second_ <= 3 ? 1 : 2; }
+  size_t vertices_at(uint32_t p) const { return count_[p]; }
   // A new vertex at p; `original`: the vertex whose attribute values it
   // has (kNoVertex: its own).
   uint32_t make(uint32_t p, uint32_t original = kNoVertex) {
-    made_[p].push_back(next_);
+    earlier_.push_back(last_[p]);
+    later_.push_back(kNoVertex);
+    if (last_[p] == kNoVertex)
+      first_[p] = next_;
+    else
+      later_[last_[p]] = next_;
+    last_[p] = next_;
+    ++count_[p];
     sum_.emplace_back();
     original_.push_back(original == kNoVertex ? next_ : original_[original]);
     return next_++;
@@ -295,12 +313,12 @@ class SplitWalk {
     walk_out.assign(next_, kNoVertex);
     walk_point.assign(next_, kNoVertex);
     uint32_t id = 0;
-    for (uint32_t p = 0; p < made_.size(); ++p) {
-      if (made_[p].empty()) {
+    for (uint32_t p = 0; p < first_.size(); ++p) {
+      if (first_[p] == kNoVertex) {
         walk_out.push_back(id++);
         walk_point.push_back(p);
       }
-      for (uint32_t w : made_[p]) {
+      for (uint32_t w = first_[p]; w != kNoVertex; w = later_[w]) {
         walk_out[w] = id++;
         walk_point[w] = p;
       }
@@ -311,17 +329,35 @@ class SplitWalk {
  private:
   static uint64_t key(uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; }
   static uint64_t pair_key(uint32_t a, uint32_t b) { return a < b ? key(a, b) : key(b, a); }
-  std::vector<std::vector<uint32_t>> made_;
+  // A candidate not offered yet goes to the end of cand_.
+  void offer(uint32_t v) {
+    if (v == kNoVertex) return;
+    for (const Candidate& c : cand_)
+      if (c.v == v) return;
+    cand_.push_back({v, 0, 0});
+  }
+  // A candidate: its vertex, closeness to the face's normal, and sort key
+  // (0-7 linked to the face's vertices so far, 8-15 not; plus closeness).
+  struct Candidate {
+    uint32_t v;
+    int close, key;
+  };
+  // The vertices made at each point, as a list in the order made: per point
+  // its first and last, per walk vertex the next and previous at its point.
+  std::vector<uint32_t> first_, last_, count_;
+  std::vector<uint32_t> later_, earlier_;
   const std::vector<uint32_t>& q_;
   std::vector<Normal> sum_;         // per walk vertex: its faces' normals summed
   std::vector<uint32_t> original_;  // per walk vertex: the one whose values it has
   Normal normal_;                   // the current face's
   Normal ref_;                      // what candidates are ranked by (refer)
   EdgeMap edge_;
-  EdgeMap linked_;               // vertex pairs an edge of a face so far joins (either way)
-  std::vector<uint32_t> taken_;  // the current face's vertices so far (refer)
-  std::vector<uint32_t> cand_, sorted_, order_;
-  std::vector<int> close_, rank_key_;
+  EdgeMap linked_;                   // vertex pairs an edge of a face so far joins (either way)
+  const uint32_t* taken_ = nullptr;  // the current face's vertices so far (refer)
+  uint32_t taken_count_ = 0;
+  std::vector<Candidate> cand_;   // in gather's order, then sorted
+  std::vector<uint32_t> sorted_;  // their vertices
+  int second_ = 6;
   int linked_first_ = 0;
   int best_ = 5;
   uint32_t across_next_ = kNoVertex, across_prev_ = kNoVertex;
@@ -419,7 +455,7 @@ std::string encode_split_layout(const Mesh& faces, uint32_t points, const std::v
   RangeEncoder e;
   const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
   SplitModels& m = *models;
-  SplitWalk walk(points, q);
+  SplitWalk walk(points, q, faces.indices.size());
   std::unordered_map<uint32_t, uint32_t> walk_of;  // input vertex -> walk vertex
   std::vector<uint32_t> input_of;                  // walk vertex -> input vertex
   std::vector<uint32_t> corner_walk(faces.indices.size());
@@ -484,9 +520,11 @@ Status decode_split_layout(std::string_view stream, uint64_t vertex_count, uint3
                            std::vector<uint32_t>& walk_point, std::vector<uint32_t>& walk_orig) {
   auto corrupt = [](const char* why) { return Status(ErrorCode::corrupt_data, std::string("split layout: ") + why); };
   RangeDecoder d(stream);
-  const std::unique_ptr<SplitModels> models = std::make_unique<SplitModels>();  // large: on the heap
+  // Default-initialized (not make_unique's value-initialization, which would
+  // zero every UIntModel's mantissa rows first: they are set up on first use).
+  const std::unique_ptr<SplitModels> models(new SplitModels);  // large: on the heap
   SplitModels& m = *models;
-  SplitWalk walk(points, q);
+  SplitWalk walk(points, q, faces.indices.size());
   std::vector<uint32_t> v;
   FaceEnds ends;
   CopyChoice choice;
