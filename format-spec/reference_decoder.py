@@ -3154,7 +3154,7 @@ GHOST = -1                      # §4.8: closes a border vertex's open fan
 class BatchModels:
     def __init__(self):
         self.flag = probs(16)
-        self.start = [UIntModel(2) for _ in range(32)]
+        self.rank = [[UIntModel(2) for _ in range(4)] for _ in range(32)]
         self.dist = [UIntModel(2) for _ in range(32)]
         self.residual = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
         self.border = [[SIntModel(3) for _ in range(3)] for _ in range(24)]
@@ -3178,6 +3178,37 @@ def plane_offset(level, qv, ring, nrm, order, e1, e2, qmax):
     mm = abs(n0)
     o = ((-t if n0 < 0 else t) + mm) // (2 * mm)
     return min(max(o, -qmax), qmax)
+
+
+def distance(a, b):
+    return math.sqrt(sum((float(a[k]) - float(b[k])) ** 2 for k in range(3)))
+
+
+def arc_order(level, qv, ring, dist):
+    """§4.8: the ring positions by the score of the arc of dist faces from each, best first."""
+    dd = len(ring)
+    length = [0.0 if r == GHOST else distance(level.q[r], qv) for r in ring]
+    total = 0.0
+    for i in range(dd):
+        if ring[i] != GHOST:
+            total += length[i]
+    mean = total / sum(1 for r in ring if r != GHOST)
+    inner = [1.5 * mean if ring[i] == GHOST else length[i] for i in range(dd)]
+    end = [mean if ring[i] == GHOST else length[i] for i in range(dd)]
+    prefix = [0.0]
+    for j in range(2 * dd):
+        prefix.append(prefix[-1] + inner[j % dd])
+    score = []
+    for ia in range(dd):
+        y, x = ring[ia], ring[(ia + dist) % dd]
+        if dist == 1:
+            s = 0.5 * mean if GHOST in (y, x) else distance(level.q[y], level.q[x])
+        else:
+            s = prefix[ia + dist] - prefix[ia + 1]
+        s -= 0.5 * end[ia]
+        s -= 0.5 * end[(ia + dist) % dd]
+        score.append(s)
+    return sorted(range(dd), key=lambda i: (-score[i], i))
 
 
 def decode_batch(payload, level, m):
@@ -3223,13 +3254,10 @@ def decode_batch(payload, level, m):
         dist = m.dist[ctx].decode(d) + 1
         if not 1 <= dist < dd:
             reject('split ring neighbours')
-        middle = m.start[ctx].decode(d)
-        if middle >= dd:
+        rank = m.rank[ctx][min(dist, 4) - 1].decode(d)
+        if rank >= dd:
             reject('split ring neighbours')
-        qv = level.q[v]
-        d2 = [sum((level.q[r][a] - qv[a]) ** 2 for a in range(3)) if r != GHOST else -1 for r in ring]
-        far = max(range(dd), key=lambda i: (d2[i], -i))
-        ia = (middle + far - dist // 2) % dd
+        ia = arc_order(level, level.q[v], ring, dist)[rank]
         arc = [ring[(ia + k) % dd] for k in range(dist + 1)]
         border = arc[0] == GHOST or arc[-1] == GHOST
         if border:                       # u on v's border: v and its border neighbour

@@ -30,7 +30,7 @@ using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 // triangles regular (where the quadric is flat, e.g. a scan's cut bottom),
 // which makes the splits' residuals smaller.
 constexpr double kRegularity = 0.1;
-constexpr double kLength = 0.005;
+constexpr double kLength = 0.02;
 // The weight of a border edge's plane (through the edge, across its face)
 // per squared edge length.
 constexpr double kBorderWeight = 1.0;

@@ -20,11 +20,12 @@ namespace tsm {
 constexpr int kFlagContexts = 16;
 constexpr int kScaleContexts = 24;
 constexpr int kRingContexts = 32;
+constexpr int kRankContexts = 4;
 
 struct BatchModels {
-  Prob flag[kFlagContexts];            // by ring size, closed then open
-  UIntModelT<2> start[kRingContexts];  // by ring size, closed then open
-  UIntModelT<2> dist[kRingContexts];   // by ring size, closed then open
+  Prob flag[kFlagContexts];                          // by ring size, closed then open
+  UIntModelT<2> rank[kRingContexts][kRankContexts];  // by ring size (closed, open), then min(dist, 4)
+  UIntModelT<2> dist[kRingContexts];                 // by ring size, closed then open
   SIntModelT<3> residual[kScaleContexts][3];
   SIntModelT<3> border[kScaleContexts][3];  // the new vertex on v's border
 };
@@ -46,22 +47,59 @@ int scale_context(const LevelMesh& level, uint32_t v, const std::vector<uint32_t
   return std::min(bit_length(static_cast<uint64_t>(span)), kScaleContexts - 1);
 }
 
-// The ring position of v's farthest neighbour (squared grid distance; ties
-// to the lower position): a collapse pulls v's ring out towards the removed
-// vertex, so the split's arc lies mostly around it.
-uint32_t farthest(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring) {
-  uint32_t best = 0;
-  uint64_t most = 0;
-  for (uint32_t i = 0; i < ring.size(); ++i) {
-    if (ring[i] == kGhost) continue;
-    uint64_t d2 = 0;
-    for (int a = 0; a < 3; ++a) {
-      const int64_t x = int64_t{level.q(ring[i])[a]} - int64_t{level.q(v)[a]};
-      d2 += static_cast<uint64_t>(x * x);
-    }
-    if (i == 0 || d2 > most) best = i, most = d2;
+double distance(const uint32_t* a, const uint32_t* b) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double x = static_cast<double>(a[k]) - static_cast<double>(b[k]);
+    s += x * x;
   }
-  return best;
+  return std::sqrt(s);
+}
+
+// The ring positions ia in the order the decoder ranks the arcs r_ia ..
+// r_{ia+dist} as a split's (FORMAT.md §4.8), likeliest first. A half-edge
+// collapse of u into v gave v the faces of u: the arc's inner vertices
+// were u's neighbours only, so they lie farther from v than the rest of
+// the ring, and its ends were neighbours of both (nearer). The score is
+// the inner vertices' distances from v (the ghost counting 1.5 times the
+// ring's mean distance m) less half the ends' (the ghost: m); for one face
+// (dist 1), the length of the edge opposite v (with the ghost: m / 2) less
+// the same. In binary64 in the order written; ties to the lower position.
+void arc_order(const LevelMesh& level, uint32_t v, const std::vector<uint32_t>& ring, uint32_t dist,
+               std::vector<uint32_t>& order) {
+  const size_t d = ring.size();
+  std::vector<double> len(d, 0.0);
+  double total = 0;
+  size_t real = 0;
+  for (size_t i = 0; i < d; ++i) {
+    if (ring[i] == kGhost) continue;
+    len[i] = distance(level.q(ring[i]), level.q(v));
+    total += len[i];
+    ++real;
+  }
+  const double mean = total / static_cast<double>(real);
+  std::vector<double> inner(d), end(d), prefix(2 * d + 1, 0.0);
+  for (size_t i = 0; i < d; ++i) {
+    inner[i] = ring[i] == kGhost ? 1.5 * mean : len[i];
+    end[i] = ring[i] == kGhost ? mean : len[i];
+  }
+  for (size_t j = 0; j < 2 * d; ++j) prefix[j + 1] = prefix[j] + inner[j % d];
+  std::vector<double> score(d);
+  for (size_t ia = 0; ia < d; ++ia) {
+    const uint32_t y = ring[ia], x = ring[(ia + dist) % d];
+    double s = 0;
+    if (dist == 1)
+      s = y == kGhost || x == kGhost ? 0.5 * mean : distance(level.q(y), level.q(x));
+    else
+      s = prefix[ia + dist] - prefix[ia + 1];
+    s -= 0.5 * end[ia];
+    s -= 0.5 * end[(ia + dist) % d];
+    score[ia] = s;
+  }
+  order.resize(d);
+  for (uint32_t i = 0; i < d; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return score[a] > score[b] || (score[a] == score[b] && a < b); });
 }
 
 bool open_ring(const std::vector<uint32_t>& ring) { return ring.back() == kGhost; }
@@ -340,7 +378,7 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     marked[i] = static_cast<uint8_t>(b);
     ones += static_cast<size_t>(b);
   }
-  std::vector<uint32_t> ids(n, 0);
+  std::vector<uint32_t> ids(n, 0), arcs;
   for (uint32_t v = 0; v < n; ++v) {
     if (!marked[v]) continue;
     const VertexSplit& s = *by_vertex[v];
@@ -351,7 +389,8 @@ Status encode_batch(LevelMesh& level, const std::vector<VertexSplit>& splits, st
     if (ia >= d || ix >= d || dist == 0) return Status(ErrorCode::internal, "progressive: a split off its ring");
     const uint32_t ctx = ring_context(ring);
     m->dist[ctx].encode(e, dist - 1);
-    m->start[ctx].encode(e, (ia + dist / 2 + d - farthest(level, v, ring)) % d);
+    arc_order(level, v, ring, dist, arcs);
+    m->rank[ctx][std::min<uint32_t>(dist, kRankContexts) - 1].encode(e, position_in(arcs, ia));
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
@@ -426,6 +465,7 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
   if (ones != splits) return corrupt("fewer split flags than the split count");
   const int64_t qmax = (int64_t{1} << level.bits()) - 1;
   uint64_t border_splits = 0;
+  std::vector<uint32_t> arcs;
   for (uint32_t v = 0; v < n; ++v) {
     if (!marked[v]) continue;
     level.ring(v, ring);
@@ -433,9 +473,10 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
     const uint32_t ctx = ring_context(ring);
     const uint32_t dist = m->dist[ctx].decode(dec) + 1;
     if (dist == 0 || dist >= d) return corrupt("a split's ring neighbours out of range");
-    const uint32_t middle = m->start[ctx].decode(dec);
-    if (middle >= d) return corrupt("a split's ring neighbours out of range");
-    const uint32_t ia = (middle + farthest(level, v, ring) + d - dist / 2) % d;
+    const uint32_t rank = m->rank[ctx][std::min<uint32_t>(dist, kRankContexts) - 1].decode(dec);
+    if (rank >= d) return corrupt("a split's ring neighbours out of range");
+    arc_order(level, v, ring, dist, arcs);
+    const uint32_t ia = arcs[rank];
     int64_t p[3];
     predict(level, v, ring, ia, dist, p);
     const int sc = scale_context(level, v, ring, ia, dist);
