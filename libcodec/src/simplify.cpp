@@ -278,14 +278,21 @@ class Simplifier {
   std::vector<std::vector<float>> cvalues_;                   // per corner attribute
   std::vector<std::vector<std::array<uint32_t, 3>>> cindex_;  // per corner attribute, per triangle
 
-  // The bound's state: pieces and which triangle holds each. A piece's bound
-  // and original triangle are also kept apart (the loops over every piece of
-  // a changed triangle read only those: fewer cache lines).
+  // The bound's state: pieces and which triangle holds each. A triangle's
+  // list holds each piece's original triangle and bound beside it (the loops
+  // over a changed triangle's pieces read only the list). A bound is kept
+  // relative to its holder's offset, and the holder keeps the largest: a
+  // triangle that moves by h with every piece still within E adds h to both,
+  // touching no piece.
+  struct PieceRef {
+    uint32_t piece, orig;
+    double delta;  // + tri_offset_[holder]: the piece's bound
+  };
   std::vector<Piece> pieces_;
-  std::vector<double> piece_delta_;
-  std::vector<uint32_t> piece_orig_;
-  std::vector<std::vector<uint32_t>> tri_pieces_;
+  std::vector<std::vector<PieceRef>> tri_pieces_;
+  std::vector<double> tri_offset_, tri_max_delta_;
   std::vector<uint32_t> free_pieces_;
+  void hold(uint32_t t, uint32_t piece, uint32_t orig, double delta);
 
   // Scratch of one attempt: the collapse u -> v at x.
   uint32_t cu_ = 0, cv_ = 0;
@@ -295,9 +302,15 @@ class Simplifier {
   // An attempt's assignments: pieces that stay whole (triangle, piece, its
   // new bound), parts of cut ones (triangle, part), the cut ones.
   struct Placed {
-    uint32_t t, piece;
+    uint32_t t, piece, orig;
     double delta;
   };
+  // Changed triangles whose pieces all stay, within E after the move by h.
+  struct Shift {
+    uint32_t t;
+    double h;
+  };
+  std::vector<Shift> shifted_;
   std::vector<Placed> placed_;
   std::vector<std::pair<uint32_t, Piece>> placed_new_;
   std::vector<uint32_t> cut_;
@@ -387,13 +400,12 @@ void Simplifier::build() {
   for (size_t t = 0; t < orig_.size(); ++t)
     longest_orig_edge_ =
         std::max(longest_orig_edge_, longest_edge(orig_.corner(t, 0), orig_.corner(t, 1), orig_.corner(t, 2)));
-  piece_delta_.assign(tri_.size(), 0.0);
-  piece_orig_.resize(tri_.size());
+  tri_offset_.assign(tri_.size(), 0.0);
+  tri_max_delta_.assign(tri_.size(), 0.0);
   for (uint32_t t = 0; t < tri_.size(); ++t) {
     for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
     pieces_[t].orig = t;
-    piece_orig_[t] = t;
-    tri_pieces_[t].push_back(t);
+    tri_pieces_[t].push_back({t, t, 0.0});
   }
 }
 
@@ -640,6 +652,7 @@ bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
   placed_.clear();
   placed_new_.clear();
   cut_.clear();
+  shifted_.clear();
   takers_.clear();
   tri_gen_ += 2;
   for (uint32_t t : changed) tri_mark_[t] = tri_gen_;
@@ -657,17 +670,22 @@ bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
       const Piece whole{{pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]]}, 0, 0, 0};
       h = std::sqrt(fit2(whole, takers_[self], e2_));
     }
-    for (uint32_t pi : tri_pieces_[t]) {
-      const double delta = piece_delta_[pi];
+    if (tri_max_delta_[t] + h <= e) {
+      shifted_.push_back({t, h});
+      continue;
+    }
+    for (const PieceRef& r : tri_pieces_[t]) {
+      const uint32_t pi = r.piece;
+      const double delta = r.delta + tri_offset_[t];
       if (delta + h <= e) {
-        placed_.push_back({t, pi, delta + h});
+        placed_.push_back({t, pi, r.orig, delta + h});
         continue;
       }
       const size_t before = placed_new_.size();
       if (!assign_piece(pieces_[pi])) return false;
       if (placed_new_.size() == before + 1 && placed_new_.back().second.depth == pieces_[pi].depth) {
         // Taken whole: the piece stays (with its new bound).
-        placed_.push_back({placed_new_.back().first, pi, placed_new_.back().second.delta});
+        placed_.push_back({placed_new_.back().first, pi, r.orig, placed_new_.back().second.delta});
         placed_new_.pop_back();
       } else {
         cut_.push_back(pi);
@@ -954,8 +972,8 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
   local_orig_.clear();
   ++orig_mark_gen_;
   for (size_t i = 0; any_local && i < changed_.size() && local_orig_.size() < 64; ++i)
-    for (uint32_t pi : tri_pieces_[changed_[i]]) {
-      const uint32_t o = piece_orig_[pi];
+    for (const PieceRef& r : tri_pieces_[changed_[i]]) {
+      const uint32_t o = r.orig;
       if (orig_mark_[o] == orig_mark_gen_) continue;
       if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
@@ -966,6 +984,14 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
         !within_original(new_tris_[i], new_err_[i]))
       return false;
   return assign_pieces(changed_);
+}
+
+// The piece to triangle t's list with the bound delta (relative to t's
+// offset; t's largest bound raised to what the list will read back).
+void Simplifier::hold(uint32_t t, uint32_t piece, uint32_t orig, double delta) {
+  const double rel = delta - tri_offset_[t];
+  tri_pieces_[t].push_back({piece, orig, rel});
+  tri_max_delta_[t] = std::max({tri_max_delta_[t], rel + tri_offset_[t], delta});
 }
 
 void Simplifier::commit(uint32_t u, uint32_t v) {
@@ -1039,11 +1065,19 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   // The pieces: the changed triangles' lists are rebuilt from placed_.
   if (bounded_) {
     for (size_t i = 0; i < new_tris_.size(); ++i) tri_err_[new_tris_[i]] = new_err_[i];
-    for (uint32_t t : changed_) tri_pieces_[t].clear();
-    for (const Placed& pl : placed_) {
-      piece_delta_[pl.piece] = pl.delta;
-      tri_pieces_[pl.t].push_back(pl.piece);
+    // Shifted triangles keep their lists (offset and largest bound + h); the
+    // other changed ones are refilled from placed_.
+    for (const Shift& sh : shifted_) {
+      tri_offset_[sh.t] += sh.h;
+      tri_max_delta_[sh.t] += sh.h;
     }
+    for (uint32_t t : changed_)
+      if (std::none_of(shifted_.begin(), shifted_.end(), [&](const Shift& sh) { return sh.t == t; })) {
+        tri_pieces_[t].clear();
+        tri_offset_[t] = 0;
+        tri_max_delta_[t] = 0;
+      }
+    for (const Placed& pl : placed_) hold(pl.t, pl.piece, pl.orig, pl.delta);
     for (uint32_t pi : cut_) free_pieces_.push_back(pi);
     for (const auto& [t, pc] : placed_new_) {
       uint32_t pi;
@@ -1051,15 +1085,11 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
         pi = free_pieces_.back();
         free_pieces_.pop_back();
         pieces_[pi] = pc;
-        piece_delta_[pi] = pc.delta;
-        piece_orig_[pi] = pc.orig;
       } else {
         pi = static_cast<uint32_t>(pieces_.size());
         pieces_.push_back(pc);
-        piece_delta_.push_back(pc.delta);
-        piece_orig_.push_back(pc.orig);
       }
-      tri_pieces_[t].push_back(pi);
+      hold(t, pi, pc.orig, pc.delta);
     }
   }
   ++collapses_;
