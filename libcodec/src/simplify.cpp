@@ -208,6 +208,9 @@ class Simplifier {
   Places placements(uint32_t a, uint32_t b, const Quadric& q) const;
   bool try_collapse(uint32_t u, uint32_t v);
   bool topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris);
+  // Scratch reused by every try (no allocation per collapse).
+  std::vector<uint32_t> edge_tris_, commit_edge_tris_, topo_nu_, topo_nv_, topo_opposite_, topo_common_;
+  std::vector<std::pair<uint32_t, uint32_t>> again_;
   bool attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris);
   void commit(uint32_t u, uint32_t v);
 
@@ -607,7 +610,8 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
         if (std::memcmp(val[0], val[1], n * sizeof(float)) != 0) return false;
       }
     }
-  std::vector<uint32_t> nu, nv, opposite;
+  std::vector<uint32_t>&nu = topo_nu_, &nv = topo_nv_, &opposite = topo_opposite_, &common = topo_common_;
+  nu.clear(), nv.clear(), opposite.clear(), common.clear();
   for (uint32_t t : vtris_[u])
     for (uint32_t w : tri_[t])
       if (w != u) nu.push_back(w);
@@ -621,7 +625,6 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
     std::sort(s->begin(), s->end());
     s->erase(std::unique(s->begin(), s->end()), s->end());
   }
-  std::vector<uint32_t> common;
   std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
   common.erase(std::remove_if(common.begin(), common.end(), [&](uint32_t w) { return w == u || w == v; }),
                common.end());
@@ -1029,7 +1032,8 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   // share one value. The corners that come to v take v's value on the edge
   // (v's value there is the same on both sides); when v moves (then v is not
   // on a seam either) every corner of v takes the interpolated value.
-  std::vector<uint32_t> edge_tris;
+  std::vector<uint32_t>& edge_tris = commit_edge_tris_;
+  edge_tris.clear();
   for (uint32_t t : vtris_[u])
     if (tri_[t][0] == v || tri_[t][1] == v || tri_[t][2] == v) edge_tris.push_back(t);
   const bool moved = !(cx_.x == pos_[v].x && cx_.y == pos_[v].y && cx_.z == pos_[v].z);
@@ -1112,7 +1116,8 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   refused_[u].clear();
   refused_[v].clear();
   push_edges_of(v);
-  std::vector<std::pair<uint32_t, uint32_t>> again;
+  std::vector<std::pair<uint32_t, uint32_t>>& again = again_;
+  again.clear();
   for (uint32_t t : vtris_[v])
     for (uint32_t w : tri_[t])
       if (w != v) {
@@ -1155,7 +1160,7 @@ Simplifier::Places Simplifier::placements(uint32_t a, uint32_t b, const Quadric&
 }
 
 bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
-  std::vector<uint32_t> edge_tris;
+  std::vector<uint32_t>& edge_tris = edge_tris_;
   if (!topology_ok(a, b, edge_tris)) return false;
   clear_near_cache();
   ring_ = vtris_[a];
