@@ -32,6 +32,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 
@@ -110,56 +111,69 @@ bool comes_before(const Candidate& a, const Candidate& b) {
 }
 
 // A 4-ary min-heap: half the levels of a binary one, the children of a
-// node side by side.
+// node side by side. The entries are placed so that each node's four
+// children fill one 64-byte cache line (entry 1 on a line boundary): one
+// miss per level of a heap far larger than the caches, not two.
 class CandidateHeap {
  public:
-  bool empty() const { return a_.empty(); }
-  size_t size() const { return a_.size(); }
+  bool empty() const { return n_ == 0; }
+  size_t size() const { return n_; }
   void push(const Candidate& c) {
-    size_t i = a_.size();
-    a_.push_back(c);
+    if (off_ + n_ + 1 > buf_.size()) grow();
+    Candidate* a = base_;
+    size_t i = n_++;
     while (i > 0) {
       const size_t parent = (i - 1) / 4;
-      if (!comes_before(c, a_[parent])) break;
-      a_[i] = a_[parent];
+      if (!comes_before(c, a[parent])) break;
+      a[i] = a[parent];
       i = parent;
     }
-    a_[i] = c;
+    a[i] = c;
   }
   Candidate pop() {
-    const Candidate top = a_[0];
-    const Candidate last = a_.back();
-    a_.pop_back();
-    if (!a_.empty()) sift_down(0, last);
+    const Candidate top = base_[0];
+    const Candidate last = base_[--n_];
+    if (n_ > 0) sift_down(0, last);
     return top;
   }
   // Keeps the entries `keep` accepts, then restores the heap order.
   template <typename Keep>
   void filter(Keep keep) {
-    a_.erase(std::remove_if(a_.begin(), a_.end(), [&](const Candidate& c) { return !keep(c); }), a_.end());
-    for (size_t i = a_.size() / 4 + 1; i-- > 0;)
-      if (i < a_.size()) sift_down(i, a_[i]);
+    n_ = static_cast<size_t>(std::remove_if(base_, base_ + n_, [&](const Candidate& c) { return !keep(c); }) - base_);
+    for (size_t i = n_ / 4 + 1; i-- > 0;)
+      if (i < n_) sift_down(i, base_[i]);
   }
 
  private:
+  void grow() {
+    std::vector<Candidate> b(std::max<size_t>(64, 2 * buf_.size()));
+    size_t off = 0;  // the vector's 16-byte alignment: entry off + 1 on a line within 4 steps
+    while (off < 3 && (reinterpret_cast<uintptr_t>(&b[off + 1]) & 63) != 0) ++off;
+    if (n_ > 0) std::copy(base_, base_ + n_, b.data() + off);
+    buf_.swap(b);
+    off_ = off;
+    base_ = buf_.data() + off_;
+  }
   void sift_down(size_t i, const Candidate c) {
-    const size_t n = a_.size();
+    Candidate* a = base_;
+    const size_t n = n_;
     for (;;) {
       const size_t first = 4 * i + 1;
       if (first >= n) break;
-      // The grandchildren's blocks, fetched while this level is compared
-      // (the heap is far larger than the caches: each level is a miss).
-      for (size_t k = 4 * first + 1; k < std::min(4 * first + 17, n); k += 4) __builtin_prefetch(&a_[k]);
+      // The grandchildren's lines, fetched while this level is compared.
+      for (size_t k = 4 * first + 1; k < std::min(4 * first + 17, n); k += 4) __builtin_prefetch(&a[k]);
       size_t best = first;
       for (size_t k = first + 1; k < std::min(first + 4, n); ++k)
-        if (comes_before(a_[k], a_[best])) best = k;
-      if (!comes_before(a_[best], c)) break;
-      a_[i] = a_[best];
+        if (comes_before(a[k], a[best])) best = k;
+      if (!comes_before(a[best], c)) break;
+      a[i] = a[best];
       i = best;
     }
-    a_[i] = c;
+    a[i] = c;
   }
-  std::vector<Candidate> a_;
+  std::vector<Candidate> buf_;
+  Candidate* base_ = nullptr;
+  size_t off_ = 0, n_ = 0;
 };
 
 class Simplifier {
@@ -194,6 +208,9 @@ class Simplifier {
   Places placements(uint32_t a, uint32_t b, const Quadric& q) const;
   bool try_collapse(uint32_t u, uint32_t v);
   bool topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge_tris);
+  // Scratch reused by every try (no allocation per collapse).
+  std::vector<uint32_t> edge_tris_, commit_edge_tris_, topo_nu_, topo_nv_, topo_opposite_, topo_common_;
+  std::vector<std::pair<uint32_t, uint32_t>> again_;
   bool attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris);
   void commit(uint32_t u, uint32_t v);
 
@@ -278,14 +295,21 @@ class Simplifier {
   std::vector<std::vector<float>> cvalues_;                   // per corner attribute
   std::vector<std::vector<std::array<uint32_t, 3>>> cindex_;  // per corner attribute, per triangle
 
-  // The bound's state: pieces and which triangle holds each. A piece's bound
-  // and original triangle are also kept apart (the loops over every piece of
-  // a changed triangle read only those: fewer cache lines).
+  // The bound's state: pieces and which triangle holds each. A triangle's
+  // list holds each piece's original triangle and bound beside it (the loops
+  // over a changed triangle's pieces read only the list). A bound is kept
+  // relative to its holder's offset, and the holder keeps the largest: a
+  // triangle that moves by h with every piece still within E adds h to both,
+  // touching no piece.
+  struct PieceRef {
+    uint32_t piece, orig;
+    double delta;  // + tri_offset_[holder]: the piece's bound
+  };
   std::vector<Piece> pieces_;
-  std::vector<double> piece_delta_;
-  std::vector<uint32_t> piece_orig_;
-  std::vector<std::vector<uint32_t>> tri_pieces_;
+  std::vector<std::vector<PieceRef>> tri_pieces_;
+  std::vector<double> tri_offset_, tri_max_delta_;
   std::vector<uint32_t> free_pieces_;
+  void hold(uint32_t t, uint32_t piece, uint32_t orig, double delta);
 
   // Scratch of one attempt: the collapse u -> v at x.
   uint32_t cu_ = 0, cv_ = 0;
@@ -295,9 +319,15 @@ class Simplifier {
   // An attempt's assignments: pieces that stay whole (triangle, piece, its
   // new bound), parts of cut ones (triangle, part), the cut ones.
   struct Placed {
-    uint32_t t, piece;
+    uint32_t t, piece, orig;
     double delta;
   };
+  // Changed triangles whose pieces all stay, within E after the move by h.
+  struct Shift {
+    uint32_t t;
+    double h;
+  };
+  std::vector<Shift> shifted_;
   std::vector<Placed> placed_;
   std::vector<std::pair<uint32_t, Piece>> placed_new_;
   std::vector<uint32_t> cut_;
@@ -387,13 +417,12 @@ void Simplifier::build() {
   for (size_t t = 0; t < orig_.size(); ++t)
     longest_orig_edge_ =
         std::max(longest_orig_edge_, longest_edge(orig_.corner(t, 0), orig_.corner(t, 1), orig_.corner(t, 2)));
-  piece_delta_.assign(tri_.size(), 0.0);
-  piece_orig_.resize(tri_.size());
+  tri_offset_.assign(tri_.size(), 0.0);
+  tri_max_delta_.assign(tri_.size(), 0.0);
   for (uint32_t t = 0; t < tri_.size(); ++t) {
     for (int k = 0; k < 3; ++k) pieces_[t].p[k] = pos_[tri_[t][k]];
     pieces_[t].orig = t;
-    piece_orig_[t] = t;
-    tri_pieces_[t].push_back(t);
+    tri_pieces_[t].push_back({t, t, 0.0});
   }
 }
 
@@ -581,7 +610,8 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
         if (std::memcmp(val[0], val[1], n * sizeof(float)) != 0) return false;
       }
     }
-  std::vector<uint32_t> nu, nv, opposite;
+  std::vector<uint32_t>&nu = topo_nu_, &nv = topo_nv_, &opposite = topo_opposite_, &common = topo_common_;
+  nu.clear(), nv.clear(), opposite.clear(), common.clear();
   for (uint32_t t : vtris_[u])
     for (uint32_t w : tri_[t])
       if (w != u) nu.push_back(w);
@@ -595,7 +625,6 @@ bool Simplifier::topology_ok(uint32_t u, uint32_t v, std::vector<uint32_t>& edge
     std::sort(s->begin(), s->end());
     s->erase(std::unique(s->begin(), s->end()), s->end());
   }
-  std::vector<uint32_t> common;
   std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
   common.erase(std::remove_if(common.begin(), common.end(), [&](uint32_t w) { return w == u || w == v; }),
                common.end());
@@ -640,6 +669,7 @@ bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
   placed_.clear();
   placed_new_.clear();
   cut_.clear();
+  shifted_.clear();
   takers_.clear();
   tri_gen_ += 2;
   for (uint32_t t : changed) tri_mark_[t] = tri_gen_;
@@ -657,17 +687,22 @@ bool Simplifier::assign_pieces(const std::vector<uint32_t>& changed) {
       const Piece whole{{pos_[tri_[t][0]], pos_[tri_[t][1]], pos_[tri_[t][2]]}, 0, 0, 0};
       h = std::sqrt(fit2(whole, takers_[self], e2_));
     }
-    for (uint32_t pi : tri_pieces_[t]) {
-      const double delta = piece_delta_[pi];
+    if (tri_max_delta_[t] + h <= e) {
+      shifted_.push_back({t, h});
+      continue;
+    }
+    for (const PieceRef& r : tri_pieces_[t]) {
+      const uint32_t pi = r.piece;
+      const double delta = r.delta + tri_offset_[t];
       if (delta + h <= e) {
-        placed_.push_back({t, pi, delta + h});
+        placed_.push_back({t, pi, r.orig, delta + h});
         continue;
       }
       const size_t before = placed_new_.size();
       if (!assign_piece(pieces_[pi])) return false;
       if (placed_new_.size() == before + 1 && placed_new_.back().second.depth == pieces_[pi].depth) {
         // Taken whole: the piece stays (with its new bound).
-        placed_.push_back({placed_new_.back().first, pi, placed_new_.back().second.delta});
+        placed_.push_back({placed_new_.back().first, pi, r.orig, placed_new_.back().second.delta});
         placed_new_.pop_back();
       } else {
         cut_.push_back(pi);
@@ -954,8 +989,8 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
   local_orig_.clear();
   ++orig_mark_gen_;
   for (size_t i = 0; any_local && i < changed_.size() && local_orig_.size() < 64; ++i)
-    for (uint32_t pi : tri_pieces_[changed_[i]]) {
-      const uint32_t o = piece_orig_[pi];
+    for (const PieceRef& r : tri_pieces_[changed_[i]]) {
+      const uint32_t o = r.orig;
       if (orig_mark_[o] == orig_mark_gen_) continue;
       if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
@@ -966,6 +1001,14 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
         !within_original(new_tris_[i], new_err_[i]))
       return false;
   return assign_pieces(changed_);
+}
+
+// The piece to triangle t's list with the bound delta (relative to t's
+// offset; t's largest bound raised to what the list will read back).
+void Simplifier::hold(uint32_t t, uint32_t piece, uint32_t orig, double delta) {
+  const double rel = delta - tri_offset_[t];
+  tri_pieces_[t].push_back({piece, orig, rel});
+  tri_max_delta_[t] = std::max({tri_max_delta_[t], rel + tri_offset_[t], delta});
 }
 
 void Simplifier::commit(uint32_t u, uint32_t v) {
@@ -989,7 +1032,8 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   // share one value. The corners that come to v take v's value on the edge
   // (v's value there is the same on both sides); when v moves (then v is not
   // on a seam either) every corner of v takes the interpolated value.
-  std::vector<uint32_t> edge_tris;
+  std::vector<uint32_t>& edge_tris = commit_edge_tris_;
+  edge_tris.clear();
   for (uint32_t t : vtris_[u])
     if (tri_[t][0] == v || tri_[t][1] == v || tri_[t][2] == v) edge_tris.push_back(t);
   const bool moved = !(cx_.x == pos_[v].x && cx_.y == pos_[v].y && cx_.z == pos_[v].z);
@@ -1039,11 +1083,19 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   // The pieces: the changed triangles' lists are rebuilt from placed_.
   if (bounded_) {
     for (size_t i = 0; i < new_tris_.size(); ++i) tri_err_[new_tris_[i]] = new_err_[i];
-    for (uint32_t t : changed_) tri_pieces_[t].clear();
-    for (const Placed& pl : placed_) {
-      piece_delta_[pl.piece] = pl.delta;
-      tri_pieces_[pl.t].push_back(pl.piece);
+    // Shifted triangles keep their lists (offset and largest bound + h); the
+    // other changed ones are refilled from placed_.
+    for (const Shift& sh : shifted_) {
+      tri_offset_[sh.t] += sh.h;
+      tri_max_delta_[sh.t] += sh.h;
     }
+    for (uint32_t t : changed_)
+      if (std::none_of(shifted_.begin(), shifted_.end(), [&](const Shift& sh) { return sh.t == t; })) {
+        tri_pieces_[t].clear();
+        tri_offset_[t] = 0;
+        tri_max_delta_[t] = 0;
+      }
+    for (const Placed& pl : placed_) hold(pl.t, pl.piece, pl.orig, pl.delta);
     for (uint32_t pi : cut_) free_pieces_.push_back(pi);
     for (const auto& [t, pc] : placed_new_) {
       uint32_t pi;
@@ -1051,15 +1103,11 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
         pi = free_pieces_.back();
         free_pieces_.pop_back();
         pieces_[pi] = pc;
-        piece_delta_[pi] = pc.delta;
-        piece_orig_[pi] = pc.orig;
       } else {
         pi = static_cast<uint32_t>(pieces_.size());
         pieces_.push_back(pc);
-        piece_delta_.push_back(pc.delta);
-        piece_orig_.push_back(pc.orig);
       }
-      tri_pieces_[t].push_back(pi);
+      hold(t, pi, pc.orig, pc.delta);
     }
   }
   ++collapses_;
@@ -1068,7 +1116,8 @@ void Simplifier::commit(uint32_t u, uint32_t v) {
   refused_[u].clear();
   refused_[v].clear();
   push_edges_of(v);
-  std::vector<std::pair<uint32_t, uint32_t>> again;
+  std::vector<std::pair<uint32_t, uint32_t>>& again = again_;
+  again.clear();
   for (uint32_t t : vtris_[v])
     for (uint32_t w : tri_[t])
       if (w != v) {
@@ -1111,7 +1160,7 @@ Simplifier::Places Simplifier::placements(uint32_t a, uint32_t b, const Quadric&
 }
 
 bool Simplifier::try_collapse(uint32_t a, uint32_t b) {
-  std::vector<uint32_t> edge_tris;
+  std::vector<uint32_t>& edge_tris = edge_tris_;
   if (!topology_ok(a, b, edge_tris)) return false;
   clear_near_cache();
   ring_ = vtris_[a];

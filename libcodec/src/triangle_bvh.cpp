@@ -88,6 +88,18 @@ TriangleBvh::TriangleBvh(const TriangleSet& set) : set_(set) {
   build(0, 0, static_cast<uint32_t>(n), centroid, box);
   leaf_box_.resize(n);
   for (size_t i = 0; i < n; ++i) leaf_box_[i] = box[order_[i]];
+  float_corners_.resize(9 * n);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 c = set.corner(order_[i], k);
+      const float f[3] = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
+      if (f[0] != c.x || f[1] != c.y || f[2] != c.z) {
+        float_corners_.clear();  // not exact as floats: the doubles are read instead
+        float_corners_.shrink_to_fit();
+        return;
+      }
+      for (int a = 0; a < 3; ++a) float_corners_[9 * i + 3 * k + a] = f[a];
+    }
 }
 
 // A float box holding the double triangle: each bound rounded outwards once.
@@ -164,9 +176,8 @@ int64_t TriangleBvh::nearest(Vec3 p, double& dist2, int64_t hint) const {
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
         if (box_dist2(leaf_box_[i], p) >= dist2) continue;  // cheaper than the exact distance
-        const uint32_t t = order_[i];
-        const double d2 = point_triangle_dist2(p, set_.corner(t, 0), set_.corner(t, 1), set_.corner(t, 2));
-        if (d2 < dist2) dist2 = d2, best = t;
+        const double d2 = leaf_dist2(i, p);
+        if (d2 < dist2) dist2 = d2, best = order_[i];
       }
       continue;
     }

@@ -69,10 +69,24 @@ class TriangleBvh {
   static double box_dist2(const Node& n, Vec3 p) { return box_dist2(n.lo, n.hi, p); }
   static double box_dist2(const Box& b, Vec3 p) { return box_dist2(b.lo, b.hi, p); }
 
+  // The distance to the triangle at position i of order_.
+  double leaf_dist2(uint32_t i, Vec3 p) const {
+    if (!float_corners_.empty()) {
+      const float* c = &float_corners_[9 * static_cast<size_t>(i)];
+      return point_triangle_dist2(p, {c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]});
+    }
+    const uint32_t t = order_[i];
+    return point_triangle_dist2(p, set_.corner(t, 0), set_.corner(t, 1), set_.corner(t, 2));
+  }
+
   const TriangleSet& set_;
   std::vector<Node> nodes_;
   std::vector<uint32_t> order_;
   std::vector<Box> leaf_box_;  // per position in order_: its triangle's box
+  // Per position in order_: its triangle's corners as floats, side by side
+  // (a leaf's triangles in one or two cache lines, not through the point
+  // indices); empty when a corner is not exactly a float (then set_ is read).
+  std::vector<float> float_corners_;
 };
 
 template <typename F>
