@@ -451,7 +451,15 @@ FileResult encode_one(const EncodeArgs& a, const Job& j, MeshFormat forced, Phas
     mesh = std::move(small);
   }
 
-  if (a.drop_attributes) mesh.attributes.clear();
+  if (a.drop_attributes) {
+    // A glTF document kept for the way back (metadata "gltf") names the
+    // attributes it had: without them it cannot be rebuilt, so it goes too
+    // and the decoded mesh is written as a plain mesh in any format.
+    mesh.attributes.clear();
+    mesh.metadata.erase(std::remove_if(mesh.metadata.begin(), mesh.metadata.end(),
+                                       [](const MetadataEntry& e) { return e.key == "gltf"; }),
+                        mesh.metadata.end());
+  }
   phase.set("encoding");
   sw.reset();
   EncodeOptions eo;
