@@ -1,11 +1,30 @@
 #include "test_util.hpp"
 
+#include "tsm/tsm.hpp"
+
 #include <atomic>
 #include <cctype>
 #include <cstdlib>
 #include <random>
 
 namespace tsm_test {
+
+int refused_flips(const std::string& bytes, size_t stride, int mask, size_t from) {
+  int refused = 0;
+  for (size_t i = from; i < bytes.size(); i += stride) {
+    std::string bad = bytes;
+    bad[i] = static_cast<char>(bad[i] ^ mask);
+    tsm::Mesh out;
+    const tsm::Status s = tsm::decode(bad, out);
+    if (!s.ok()) {
+      EXPECT_FALSE(s.message().empty()) << "byte " << i;
+      ++refused;
+    } else {
+      EXPECT_TRUE(out.valid()) << "byte " << i;
+    }
+  }
+  return refused;
+}
 
 bool running_in_ci() {
   const char* ci = std::getenv("CI");

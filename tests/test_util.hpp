@@ -46,6 +46,11 @@ bool running_in_ci();
 // "corpus not found at DIR (...how to provide it)".
 std::string corpus_missing_message();
 
+// Decodes `bytes` with every `stride`-th byte from `from` on XORed with
+// `mask`, one at a time: each decode must fail with a message or give a
+// valid mesh. Returns how many were refused.
+int refused_flips(const std::string& bytes, size_t stride, int mask, size_t from = 0);
+
 // The bits of a float and back, for bit-exact comparisons.
 inline uint32_t bits(float x) {
   uint32_t b;

@@ -22,6 +22,8 @@ using namespace tsm_test;
 
 namespace {
 
+using tsm_test::refused_flips;
+
 Attribute vertex_attribute(const std::string& name, AttributeKind kind, uint32_t comps) {
   Attribute a;
   a.name = name;
@@ -30,6 +32,27 @@ Attribute vertex_attribute(const std::string& name, AttributeKind kind, uint32_t
   a.type = AttributeType::f32;
   a.components = comps;
   return a;
+}
+
+// The mesh with every face's corners as vertices of their own (glTF without
+// indices): positions and the first attribute's values copied per corner.
+Mesh unindexed(const Mesh& indexed) {
+  const Attribute& src = indexed.attributes[0];
+  Mesh soup;
+  Attribute a = vertex_attribute(src.name, src.kind, src.components);
+  for (uint32_t f = 0; f < indexed.face_count(); ++f) {
+    uint32_t c[3];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t v = indexed.face(f)[k];
+      c[k] = static_cast<uint32_t>(soup.vertex_count());
+      soup.add_vertex(indexed.positions[3 * size_t{v}], indexed.positions[3 * size_t{v} + 1],
+                      indexed.positions[3 * size_t{v} + 2]);
+      for (uint32_t j = 0; j < src.components; ++j) a.values.push_back(src.values[src.components * size_t{v} + j]);
+    }
+    soup.add_triangle(c[0], c[1], c[2]);
+  }
+  soup.attributes = {a};
+  return soup;
 }
 
 // A sphere with spherical UVs per vertex and a seam: the faces on one side
@@ -127,20 +150,7 @@ TEST(Welding, UnindexedSmoothSphereCostsAboutTheIndexedOne) {
   for (size_t v = 0; v < indexed.vertex_count(); ++v)
     for (int a = 0; a < 3; ++a) n.values.push_back(indexed.positions[3 * v + a]);
   indexed.attributes = {n};
-  Mesh soup;
-  Attribute sn = vertex_attribute("normal", AttributeKind::normal, 3);
-  for (uint32_t f = 0; f < indexed.face_count(); ++f) {
-    uint32_t c[3];
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t v = indexed.face(f)[k];
-      c[k] = static_cast<uint32_t>(soup.vertex_count());
-      soup.add_vertex(indexed.positions[3 * size_t{v}], indexed.positions[3 * size_t{v} + 1],
-                      indexed.positions[3 * size_t{v} + 2]);
-      for (int a = 0; a < 3; ++a) sn.values.push_back(n.values[3 * size_t{v} + a]);
-    }
-    soup.add_triangle(c[0], c[1], c[2]);
-  }
-  soup.attributes = {sn};
+  const Mesh soup = unindexed(indexed);
   const size_t a = expect_exact(indexed, "indexed sphere").size();
   const size_t b = expect_exact(soup, "unindexed sphere").size();
   EXPECT_LT(b, a + a / 4) << "indexed " << a << ", unindexed " << b;
@@ -453,25 +463,6 @@ TEST(IndexedCorners, RanksKeepCoincidingValuesAndPointsApart) {
 
 namespace {
 
-// Decodes `bytes` with every `stride`-th byte XORed with `mask`, one at a
-// time: each decode must fail with a message or give a valid mesh. Returns
-// how many were refused.
-int refused_flips(const std::string& bytes, size_t stride, int mask) {
-  int refused = 0;
-  for (size_t i = 0; i < bytes.size(); i += stride) {
-    std::string bad = bytes;
-    bad[i] = static_cast<char>(bad[i] ^ mask);
-    Mesh out;
-    const Status s = decode(bad, out);
-    if (!s.ok()) {
-      EXPECT_FALSE(s.message().empty());
-      ++refused;
-    } else {
-      EXPECT_TRUE(out.valid());
-    }
-  }
-  return refused;
-}
 
 }  // namespace
 
@@ -692,20 +683,7 @@ TEST(IndexedCorners, PointRanksFollowTheirNeighbours) {
 // counts say every corner is a vertex of its own).
 TEST(Welding, UnindexedTexturedMeshCopiesAcrossItsEdges) {
   const Mesh indexed = uv_seam_sphere(3);
-  Mesh soup;
-  Attribute st = vertex_attribute("texcoord", AttributeKind::texcoord, 2);
-  for (uint32_t f = 0; f < indexed.face_count(); ++f) {
-    uint32_t c[3];
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t v = indexed.face(f)[k];
-      c[k] = static_cast<uint32_t>(soup.vertex_count());
-      soup.add_vertex(indexed.positions[3 * size_t{v}], indexed.positions[3 * size_t{v} + 1],
-                      indexed.positions[3 * size_t{v} + 2]);
-      for (int a = 0; a < 2; ++a) st.values.push_back(indexed.attributes[0].values[2 * size_t{v} + a]);
-    }
-    soup.add_triangle(c[0], c[1], c[2]);
-  }
-  soup.attributes = {st};
+  const Mesh soup = unindexed(indexed);
   const size_t a = expect_exact(indexed, "indexed sphere").size();
   const std::string b = expect_exact(soup, "unindexed sphere");
   std::printf("indexed %zu bytes, unindexed %zu\n", a, b.size());
