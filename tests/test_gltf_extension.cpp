@@ -161,6 +161,19 @@ std::string floats(const std::vector<float>& v) {
   return std::string(reinterpret_cast<const char*>(v.data()), v.size() * 4);
 }
 
+// A POSITION accessor with the min and max glTF requires.
+size_t add_positions(json& doc, std::string& bin, const std::vector<float>& p, size_t vertices) {
+  std::vector<float> pmin(3, 1e9f), pmax(3, -1e9f);
+  for (size_t i = 0; i < p.size(); ++i) {
+    pmin[i % 3] = std::min(pmin[i % 3], p[i]);
+    pmax[i % 3] = std::max(pmax[i % 3], p[i]);
+  }
+  const size_t pos = add_accessor(doc, bin, floats(p), 5126, "VEC3", vertices, 34962);
+  doc["accessors"][pos]["min"] = pmin;
+  doc["accessors"][pos]["max"] = pmax;
+  return pos;
+}
+
 Source make_source() {
   Source s;
   const tsm::Mesh sphere = tsm_test::icosphere(3);
@@ -189,14 +202,7 @@ Source make_source() {
               {"accessors", json::array()},
               {"bufferViews", json::array()}};
   std::string bin;
-  std::vector<float> pmin(3, 1e9f), pmax(3, -1e9f);
-  for (size_t i = 0; i < s.positions.size(); ++i) {
-    pmin[i % 3] = std::min(pmin[i % 3], s.positions[i]);
-    pmax[i % 3] = std::max(pmax[i % 3], s.positions[i]);
-  }
-  const size_t pos = add_accessor(doc, bin, floats(s.positions), 5126, "VEC3", s.vertices, 34962);
-  doc["accessors"][pos]["min"] = pmin;
-  doc["accessors"][pos]["max"] = pmax;
+  const size_t pos = add_positions(doc, bin, s.positions, s.vertices);
   const size_t nor = add_accessor(doc, bin, floats(s.normals), 5126, "VEC3", s.vertices, 34962);
   const size_t uv = add_accessor(doc, bin, floats(s.uvs), 5126, "VEC2", s.vertices, 34962);
   // JOINTS_0 numbers the vertices (exact integers): the test's vertex map.
@@ -517,14 +523,7 @@ SharedSource make_shared_source(bool with_target, bool zero_target = false) {
               {"scenes", {{{"nodes", {0, 1}}}}}, {"nodes", {{{"mesh", 0}}, {{"mesh", 1}}}},
               {"accessors", json::array()},      {"bufferViews", json::array()}};
   std::string bin;
-  std::vector<float> pmin(3, 1e9f), pmax(3, -1e9f);
-  for (size_t i = 0; i < s.positions.size(); ++i) {
-    pmin[i % 3] = std::min(pmin[i % 3], s.positions[i]);
-    pmax[i % 3] = std::max(pmax[i % 3], s.positions[i]);
-  }
-  const size_t pos = add_accessor(doc, bin, floats(s.positions), 5126, "VEC3", s.vertices, 34962);
-  doc["accessors"][pos]["min"] = pmin;
-  doc["accessors"][pos]["max"] = pmax;
+  const size_t pos = add_positions(doc, bin, s.positions, s.vertices);
   const size_t nor = add_accessor(doc, bin, floats(normals), 5126, "VEC3", s.vertices, 34962);
   const size_t id = add_accessor(doc, bin, ids, 5123, "SCALAR", s.vertices, 34962);
   auto indices = [&](const std::vector<uint32_t>& t) {
