@@ -356,8 +356,7 @@ struct Coder {
   // branches are compiled out (the fast levels' gate predictor).
   // kLattice false: the caller knows no axis has lattice planes.
   bool plain() const {
-    return !tangent && !mix && !spread_ctx && lattice.values[0].empty() && lattice.values[1].empty() &&
-           lattice.values[2].empty();
+    return !tangent && !mix && !spread_ctx && lattice.empty();
   }
   // Encoder, after vertex v is coded without the tangent step: the sample
   // vertex() collects with the tangent step on the axis nearest `normal`
@@ -950,7 +949,7 @@ struct FanTableDecoder {
         q(qs),
         last(last_),
         last_act(last_act_),
-        lattice(!(c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty())) {}
+        lattice(!c.lattice.empty()) {}
   uint32_t known(uint32_t h) const {
     const uint32_t v = cv[h];
     return v != kNone && act[v] != kUnknown ? v : kNone;
@@ -1124,7 +1123,7 @@ bool code_march_order(const GeometryLayout& g, bool multi, Coder& c, Sink& s, st
     }
   }
   if constexpr (std::is_same_v<Sink, TableDecodeSink>) {
-    const bool no_lattice = c.lattice.values[0].empty() && c.lattice.values[1].empty() && c.lattice.values[2].empty();
+    const bool no_lattice = c.lattice.empty();
     if (!multi && !c.tangent && !c.mix && !c.spread_ctx) {
       if (!(no_lattice ? decode_gate_tables<false>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)
                        : decode_gate_tables<true>(g, c, s, q, first.get(), nfirst, sc.last, sc.last_act)))
@@ -1934,7 +1933,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
     // Shared coordinate planes: keep them where they make the file smaller
     // (all candidate axes at once, then at high levels each axis alone).
     const Lattice& found = *candidate;
-    if (!found.values[0].empty() || !found.values[1].empty() || !found.values[2].empty()) {
+    if (!found.empty()) {
       consider(st.predictor, 0, found, weights);
       if (level >= 8)
         for (int a = 0; a < 3; ++a) {
@@ -1969,9 +1968,8 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // parts: 2CylinderEngine's 8,618-vertex primitives, 3% smaller with it);
   // on the scans it won nowhere (5-10% larger than the surface predictors)
   // and costs a pass of its own for the weights.
-  const bool planes = !st.lattice.values[0].empty() || !st.lattice.values[1].empty() || !st.lattice.values[2].empty();
-  int32_t gate_lsq[3], gate_est[3];
-  if (level >= 3 && (adaptive_search || planes)) {
+    int32_t gate_lsq[3], gate_est[3];
+  if (level >= 3 && (adaptive_search || !st.lattice.empty())) {
     fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est, &order);
     consider(Predictor::gate, 0, st.lattice, gate_est);
   }
@@ -1994,7 +1992,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
       if (2 * vals.size() <= g.vertex_count) shared.values[a] = vals;
       vals.resize(g.vertex_count);
     }
-    if (!shared.values[0].empty() || !shared.values[1].empty() || !shared.values[2].empty()) {
+    if (!shared.empty()) {
       for (Predictor pred : {Predictor::gate, Predictor::parallelograms}) consider(pred, 0, shared, nullptr);
       consider(Predictor::raw, 0, shared, nullptr);
     }

@@ -67,6 +67,7 @@ constexpr int kMixLevel = 7;
 // planes of a marching-cubes surface, a CAD grid); empty when not used.
 struct Lattice {
   std::vector<uint32_t> values[3];
+  bool empty() const { return values[0].empty() && values[1].empty() && values[2].empty(); }
 };
 
 struct GeometryStats {
