@@ -1,8 +1,14 @@
 #!/usr/bin/env bash
-# Builds the tsm decoder for the browser: build/web/tsm_decoder.{js,wasm}
-# (emscripten glue + WebAssembly), from the sources of the native decoder
-# library (libcodec/decoder_sources.txt, CMake's tsm_decoder), with emcc
-# directly (no CMake).
+# Builds the tsm decoder for the browser, from the sources of the native
+# decoder library (libcodec/decoder_sources.txt, CMake's tsm_decoder), with
+# emcc directly (no CMake), as two modules (emscripten glue + WebAssembly):
+#   build/web/tsm_decoder.{js,wasm}       the core, what tsm.js loads first: every
+#                                         path the encoder's default files take
+#   build/web/tsm_decoder_full.{js,wasm}  every path: progressive batches, keep-order
+#                                         and zstd-coded sections besides; tsm.js
+#                                         loads it when a file needs one of them
+# The core links web/core_stubs.cpp instead of CORE_OMITS and zstd's
+# decompressor: each stub refuses and raises a flag tsm.js reads.
 #
 #   web/build.sh            # needs emcc (Debian: apt-get install emscripten node-acorn)
 #   TSM_WEB_DEBUG=1 web/build.sh   # -O1 -g, assertions on
@@ -156,7 +162,21 @@ done
 for f in "${ZSTD_FILES[@]}"; do
   o="$OBJ/z_$(basename "${f%.c}").o"; OBJS+=("$o"); run "$f" "$o" "${OPT[@]}" "${COLD[@]}" "${ZSTD_CFLAGS[@]}" "${ZSTD_INC[@]}"
 done
+# The core module's stand-ins (web/core_stubs.cpp).
+STUBS_O="$OBJ/web_core_stubs.o"
+run "$ROOT/web/core_stubs.cpp" "$STUBS_O" "${CXXFLAGS[@]}" "${COLD[@]}"
 for p in "${pids[@]}"; do wait "$p"; done
+# The core leaves out the sources of progressive batches and keep-order, and
+# zstd's decompressor (z_*.o; in the stub build, zstd_stub.c).
+CORE_OMITS="progressive_split.cpp order_coding.cpp"
+CORE_OBJS=()
+for o in "${OBJS[@]}"; do
+  b="$(basename "$o" .o)"
+  case "$b" in z_*) continue ;; esac
+  case " $CORE_OMITS " in *" ${b#lib_}.cpp "*) continue ;; esac
+  CORE_OBJS+=("$o")
+done
+CORE_OBJS+=("$STUBS_O")
 
 # ---- link ----------------------------------------------------------------------
 EXPORTS="_malloc,_free,_tsm_decode,_tsm_mesh_vertex_count,_tsm_mesh_face_count,_tsm_mesh_index_count"
@@ -184,14 +204,20 @@ fi
 # ms, dragon res2 55.2 -> 49.8, bunny unchanged).
 LINK_TUNE=(-sBINARYEN_EXTRA_PASSES=--one-caller-inline-max-function-size=500)
 [ "${TSM_WEB_DEBUG:-0}" = 1 ] && LINK_TUNE=()
-emcc "${LOPT[@]}" "${LINK_TUNE[@]}" "${OBJS[@]}" -o "$OUT/tsm_decoder.js" \
-  -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTsmModule \
-  -sENVIRONMENT=web,worker -sFILESYSTEM=0 \
-  -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB -sINITIAL_MEMORY=16MB -sMALLOC=emmalloc \
-  -sEXPORTED_FUNCTIONS="$EXPORTS" -sEXPORTED_RUNTIME_METHODS=[] \
-  -sINCOMING_MODULE_JS_API=[wasmBinary,locateFile,instantiateWasm,print,printErr,onAbort] \
-  -sTEXTDECODER=2 -sDYNAMIC_EXECUTION=0
-echo "web/build.sh: built $OUT/tsm_decoder.js + tsm_decoder.wasm ($(stat -c %s "$OUT/tsm_decoder.wasm") bytes wasm, $(stat -c %s "$OUT/tsm_decoder.js") bytes js)"
+link() {  # output.js exports objects...
+  local out="$1" exports="$2"; shift 2
+  emcc "${LOPT[@]}" "${LINK_TUNE[@]}" "$@" -o "$out" \
+    -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTsmModule \
+    -sENVIRONMENT=web,worker -sFILESYSTEM=0 \
+    -sALLOW_MEMORY_GROWTH=1 -sMAXIMUM_MEMORY=4GB -sINITIAL_MEMORY=16MB -sMALLOC=emmalloc \
+    -sEXPORTED_FUNCTIONS="$exports" -sEXPORTED_RUNTIME_METHODS=[] \
+    -sINCOMING_MODULE_JS_API=[wasmBinary,locateFile,instantiateWasm,print,printErr,onAbort] \
+    -sTEXTDECODER=2 -sDYNAMIC_EXECUTION=0
+  local w="${out%.js}.wasm"
+  echo "web/build.sh: built $out + $(basename "$w") ($(stat -c %s "$w") bytes wasm, $(stat -c %s "$out") bytes js)"
+}
+link "$OUT/tsm_decoder_full.js" "$EXPORTS" "${OBJS[@]}"
+link "$OUT/tsm_decoder.js" "$EXPORTS,_tsm_web_core_refused" "${CORE_OBJS[@]}"
 # The JS API and the three.js plugin beside the glue: build/web/ is the folder a site serves.
 cp "$ROOT/web/tsm.js" "$ROOT/web/tsm-worker.js" "$ROOT/web/gltf-tsm-extension.js" "$OUT/"
 STREAMING=false

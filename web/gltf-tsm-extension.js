@@ -146,14 +146,10 @@ export class GLTFTsmExtension {
     }
     const key = String(o.wasmUrl || '');
     const decoder = this.decoder || shared(decoders, key, () => loadTsm(o.wasmUrl ? { wasmUrl: o.wasmUrl } : {}));
-    return decoder.then((d) => {
-      try {
-        return d.decode(bytes, o.decodeOptions);
-      } catch (e) {
-        if (d.dead && decoders.get(key) === decoder) decoders.delete(key); // aborted (out of memory): a new one next time
-        throw e;
-      }
-    });
+    return decoder.then((d) => d.decodeAsync(bytes, o.decodeOptions).catch((e) => {
+      if (d.dead && decoders.get(key) === decoder) decoders.delete(key); // aborted (out of memory): a new one next time
+      throw e;
+    }));
   }
 }
 

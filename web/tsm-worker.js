@@ -53,7 +53,7 @@ self.onmessage = (e) => {
       let dec = null;
       try {
         dec = await decoder(msg.wasmUrl);
-        const mesh = dec.decode(msg.bytes, msg.decodeOptions);
+        const mesh = await dec.decodeAsync(msg.bytes, msg.decodeOptions);
         self.postMessage({ type: 'mesh', id: msg.id, mesh }, buffersOf(mesh));
       } catch (err) {
         if (dec && dec.dead) decoderReady = null; // the module aborted (out of memory): load a new one next time
@@ -69,10 +69,10 @@ self.onmessage = (e) => {
         const dec = await decoder(msg.wasmUrl);
         stream = dec.createStream(msg.decodeOptions);
       } else if (msg.type === 'chunk') {
-        if (stream) send(stream.feed(msg.bytes));
+        if (stream) send(await stream.feedAsync(msg.bytes));
       } else if (msg.type === 'end') {
         if (stream) {
-          send(stream.finish());
+          send(await stream.finishAsync());
           stream.free();
           stream = null;
           self.postMessage({ type: 'done', id: runId });

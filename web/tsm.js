@@ -60,6 +60,14 @@
 // string, UTF-8), value (Uint8Array) }] on a decoded mesh; in a stream, the
 // whole list on the piece where it first appears (that piece may have no
 // vertices or faces), else absent.
+//
+// Two modules: tsm_decoder.wasm, the core that loadTsm() loads, decodes what
+// the encoder writes by default; tsm_decoder_full.wasm adds the paths files
+// rarely need (progressive batches, keep-order, zstd-coded sections) and is
+// loaded only when a file needs one of them: decodeAsync, decodeStream and
+// the worker functions load it by themselves; decode() (synchronous) throws
+// a TsmError with needsFull set unless loadFull() has been awaited before
+// (or loadTsm({ full: true }) was called).
 import createTsmModule from './tsm_decoder.js';
 
 const ERR_SIZE = 512;
@@ -85,24 +93,39 @@ export class TsmError extends Error {
 }
 
 const DEFAULT_WASM = new URL('./tsm_decoder.wasm', import.meta.url).href;
+const DEFAULT_FULL_WASM = new URL('./tsm_decoder_full.wasm', import.meta.url).href;
 
-/** Loads the WebAssembly decoder. options: { wasmUrl, wasmBinary } (wasmBinary, an
- *  ArrayBuffer or Uint8Array, skips the fetch: needed under Node). */
-export async function loadTsm(options = {}) {
-  const moduleArgs = {};
-  if (options.wasmBinary) {
-    moduleArgs.wasmBinary = options.wasmBinary;
-  } else {
-    const url = options.wasmUrl || DEFAULT_WASM;
-    moduleArgs.locateFile = (name) => (name.endsWith('.wasm') ? url : name);
-  }
-  const mod = await createTsmModule(moduleArgs);
-  return new TsmDecoder(mod);
+function moduleArgs(wasmBinary, wasmUrl) {
+  if (wasmBinary) return { wasmBinary };
+  return { locateFile: (name) => (name.endsWith('.wasm') ? wasmUrl : name) };
 }
 
+/** Loads the WebAssembly decoder. options: { wasmUrl, wasmBinary, fullWasmUrl,
+ *  fullWasmBinary, full } (wasmBinary, an ArrayBuffer or Uint8Array, skips the
+ *  fetch: needed under Node; the full* ones are the full module's, fetched or
+ *  used when a file first needs it; full: true loads the full module now). */
+export async function loadTsm(options = {}) {
+  const mod = await createTsmModule(moduleArgs(options.wasmBinary, options.wasmUrl || DEFAULT_WASM));
+  const loadFull = async () => {
+    const { default: createFull } = await import('./tsm_decoder_full.js');
+    return new TsmDecoder(await createFull(moduleArgs(options.fullWasmBinary, options.fullWasmUrl || DEFAULT_FULL_WASM)));
+  };
+  const dec = new TsmDecoder(mod, loadFull);
+  if (options.full) await dec.loadFull();
+  return dec;
+}
+
+// What a core module's call hands back when it reached a path only the full module has.
+const NEEDS_FULL = Symbol('needs the full module');
+
 export class TsmDecoder {
-  constructor(mod) {
+  constructor(mod, loadFull) {
     this.mod = mod;
+    // A core module (tsm_web_core_refused exported) and how to load the full one.
+    this.core = typeof mod._tsm_web_core_refused === 'function';
+    this.loadFullModule = loadFull;
+    this.full = null;
+    this.fullReady = null;
     this.errPtr = mod._malloc(ERR_SIZE);
     this.optPtr = mod._malloc(OPTIONS_SIZE);
     this.outPtr = mod._malloc(4); // tsm_mesh* out-parameter
@@ -123,8 +146,38 @@ export class TsmDecoder {
    *  Returns { positions, indices, faceOffsets?, vertexCount, faceCount, attributes,
    *  metadata } (see the top of this file). */
   decode(bytes, options) {
-    return this.guard(() => this.decodeNow(bytes, options));
+    const r = this.guard(() => this.decodeNow(bytes, options));
+    return r === NEEDS_FULL ? this.fullDecoder().decode(bytes, options) : r;
   }
+
+  /** decode(), loading the full module first when the file needs it. */
+  async decodeAsync(bytes, options) {
+    try {
+      return this.decode(bytes, options);
+    } catch (e) {
+      if (!e.needsFull) throw e;
+      return (await this.loadFull()).decode(bytes, options);
+    }
+  }
+
+  /** Loads the full module (once); decode() then handles every file. */
+  loadFull() {
+    if (!this.core) return Promise.resolve(this);
+    this.fullReady = this.fullReady || this.loadFullModule().then((d) => (this.full = d));
+    return this.fullReady.catch((err) => { this.fullReady = null; throw err; });
+  }
+
+  // The full module's decoder; throws (needsFull) while it is not loaded.
+  fullDecoder() {
+    if (this.full) return this.full;
+    const e = new TsmError(ErrorCode.UNSUPPORTED,
+      'this file needs the full decoder module (tsm_decoder_full.wasm): await loadFull() first, or use decodeAsync');
+    e.needsFull = true;
+    throw e;
+  }
+
+  // Whether the last call into a core module reached a path it lacks (clears the flag).
+  refused() { return this.core && this.mod._tsm_web_core_refused() !== 0; }
 
   decodeNow(bytes, options) {
     const m = this.mod;
@@ -132,6 +185,10 @@ export class TsmDecoder {
     const inPtr = this.input(data);
     const opt = this.options(options);
     const rc = m._tsm_decode(inPtr, data.length, opt, this.outPtr, this.errPtr, ERR_SIZE);
+    if (this.refused()) {
+      if (rc === 0) m._tsm_mesh_free(m.HEAPU32[this.outPtr >> 2]);
+      return NEEDS_FULL;
+    }
     if (rc !== 0) throw new TsmError(rc, this.cstring(this.errPtr));
     const mesh = m.HEAPU32[this.outPtr >> 2];
     try {
@@ -154,9 +211,9 @@ export class TsmDecoder {
     const stream = this.createStream(options);
     try {
       for await (const chunk of chunks(source)) {
-        for (const seg of stream.feed(chunk)) yield seg;
+        for (const seg of await stream.feedAsync(chunk)) yield seg;
       }
-      for (const seg of stream.finish()) yield seg;
+      for (const seg of await stream.finishAsync()) yield seg;
     } finally {
       stream.free();
     }
@@ -305,27 +362,90 @@ export class TsmStream {
       this.s = this.m._tsm_stream_new(dec.options(options));
       if (!this.s) throw new TsmError(ErrorCode.LIMIT_EXCEEDED, 'out of memory');
       if (dec.hasLevels) this.m._tsm_stream_stop_at_levels(this.s, 1);
+      // On a core module: the chunks so far, for the full module's stream
+      // that takes over when the file needs it (toFull); pieces handed out.
+      this.opts = options;
+      this.fed = dec.core ? [] : null;
+      this.delivered = 0;
+      this.inner = null;   // the full module's stream, once it took over
+      this.switching = 0;  // 1: a feed, 2: finish reached a path the core lacks; the full module is awaited
     } else {
       // The library has no streaming API yet: gather the chunks, decode at finish.
       this.s = 0; this.parts = []; this.opts = options;
     }
   }
 
-  get segmentCount() { return this.s ? this.m._tsm_stream_segment_count(this.s) : (this.done ? 1 : 0); }
-  get segmentsDone() { return this.s ? this.m._tsm_stream_segments_done(this.s) : (this.done ? 1 : 0); }
+  get segmentCount() {
+    if (this.inner) return this.inner.segmentCount;
+    return this.s ? this.m._tsm_stream_segment_count(this.s) : (this.done ? 1 : 0);
+  }
+  get segmentsDone() {
+    if (this.inner) return this.inner.segmentsDone;
+    return this.s ? this.m._tsm_stream_segments_done(this.s) : (this.done ? 1 : 0);
+  }
 
   feed(chunk) {
+    if (this.inner) return this.inner.feed(chunk);
     const data = toBytes(chunk);
     this.bytesIn += data.length;
     if (this.failed) throw this.failed;
+    if (this.switching) { // throws until the full module is loaded
+      if (data.length) this.fed.push(data.slice());
+      return this.toFull();
+    }
     if (!this.s) { this.parts.push(data.slice()); return []; }
     if (data.length === 0) return [];
-    return this.dec.guard(() => {
+    if (this.fed) this.fed.push(data.slice());
+    const out = this.dec.guard(() => {
       const t0 = now();
       const ptr = this.dec.input(data);
       const rc = this.m._tsm_stream_feed(this.s, ptr, data.length, this.dec.errPtr, ERR_SIZE);
-      return this.collect(rc, t0).concat(this.pendingLevels());
+      if (this.dec.refused()) return NEEDS_FULL;
+      const pieces = this.collect(rc, t0);
+      const levels = this.pendingLevels();
+      return levels === NEEDS_FULL ? NEEDS_FULL : pieces.concat(levels);
     });
+    if (out === NEEDS_FULL) { this.switching = 1; return this.toFull(); }
+    this.delivered += out.length;
+    return out;
+  }
+
+  /** feed(), loading the full module when the file needs it. */
+  async feedAsync(chunk) {
+    try {
+      return this.feed(chunk);
+    } catch (e) {
+      if (!e.needsFull) throw e;
+      await this.dec.loadFull();
+      return this.toFull();
+    }
+  }
+
+  /** finish(), loading the full module when the file needs it. */
+  async finishAsync() {
+    try {
+      return this.finish();
+    } catch (e) {
+      if (!e.needsFull) throw e;
+      await this.dec.loadFull();
+      return this.toFull();
+    }
+  }
+
+  // Hands the stream to the full module: a stream of its own is fed the
+  // chunks so far (the same chunks give the same pieces) and the pieces
+  // already handed out are dropped; throws (needsFull) while the full
+  // module is not loaded.
+  toFull() {
+    const full = this.dec.fullDecoder();
+    const inner = new TsmStream(full, this.opts);
+    let out = [];
+    for (const c of this.fed) out = out.concat(inner.feed(c));
+    if (this.switching === 2) out = out.concat(inner.finish());
+    out = out.slice(this.delivered);
+    if (this.s && !this.dec.dead) this.m._tsm_stream_free(this.s);
+    this.s = 0; this.fed = null; this.inner = inner; this.switching = 0;
+    return out;
   }
 
   // Levels of a progressive file left in the chunk after the first: one
@@ -335,13 +455,16 @@ export class TsmStream {
     while (this.dec.hasLevels && this.m._tsm_stream_level_pending(this.s)) {
       const t0 = now();
       const rc = this.m._tsm_stream_feed(this.s, 0, 0, this.dec.errPtr, ERR_SIZE);
+      if (this.dec.refused()) return NEEDS_FULL;
       out.push(...this.collect(rc, t0));
     }
     return out;
   }
 
   finish() {
+    if (this.inner) return this.inner.finish();
     if (this.failed) throw this.failed;
+    if (this.switching) { this.switching = 2; return this.toFull(); }
     const t0 = now();
     if (!this.s) {
       const all = concat(this.parts, this.bytesIn);
@@ -351,11 +474,16 @@ export class TsmStream {
       this.decodeMs += now() - t0;
       return [{ ...mesh, index: 0, segmentCount: 1, segmentsDone: 1, bytesIn: this.bytesIn, decodeMs: this.decodeMs }];
     }
-    return this.dec.guard(() => {
+    const out = this.dec.guard(() => {
       const levels = this.pendingLevels();
+      if (levels === NEEDS_FULL) return NEEDS_FULL;
       const rc = this.m._tsm_stream_finish(this.s, this.dec.errPtr, ERR_SIZE);
+      if (this.dec.refused()) return NEEDS_FULL;
       return levels.concat(this.collect(rc, t0));
     });
+    if (out === NEEDS_FULL) { this.switching = 2; return this.toFull(); }
+    this.delivered += out.length;
+    return out;
   }
 
   collect(rc, t0) {
@@ -412,6 +540,7 @@ export class TsmStream {
   }
 
   free() {
+    if (this.inner) this.inner.free();
     if (this.s && !this.dec.dead) this.m._tsm_stream_free(this.s);
     this.s = 0; this.parts = [];
     if (!this.failed) this.failed = new TsmError(ErrorCode.INVALID_ARGUMENT, 'stream already freed');

@@ -17,6 +17,8 @@ export declare class TsmError extends Error {
   readonly code: number;
   /** 'invalid_argument', 'corrupt_data', 'limit_exceeded', ... */
   readonly codeName: string;
+  /** Set when the file needs the full module and it is not loaded (decode, feed, finish): await loadFull(). */
+  readonly needsFull?: boolean;
 }
 
 export type Bytes = Uint8Array | ArrayBuffer | ArrayBufferView;
@@ -86,10 +88,16 @@ export interface Segment extends Omit<DecodedMesh, 'metadata'> {
 }
 
 export interface LoadOptions {
-  /** Where tsm_decoder.wasm is (default: beside tsm.js). */
+  /** Where tsm_decoder.wasm, the core module, is (default: beside tsm.js). */
   wasmUrl?: string | URL;
-  /** The module's bytes: no fetch (Node). */
+  /** The core module's bytes: no fetch (Node). */
   wasmBinary?: ArrayBuffer | Uint8Array;
+  /** Where tsm_decoder_full.wasm is (default: beside tsm.js); fetched when a file first needs it. */
+  fullWasmUrl?: string | URL;
+  /** The full module's bytes (Node). */
+  fullWasmBinary?: ArrayBuffer | Uint8Array;
+  /** Load the full module now: decode() then handles every file without decodeAsync. */
+  full?: boolean;
 }
 
 export declare class TsmStream {
@@ -99,6 +107,9 @@ export declare class TsmStream {
   feed(chunk: Bytes): Segment[];
   /** Throws a TsmError on a truncated file. */
   finish(): Segment[];
+  /** feed() and finish(), loading the full module when the file needs it. */
+  feedAsync(chunk: Bytes): Promise<Segment[]>;
+  finishAsync(): Promise<Segment[]>;
   free(): void;
 }
 
@@ -106,8 +117,13 @@ export declare class TsmDecoder {
   readonly version: string;
   readonly hasStreaming: boolean;
   readonly hasAttributes: boolean;
-  /** Throws a TsmError on a damaged, truncated or over-limit file. */
+  /** Throws a TsmError on a damaged, truncated or over-limit file, and (needsFull)
+   *  on a file that needs the full module while only the core is loaded. */
   decode(bytes: Bytes, options?: DecodeOptions): DecodedMesh;
+  /** decode(), loading the full module first when the file needs it. */
+  decodeAsync(bytes: Bytes, options?: DecodeOptions): Promise<DecodedMesh>;
+  /** Loads the full module (progressive batches, keep-order, zstd-coded sections) once. */
+  loadFull(): Promise<TsmDecoder>;
   createStream(options?: DecodeOptions): TsmStream;
   decodeStream(source: ByteSource, options?: DecodeOptions): AsyncGenerator<Segment, void, undefined>;
 }

@@ -194,10 +194,16 @@ try {
       s.free();
       try { tsm.decode(bytes, { maxVertices: 100 }); out.limit = 'decoded'; } catch (e) { out.limit = `${e.name}:${e.codeName}`; }
       out.after = tsm.decode(bytes).faceCount; // the module still works
+      // A progressive file needs the full module: decode() says so until loadFull().
+      const prog = new Uint8Array(await (await fetch('/data/bunny_prog.tsm')).arrayBuffer());
+      try { tsm.decode(prog); out.needsFull = 'decoded'; } catch (e) { out.needsFull = e.needsFull ? 'needsFull' : `${e.name}:${e.codeName}`; }
+      await tsm.loadFull();
+      out.fullAfter = tsm.decode(prog).faceCount;
       return out;
     });
     const ok = r.flipped === 'TsmError:corrupt_data' && r.truncated.startsWith('TsmError:') &&
-      r.streamTruncated.startsWith('TsmError:') && r.limit === 'TsmError:limit_exceeded' && r.after > 0;
+      r.streamTruncated.startsWith('TsmError:') && r.limit === 'TsmError:limit_exceeded' && r.after > 0 &&
+      r.needsFull === 'needsFull' && r.fullAfter > 0;
     if (ok) { passed++; console.log(`ok   damaged input refused: ${JSON.stringify(r)}`); }
     else { failed++; console.log(`FAIL damaged input: ${JSON.stringify(r)}`); }
   }
@@ -244,7 +250,7 @@ try {
       const { fnv1a, hex } = await import('/hash.js');
       const tsm = await loadTsm();
       const bytes = new Uint8Array(await (await fetch(`/data/${name}.tsm`)).arrayBuffer());
-      const whole = tsm.decode(bytes);
+      const whole = await tsm.decodeAsync(bytes);
       function* sliced(b, k) { for (let i = 0; i < b.length; i += k) yield b.subarray(i, i + k); }
       const equal = (a, b) => a.length === b.length && a.every((x, i) => Object.is(x, b[i]));
       const run = async (pieces) => {
@@ -318,7 +324,7 @@ try {
         };
         function* sliced(b, k) { for (let i = 0; i < b.length; i += k) yield b.subarray(i, i + k); }
         return {
-          whole: await sum([tsm.decode(bytes)]),
+          whole: await sum([await tsm.decodeAsync(bytes)]),
           streamed: await sum(tsm.decodeStream(sliced(bytes, 61))),
           worker: await sum(decodeStreamInWorker(sliced(bytes, 200))),
         };

@@ -25,7 +25,7 @@ const check = (cond, msg) => { console.log(`${cond ? 'ok  ' : 'FAIL'} package: $
 const tarball = run('bash', [path.join(web, 'pack.sh')]).trim();
 const files = run('tar', ['tzf', tarball]).split('\n').filter(Boolean).map((f) => f.replace(/^package\//, '')).sort();
 const want = ['README.md', 'gltf-tsm-extension.d.ts', 'gltf-tsm-extension.js', 'package.json', 'tsm-worker.js',
-  'tsm.d.ts', 'tsm.js', 'tsm_decoder.js', 'tsm_decoder.wasm'];
+  'tsm.d.ts', 'tsm.js', 'tsm_decoder.js', 'tsm_decoder.wasm', 'tsm_decoder_full.js', 'tsm_decoder_full.wasm'];
 check(JSON.stringify(files) === JSON.stringify(want), `${path.basename(tarball)} (${fs.statSync(tarball).size} bytes) holds ${files.join(', ')}`);
 
 // The scratch project: the tarball installed by npm, three.js linked from web/.
@@ -49,8 +49,9 @@ import { loadTsm, TsmError } from '@tsm-codec/decoder';
 import { GLTFTsmExtension, EXTENSION_NAME } from '@tsm-codec/decoder/three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 const wasm = new URL(import.meta.resolve('@tsm-codec/decoder/tsm_decoder.wasm'));
-const tsm = await loadTsm({ wasmBinary: fs.readFileSync(wasm) });
-const mesh = tsm.decode(fs.readFileSync('sphere.tsm'));
+const fullWasm = new URL(import.meta.resolve('@tsm-codec/decoder/tsm_decoder_full.wasm'));
+const tsm = await loadTsm({ wasmBinary: fs.readFileSync(wasm), fullWasmBinary: fs.readFileSync(fullWasm) });
+const mesh = await tsm.decodeAsync(fs.readFileSync('sphere.tsm')); // glTF metadata, zstd-coded: the full module
 let refused = '';
 try { tsm.decode(new Uint8Array(16)); } catch (e) { refused = e instanceof TsmError ? e.codeName : String(e); }
 const loader = new GLTFLoader();

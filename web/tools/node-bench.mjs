@@ -75,12 +75,26 @@ for (const c of cases) {
     tsmMinMs: Math.min(...ts), dracoMinMs: Math.min(...ds) });
 }
 const gz = (f) => zlib.gzipSync(fs.readFileSync(f), { level: 9 }).length;
+const br = (f) => zlib.brotliCompressSync(fs.readFileSync(f)).length;
+// Download sizes (raw, gzip -9, brotli) of a module: wasm + glue. The core
+// (tsm_decoder) is what a page loads; the full module only when a file needs it.
+const sizes = (wasm, glue) => Object.fromEntries(Object.entries({ raw: (f) => fs.statSync(f).size, gzip: gz, brotli: br })
+  .map(([k, f]) => [k, f(wasm) + f(glue)]));
+const core = sizes(path.join(dist, 'tsm_decoder.wasm'), path.join(dist, 'tsm_decoder.js'));
+const fullWasm = path.join(dist, 'tsm_decoder_full.wasm');
+const full = fs.existsSync(fullWasm) ? sizes(fullWasm, path.join(dist, 'tsm_decoder_full.js')) : null;
+const dracoSizes = sizes(path.join(dracoDir, 'draco_decoder.wasm'), path.join(dracoDir, 'draco_decoder_nodejs.js'));
 const wasmGz = gz(path.join(dist, 'tsm_decoder.wasm')), glueGz = gz(path.join(dist, 'tsm_decoder.js'));
-const dracoGz = gz(path.join(dracoDir, 'draco_decoder.wasm')) + gz(path.join(dracoDir, 'draco_decoder_nodejs.js'));
-const res = { wasmGz, glueGz, dracoGz, rows };
+const dracoGz = dracoSizes.gzip;
+const res = { wasmGz, glueGz, dracoGz, core, full, draco: dracoSizes, rows };
 if (process.argv.includes('--json')) { console.log(JSON.stringify(res)); process.exit(0); }
 console.log(`node ${process.version}; tsm wasm gzip ${wasmGz}, glue gzip ${glueGz}, total ${wasmGz + glueGz} = ` +
   `${((wasmGz + glueGz) / dracoGz).toFixed(3)}x draco3d's ${dracoGz} (wasm + glue); median and fastest of ${REPS}`);
+const line = (name, s) => `| ${name} | ${s.raw} | ${s.gzip} | ${s.brotli} | ${(s.gzip / dracoGz).toFixed(3)} |`;
+console.log('| wasm + glue | raw | gzip | brotli | gzip / draco3d |\n|---|---:|---:|---:|---:|');
+console.log(line('tsm core (tsm_decoder)', core));
+if (full) console.log(line('tsm full (tsm_decoder_full, on demand)', full));
+console.log(line('draco3d decoder', dracoSizes) + '\n');
 console.log('| mesh | streams | tsm ms | draco3d ms | tsm/draco | tsm fastest ms | draco3d fastest ms | tsm/draco (fastest) |');
 console.log('|---|---:|---:|---:|---:|---:|---:|---:|');
 const f = (x) => x.toFixed(3);

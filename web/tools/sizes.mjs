@@ -11,7 +11,8 @@ const root = path.resolve(here, '../..');
 const dist = process.env.TSM_WEB_DIST || path.join(root, 'build/web');
 const draco = path.join(root, 'web/node_modules/draco3d');
 const sets = {
-  'tsm (wasm + glue + tsm.js)': [path.join(dist, 'tsm_decoder.wasm'), path.join(dist, 'tsm_decoder.js'), path.join(dist, 'tsm.js')],
+  'tsm core (wasm + glue + tsm.js)': [path.join(dist, 'tsm_decoder.wasm'), path.join(dist, 'tsm_decoder.js'), path.join(dist, 'tsm.js')],
+  'tsm full module, loaded when a file needs it (wasm + glue)': [path.join(dist, 'tsm_decoder_full.wasm'), path.join(dist, 'tsm_decoder_full.js')],
   'draco3d decoder (wasm + glue)': [path.join(draco, 'draco_decoder.wasm'), path.join(draco, 'draco_decoder_nodejs.js')],
 };
 const measure = (f) => {
