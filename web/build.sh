@@ -54,10 +54,12 @@ is_cold() {
   case " $(echo $HOT_FILES) " in *" $(basename "$1") "*) return 1 ;; esac
   return 0
 }
-# TSM_WEB_FLAGS: extra compile and link flags, for trying variants (e.g. "-flto", "-msimd128")
+# TSM_WEB_FLAGS: extra compile and link flags, for trying variants (e.g. "-flto", "-msimd128");
+# TSM_WEB_HOT_FLAGS: extra compile flags of the HOT_FILES only (e.g. "-mllvm -inline-threshold=400")
 read -r -a EXTRA <<<"${TSM_WEB_FLAGS:-}"
 OPT+=("${EXTRA[@]}")
 LOPT+=("${EXTRA[@]}")
+read -r -a HOT_EXTRA <<<"${TSM_WEB_HOT_FLAGS:-}"
 
 # ---- zstd decompressor (Debian source package) --------------------------------
 ZSTD_SRC=""
@@ -145,7 +147,7 @@ compile() {  # src obj flags...
     emcc "$@" -c "$src" -o "$obj"
   fi
 }
-FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}" "${COLD[@]}" "$HOT_FILES")"
+FLAGSIG="$(printf '%s\n' "$LIBCODEC" "${CXXFLAGS[@]}" "${ZSTD_CFLAGS[@]}" "${LOPT[@]}" "${COLD[@]}" "$HOT_FILES" "${HOT_EXTRA[@]}")"
 if [ ! -f "$OUT/.flags" ] || [ "$(cat "$OUT/.flags")" != "$FLAGSIG" ]; then printf '%s\n' "$FLAGSIG" > "$OUT/.flags"; fi
 # headers: rebuild everything when any library header is newer than the last link
 if [ -f "$OUT/tsm_decoder.wasm" ]; then
@@ -157,7 +159,7 @@ pids=()
 run() { compile "$@" & pids+=($!); if [ "${#pids[@]}" -ge "$JOBS" ]; then wait "${pids[0]}"; pids=("${pids[@]:1}"); fi; }
 for f in "${LIB_FILES[@]}"; do
   o="$OBJ/lib_$(basename "${f%.cpp}").o"; OBJS+=("$o")
-  if is_cold "$f"; then run "$f" "$o" "${CXXFLAGS[@]}" "${COLD[@]}"; else run "$f" "$o" "${CXXFLAGS[@]}"; fi
+  if is_cold "$f"; then run "$f" "$o" "${CXXFLAGS[@]}" "${COLD[@]}"; else run "$f" "$o" "${CXXFLAGS[@]}" "${HOT_EXTRA[@]}"; fi
 done
 for f in "${ZSTD_FILES[@]}"; do
   o="$OBJ/z_$(basename "${f%.c}").o"; OBJS+=("$o"); run "$f" "$o" "${OPT[@]}" "${COLD[@]}" "${ZSTD_CFLAGS[@]}" "${ZSTD_INC[@]}"

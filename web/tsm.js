@@ -71,6 +71,7 @@
 import createTsmModule from './tsm_decoder.js';
 
 const ERR_SIZE = 512;
+const utf8 = new TextDecoder(); // one for all names and keys: a TextDecoder per string costs more than the string
 const OPTIONS_SIZE = 64; // room for tsm_decode_options (three uint64 and an int: 32 bytes today)
 
 export const ErrorCode = Object.freeze({
@@ -266,7 +267,7 @@ export class TsmDecoder {
     ptr >>>= 0;
     let end = ptr;
     while (h[end]) ++end;
-    return new TextDecoder().decode(h.subarray(ptr, end));
+    return utf8.decode(h.subarray(ptr, end));
   }
 
   // Copies vertices [v0, v1) and faces [f0, f1) of a tsm_mesh out of the heap:
@@ -342,7 +343,7 @@ export class TsmDecoder {
       const kn = m.HEAPU32[this.sizePtr >> 2];
       const v = m._tsm_mesh_metadata_value(mesh, i, this.sizePtr) >>> 0;
       const vn = m.HEAPU32[this.sizePtr >> 2];
-      out.push({ key: new TextDecoder().decode(m.HEAPU8.subarray(k, k + kn)), value: m.HEAPU8.slice(v, v + vn) });
+      out.push({ key: utf8.decode(m.HEAPU8.subarray(k, k + kn)), value: m.HEAPU8.slice(v, v + vn) });
     }
     return out;
   }
