@@ -147,6 +147,8 @@ export class TsmDecoder {
    *  Returns { positions, indices, faceOffsets?, vertexCount, faceCount, attributes,
    *  metadata } (see the top of this file). */
   decode(bytes, options) {
+    // Once loaded, the full module decodes everything (the core would only repeat its work on files it lacks a path for).
+    if (this.full) return this.full.decode(bytes, options);
     const r = this.guard(() => this.decodeNow(bytes, options));
     return r === NEEDS_FULL ? this.fullDecoder().decode(bytes, options) : r;
   }
@@ -203,7 +205,7 @@ export class TsmDecoder {
 
   /** A streaming decoder: feed(chunk) and finish() return the segments that chunk
    *  completed (often none, sometimes several). */
-  createStream(options) { return new TsmStream(this, options); }
+  createStream(options) { return new TsmStream(this.full || this, options); }
 
   /** Decodes a ReadableStream (a fetch body) or any (async) iterable of byte
    *  chunks, yielding each segment as soon as it is decoded. Leaving the loop

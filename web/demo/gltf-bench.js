@@ -72,6 +72,9 @@ function table(head, rows) {
 async function main() {
   const index = await (await fetch('/data/gltf-bench/index.json')).json();
   const tsm = await loadTsm();
+  // Files given by `tsm bench --browser` may need the full module: loaded
+  // first, it decodes them all (the same code as the core's for the others).
+  await tsm.loadFull();
   const draco = await loadDraco();
   await MeshoptDecoder.ready;
   const codecs = {
