@@ -4,9 +4,9 @@
 # emcc directly (no CMake), as two modules (emscripten glue + WebAssembly):
 #   build/web/tsm_decoder.{js,wasm}       the core, what tsm.js loads first: every
 #                                         path the encoder's default files take
-#   build/web/tsm_decoder_full.{js,wasm}  every path: progressive batches, keep-order
-#                                         and zstd-coded sections besides; tsm.js
-#                                         loads it when a file needs one of them
+#   build/web/tsm_decoder_full.{js,wasm}  every path: progressive batches, keep-order,
+#                                         lossless exact grids and zstd-coded sections
+#                                         besides; tsm.js loads it when a file needs one
 # The core links web/core_stubs.cpp instead of CORE_OMITS and zstd's
 # decompressor: each stub refuses and raises a flag tsm.js reads.
 #
@@ -168,9 +168,9 @@ done
 STUBS_O="$OBJ/web_core_stubs.o"
 run "$ROOT/web/core_stubs.cpp" "$STUBS_O" "${CXXFLAGS[@]}" "${COLD[@]}"
 for p in "${pids[@]}"; do wait "$p"; done
-# The core leaves out the sources of progressive batches and keep-order, and
-# zstd's decompressor (z_*.o; in the stub build, zstd_stub.c).
-CORE_OMITS="progressive_split.cpp order_coding.cpp"
+# The core leaves out the sources of progressive batches, keep-order and
+# lossless exact grids, and zstd's decompressor (z_*.o; in the stub build, zstd_stub.c).
+CORE_OMITS="progressive_split.cpp order_coding.cpp exact_grid.cpp"
 CORE_OBJS=()
 for o in "${OBJS[@]}"; do
   b="$(basename "$o" .o)"

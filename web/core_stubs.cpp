@@ -1,14 +1,15 @@
-// The core browser decoder (web/build.sh, tsm_core.wasm) links these in
+// The core browser decoder (web/build.sh, tsm_decoder.wasm) links these in
 // place of the decoding paths files rarely need: progressive batches
-// (progressive_split.cpp), keep-order (order_coding.cpp) and zstd-coded
-// sections (zstd's decompressor). Each one refuses and raises a flag;
+// (progressive_split.cpp), keep-order (order_coding.cpp), lossless exact
+// grids (exact_grid.cpp) and zstd-coded sections (zstd's decompressor). Each one refuses and raises a flag;
 // tsm.js reads the flag after every call into the core module
 // (tsm_web_core_refused) and then decodes the same bytes with the full
 // module (tsm_decoder.wasm), which has every path. A call that raised the
 // flag may have returned success with a partial result (LevelMesh::init
-// cannot fail): tsm.js never reads results from such a call.
+// and exact_value cannot fail): tsm.js never reads results from such a call.
 #include <zstd.h>
 
+#include "exact_grid.hpp"
 #include "order_coding.hpp"
 #include "progressive.hpp"
 
@@ -48,5 +49,12 @@ Status decode_batch(std::string_view, LevelMesh&, const BatchLimits&) { return n
 Status decode_loose(std::string_view, LevelMesh&, const BatchLimits&) { return needs_full("loose vertices"); }
 
 Status decode_order(std::string_view, Mesh&) { return needs_full("keep-order section"); }
+
+float exact_value(double, int64_t, uint32_t) {
+  refused = true;
+  return 0;
+}
+
+Status apply_exceptions(std::string_view, std::vector<float>&) { return needs_full("exact grid exceptions"); }
 
 }  // namespace tsm
