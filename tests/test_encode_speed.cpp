@@ -235,6 +235,45 @@ TEST(EncoderSpeed, FindLatticeCountsAsItSorts) {
 // and points off it (some with an anchor, tangent set 1): as gathered by
 // the first coding pass, and by fit_betas' own pass with the step on, for
 // the parallelogram and spread predictors, with and without planes.
+// With CutHints::streams false and the streams coded afterwards, the
+// encoding is the one coded at once: on a surface with stitches (shared
+// vertices), and on one with polygons and degenerate faces (whose streams
+// are coded at once anyway).
+TEST(EncoderSpeed, StreamsCodedLaterAreTheSame) {
+  tsm::Mesh stitched = tsm_test::icosphere(2);
+  for (uint32_t f = 0; f < 6; ++f) {  // the first faces again, reversed: edges of four uses
+    const uint32_t* c = stitched.face(f);
+    const uint32_t r[3] = {c[0], c[2], c[1]};
+    stitched.add_face(r, 3);
+  }
+  tsm::Mesh mixed = tsm_test::icosphere(2);
+  const uint32_t quad[4] = {0, 1, 2, 3}, degenerate[3] = {4, 4, 5};
+  mixed.add_face(quad, 4);
+  mixed.add_face(degenerate, 3);
+  for (const tsm::Mesh* m : {&stitched, &mixed}) {
+    tsm::ConnectivityEncoding now, later;
+    ASSERT_TRUE(tsm::encode_connectivity(*m, now).ok());
+    if (m == &stitched) {
+      EXPECT_GT(now.stats.stitches, 0u);
+    } else {
+      EXPECT_GT(now.stats.polygons * now.stats.side_faces, 0u);
+    }
+    tsm::CutHints hints;
+    hints.streams = false;
+    ASSERT_TRUE(tsm::encode_connectivity(*m, later, hints).ok());
+    EXPECT_EQ(later.vertex_order, now.vertex_order);
+    EXPECT_EQ(later.layout.corners(), now.layout.corners());
+    ASSERT_TRUE(tsm::code_connectivity_streams(later).ok());
+    EXPECT_FALSE(later.pending);
+    EXPECT_EQ(later.streams.vertex_tree, now.streams.vertex_tree);
+    EXPECT_EQ(later.streams.triangle_tree, now.streams.triangle_tree);
+    EXPECT_EQ(later.streams.topology, now.streams.topology);
+    EXPECT_EQ(later.distance_topology, now.distance_topology);
+    EXPECT_EQ(later.stats.vertex_runs, now.stats.vertex_runs);
+    EXPECT_EQ(later.stats.bytes, now.stats.bytes);
+  }
+}
+
 TEST(EncoderSpeed, TangentSamplesGatheredOnTheFirstPass) {
   tsm::Mesh m = tsm_test::jittered(tsm_test::icosphere(4), 0.02f, 5);
   // Holes: every 7th face dropped.

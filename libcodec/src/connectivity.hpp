@@ -115,6 +115,10 @@ struct CutHints {
   int root_rule = 0;
   // How the run values are coded (FORMAT.md §8.3.1; tables: where they pay).
   RunCoding runs = RunCoding::adaptive;
+  // false: the cut surface only (vertex order, layout, stats) where the
+  // decoded faces are its triangles; code_connectivity_streams codes the
+  // streams later (the encoder's canonical rounds need them for one round).
+  bool streams = true;
 };
 
 // Lexicographic order of quantized positions (3 per input vertex), from
@@ -295,6 +299,8 @@ struct ConnectivityStreams {
   std::string topology;
 };
 
+struct PendingStreams;  // connectivity_encode.cpp
+
 struct ConnectivityEncoding {
   ConnectivityStreams streams;
   // Output vertex id (vertex-tree pre-order) -> input vertex id.
@@ -308,9 +314,14 @@ struct ConnectivityEncoding {
   // (encode.cpp) order the codings of a cycle by it.
   std::string distance_topology;
   bool root_tie = false;  // CutHints::root_rule > 0 and a root or reference edge tied on position
+  // Set while the streams are not coded yet (CutHints::streams false).
+  std::shared_ptr<PendingStreams> pending;
 };
 
 Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints = CutHints());
+// Codes the streams of an encoding made with CutHints::streams false (does
+// nothing when they are coded).
+Status code_connectivity_streams(ConnectivityEncoding& ce);
 // Fills out.face_offsets / out.indices (positions are the geometry stage's
 // job) and the layout the geometry decoder walks. The counts come from the
 // header and are checked against what the streams say.

@@ -160,52 +160,46 @@ std::string candidate_topology(CandidateTail& c) {
 
 }  // namespace
 
-Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
-  out = ConnectivityEncoding();
-  if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
-    return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
-  PreparedInput prep = prepare_input(mesh);
-  CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), hints);
-  const bool by_position = hints.root_rule > 0 && hints.qpos;
-  out.root_tie = m.root_tie;
-  const VertexForest f =
-      build_vertex_tree(m, hints.qpos, hints.midpoint_tree && hints.qpos, by_position, &out.root_tie);
+// What the streams are coded from once the cut surface is built: the
+// vertex forest, each component's loop and triangle tree, and the topology
+// stream's lists. encode_connectivity keeps it in ConnectivityEncoding::
+// pending when asked for the surface only (CutHints::streams false), and
+// code_connectivity_streams codes the streams from it later.
+struct PendingStreams {
+  RunCoding runs = RunCoding::adaptive;
+  VertexForest f;
+  bool polygons = false;
+  std::vector<uint8_t> diagonal;             // the cut mesh's polygon-diagonal flags (with polygons)
+  std::vector<ComponentLoop> loops;          // per component (empty below two vertices)
+  std::vector<TriangleRuns> trees;           // per component (likewise)
+  std::vector<uint32_t> pos_of;              // cut-mesh vertex -> pre-order position
+  TopologyTail tail;
+  std::vector<uint32_t> cut_corner, twin;    // with stitches: candidate_topology's cut surface
+  uint32_t positions = 0;
+};
 
+namespace {
+
+// The three streams from `p`, run values coded as `runs` says (tables
+// fall back to the adaptive models where they do not pay).
+Status code_streams(const PendingStreams& p, RunCoding run_coding, ConnectivityEncoding& out) {
+  const VertexForest& f = p.f;
   RangeEncoder ev, et, eo;
   RunEncoder runs;
-  runs.tables = hints.runs == RunCoding::tables;
+  runs.tables = run_coding == RunCoding::tables;
   VertexTreeModels vm;
   TriangleTreeModels tm;
   TopologyModels om;
   ConnectivityStats& st = out.stats;
-  const uint32_t C = m.component_count();
+  const uint32_t C = static_cast<uint32_t>(p.loops.size());
   om.count.encode(eo, C);
-  const bool polygons = prep.polygon_count > 0;
-  eo.bit(om.has_polygons, polygons);
-
-  // Triangles per component.
-  std::vector<uint32_t> tri_start(C + 1, 0), tris(m.triangle_count());
-  for (uint32_t t = 0; t < m.triangle_count(); ++t) tri_start[m.vertex_component[m.tri[3 * t]] + 1]++;
-  for (uint32_t c = 0; c < C; ++c) tri_start[c + 1] += tri_start[c];
-  {
-    std::vector<uint32_t> fill(tri_start.begin(), tri_start.end() - 1);
-    for (uint32_t t = 0; t < m.triangle_count(); ++t) tris[fill[m.vertex_component[m.tri[3 * t]]]++] = t;
-  }
-  std::vector<uint8_t> cut_he = f.tree_he;
-  std::vector<uint32_t> local(m.triangle_count()), corner_pos(m.tri.size());
-  std::vector<uint32_t> comp_tris, scratch_corner, scratch_twin, scratch_loop_he;
-  // Per pre-order position: which triangle corners reference it, filled as we go.
-  std::vector<uint32_t> pos_of(m.vertex_count);
-  for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
+  eo.bit(om.has_polygons, p.polygons);
   std::vector<uint32_t> last_child(f.order.size(), kNone);
-  // Triangles in decode order, and how each is rotated to start at its gate.
-  std::vector<uint32_t> dec_tri, dec_of(m.triangle_count(), kNone);
-  std::vector<uint8_t> rot(m.triangle_count(), 0);
-  dec_tri.reserve(m.triangle_count());
-  for (uint32_t p = 0; p < f.order.size(); ++p)
-    if (f.parent[p] != kNone) last_child[f.parent[p]] = p;
+  for (uint32_t q = 0; q < f.order.size(); ++q)
+    if (f.parent[q] != kNone) last_child[f.parent[q]] = q;
   std::vector<uint32_t> kids_seen(f.order.size(), 0);  // runs started so far at each branching node
-
+  std::vector<uint32_t> scratch_corner, scratch_twin, scratch_loop_he;
+  st.vertex_runs = 0;
   int prev_leaf = 1;
   for (uint32_t c = 0; c < C; ++c) {
     const uint32_t start = f.component_start[c], end = f.component_start[c + 1];
@@ -225,9 +219,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       i = j + 1;
     }
     if (end - start < 2) continue;
-    // Jumps and loop.
-    comp_tris.assign(tris.begin() + tri_start[c], tris.begin() + tri_start[c + 1]);
-    ComponentLoop cl = encoder_loop(m, f, c, comp_tris, cut_he, local);
+    // Jumps.
+    const ComponentLoop& cl = p.loops[c];
     om.count.encode(eo, static_cast<uint32_t>(cl.jumps.size()));
     uint32_t prev_corner = 0;
     for (uint32_t i = 0; i < cl.jumps.size(); ++i) {
@@ -236,9 +229,134 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
     }
     for (uint32_t i = 0; i < cl.jumps.size(); ++i)
       if (cl.jumps[i].partner > i) om.partner.encode(eo, cl.jumps[i].partner - i - 1);
+    // Triangle tree.
+    const TriangleRuns& tr = p.trees[c];
+    tm.root.encode(et, tr.root);
+    int prev_end = 1, prev_end2 = 1;
+    for (size_t r = 0; r < tr.march.size(); ++r) {
+      et.bit(tm.end[prev_end][prev_end2], tr.branch[r]);
+      runs.put(et, tm.march[prev_end][tr.branch[r]], kRunMarchCtx + 2 * prev_end + tr.branch[r], tr.march[r]);
+      prev_end2 = prev_end;
+      prev_end = tr.branch[r];
+    }
+    {  // Marching bits, coded during the same walk the decoder makes.
+      MarchBitEncoder source{et, tm.bit, tr.bits};
+      std::vector<uint32_t> local_loop(cl.loop.size());
+      for (size_t q = 0; q < cl.loop.size(); ++q) local_loop[q] = p.pos_of[cl.loop[q]] - start;
+      uint64_t used = 0;
+      const uint32_t L = static_cast<uint32_t>(cl.loop.size());
+      scratch_corner.resize(3 * size_t{L});
+      scratch_twin.resize(3 * size_t{L});
+      scratch_loop_he.assign(L, kNone);
+      TriangleTreeOut walk;
+      walk.corner = scratch_corner.data();
+      walk.twin = scratch_twin.data();
+      walk.loop_he = scratch_loop_he.data();
+      TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, local_loop, end - start, source, walk, used));
+      if (used != tr.bits.size()) return Status(ErrorCode::internal, "marching bits: the walk used another count");
+    }
+    if (p.polygons) {
+      int prev = 0;
+      for (size_t k = 1; k < tr.triangle_order.size(); ++k) {
+        int d = p.diagonal[3 * tr.triangle_order[k] + tr.parent_slot[k]];
+        et.bit(tm.diagonal[prev], d);
+        prev = d;
+      }
+    }
+  }
+  // The rest of the topology stream: virtual vertices, stitches, side
+  // faces. Coded first with every stitch target as a distance (what the
+  // choice of run tables below is measured on); with stitches, the coder's
+  // state where the tail starts is kept for candidate_topology, which codes
+  // the tail as the file has it.
+  std::unique_ptr<CandidateTail> cand;
+  if (!p.tail.stitches.empty()) {
+    cand = std::make_unique<CandidateTail>();
+    cand->coder = eo;
+    cand->models = om;
+    cand->runs = runs;
+  }
+  code_tail(eo, om, runs, p.tail);
+  out.streams.vertex_tree = ev.finish();
+  out.streams.triangle_tree = et.finish();
+  out.streams.topology = eo.finish();
+  // The mode byte (and the tables) first.
+  const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
+  if (runs.tables) {
+    // Tables where they cost at most 1/8 more than the adaptive models
+    // (the corpus scans: 3-11% more, tables included). On regular meshes,
+    // whose runs repeat, the models learn the values down to a small
+    // fraction of a bit while a prefix code spends at least one bit on
+    // each (40-500% more): those are coded again without tables.
+    const size_t adaptive = runs.adaptive.finish().size();
+    if (block.size() > adaptive + adaptive / 8) return code_streams(p, RunCoding::adaptive, out);
+  }
+  out.streams.topology = block + out.streams.topology;
+  out.distance_topology.clear();
+  if (cand) {  // the stitch targets by candidates, as the file has them
+    cand->corner = p.cut_corner;
+    cand->twin = p.twin;
+    cand->positions = p.positions;
+    cand->tail = p.tail;
+    out.distance_topology = std::move(out.streams.topology);
+    out.streams.topology = candidate_topology(*cand);
+  }
+  st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const CutHints& hints) {
+  out = ConnectivityEncoding();
+  if (mesh.vertex_count() >= 0x3FFFFFFFu || mesh.corner_count() >= 0x3FFFFFFFu)
+    return Status(ErrorCode::limit_exceeded, "meshes above 2^30 vertices or corners are not supported");
+  PreparedInput prep = prepare_input(mesh);
+  CutMesh m = cut_mesh(prep, static_cast<uint32_t>(mesh.vertex_count()), hints);
+  const bool by_position = hints.root_rule > 0 && hints.qpos;
+  out.root_tie = m.root_tie;
+  auto pending = std::make_shared<PendingStreams>();
+  PendingStreams& ps = *pending;
+  ps.runs = hints.runs;
+  ps.f = build_vertex_tree(m, hints.qpos, hints.midpoint_tree && hints.qpos, by_position, &out.root_tie);
+  const VertexForest& f = ps.f;
+
+  ConnectivityStats& st = out.stats;
+  const uint32_t C = m.component_count();
+  ps.polygons = prep.polygon_count > 0;
+  ps.loops.resize(C);
+  ps.trees.resize(C);
+
+  // Triangles per component.
+  std::vector<uint32_t> tri_start(C + 1, 0), tris(m.triangle_count());
+  for (uint32_t t = 0; t < m.triangle_count(); ++t) tri_start[m.vertex_component[m.tri[3 * t]] + 1]++;
+  for (uint32_t c = 0; c < C; ++c) tri_start[c + 1] += tri_start[c];
+  {
+    std::vector<uint32_t> fill(tri_start.begin(), tri_start.end() - 1);
+    for (uint32_t t = 0; t < m.triangle_count(); ++t) tris[fill[m.vertex_component[m.tri[3 * t]]]++] = t;
+  }
+  std::vector<uint8_t> cut_he = f.tree_he;
+  std::vector<uint32_t> local(m.triangle_count()), corner_pos(m.tri.size());
+  std::vector<uint32_t> comp_tris;
+  // Per cut-mesh vertex: its pre-order position.
+  std::vector<uint32_t>& pos_of = ps.pos_of;
+  pos_of.resize(m.vertex_count);
+  for (uint32_t p = 0; p < f.order.size(); ++p) pos_of[f.order[p]] = p;
+  // Triangles in decode order, and how each is rotated to start at its gate.
+  std::vector<uint32_t> dec_tri, dec_of(m.triangle_count(), kNone);
+  std::vector<uint8_t> rot(m.triangle_count(), 0);
+  dec_tri.reserve(m.triangle_count());
+
+  for (uint32_t c = 0; c < C; ++c) {
+    const uint32_t start = f.component_start[c], end = f.component_start[c + 1];
+    if (end - start < 2) continue;
+    // Jumps and loop.
+    comp_tris.assign(tris.begin() + tri_start[c], tris.begin() + tri_start[c + 1]);
+    ComponentLoop& cl = ps.loops[c];
+    cl = encoder_loop(m, f, c, comp_tris, cut_he, local);
     st.jump_edges += cl.jumps.size() / 2;
     // Triangle tree.
-    TriangleRuns tr;
+    TriangleRuns& tr = ps.trees[c];
     TSM_RETURN_IF_ERROR(encode_triangle_tree(m, cl, corner_pos, tr));
     if (tr.triangle_order.size() != comp_tris.size())
       return Status(ErrorCode::internal, "component " + std::to_string(c) + ": triangle tree covers " +
@@ -256,47 +374,16 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       for (uint8_t j = 0; j < 3; ++j)
         if (m.tri[3 * t + j] == first) rot[t] = j;
     }
-    tm.root.encode(et, tr.root);
-    int prev_end = 1, prev_end2 = 1;
-    for (size_t r = 0; r < tr.march.size(); ++r) {
-      et.bit(tm.end[prev_end][prev_end2], tr.branch[r]);
-      runs.put(et, tm.march[prev_end][tr.branch[r]], kRunMarchCtx + 2 * prev_end + tr.branch[r], tr.march[r]);
-      prev_end2 = prev_end;
-      prev_end = tr.branch[r];
-    }
-    {  // Marching bits, coded during the same walk the decoder makes.
-      MarchBitEncoder source{et, tm.bit, tr.bits};
-      std::vector<uint32_t> local_loop(cl.loop.size());
-      for (size_t p = 0; p < cl.loop.size(); ++p) local_loop[p] = pos_of[cl.loop[p]] - start;
-      uint64_t used = 0;
-      const uint32_t L = static_cast<uint32_t>(cl.loop.size());
-      scratch_corner.resize(3 * size_t{L});
-      scratch_twin.resize(3 * size_t{L});
-      scratch_loop_he.assign(L, kNone);
-      TriangleTreeOut walk;
-      walk.corner = scratch_corner.data();
-      walk.twin = scratch_twin.data();
-      walk.loop_he = scratch_loop_he.data();
-      TSM_RETURN_IF_ERROR(decode_triangle_tree(L, tr, local_loop, end - start, source, walk, used));
-      if (used != tr.bits.size()) return Status(ErrorCode::internal, "marching bits: the walk used another count");
-    }
     st.triangle_runs += tr.march.size();
     st.marching_bits += tr.bits.size();
-    if (polygons) {
-      int prev = 0;
-      for (size_t k = 1; k < tr.triangle_order.size(); ++k) {
-        int d = m.diagonal[3 * tr.triangle_order[k] + tr.parent_slot[k]];
-        et.bit(tm.diagonal[prev], d);
-        prev = d;
-      }
-    }
   }
+  if (ps.polygons) ps.diagonal = std::move(m.diagonal);
 
   // Vertex numbering: the first occurrence of an input vertex in pre-order
   // carries it; later ones are stitched to it; virtual vertices carry nothing.
   const uint32_t P = static_cast<uint32_t>(f.order.size());
   std::vector<uint32_t> first_pos(mesh.vertex_count(), kNone), out_id(P, kNone);
-  TopologyTail tail;  // the topology stream's lists from the virtual vertices on
+  TopologyTail& tail = ps.tail;  // the topology stream's lists from the virtual vertices on
   std::vector<uint32_t>& virtual_pos = tail.virtual_pos;
   std::vector<std::pair<uint32_t, uint32_t>>& stitches = tail.stitches;
   for (uint32_t p = 0; p < P; ++p) {
@@ -331,7 +418,8 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   g.twin.resize(3 * dec_tri.size());
   // With stitches also the corners as pre-order positions (the cut surface
   // the stitch candidates are found on, candidate_topology).
-  std::vector<uint32_t> cut_corner(stitches.empty() ? 0 : g.corner.size());
+  std::vector<uint32_t>& cut_corner = ps.cut_corner;
+  cut_corner.resize(stitches.empty() ? 0 : g.corner.size());
   for (size_t k = 0; k < dec_tri.size(); ++k) {
     const uint32_t t = dec_tri[k];
     for (uint32_t e = 0; e < 3; ++e) {
@@ -425,50 +513,26 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
       for (uint32_t i = 0; i < mesh.face_size(face); ++i) tail.side.push_back(input_to_out[mesh.face(face)[i]]);
     }
   }
-  std::unique_ptr<CandidateTail> c;
-  if (!stitches.empty()) {
-    c = std::make_unique<CandidateTail>();
-    c->coder = eo;
-    c->models = om;
-    c->runs = runs;
-  }
-  code_tail(eo, om, runs, tail);
   st.components = C;
   st.virtual_vertices = virtual_pos.size();
   st.stitches = stitches.size();
-  if (c) {
-    c->corner = std::move(cut_corner);
-    c->twin = g.twin;
-    c->positions = P;
-    c->tail = std::move(tail);
-  }
   st.side_faces = prep.side_faces.size();
   st.polygons = prep.polygon_count;
-  out.streams.vertex_tree = ev.finish();
-  out.streams.triangle_tree = et.finish();
-  out.streams.topology = eo.finish();
-  // The mode byte (and the tables) first.
-  const std::string block = runs.tables ? runs.block() : std::string(1, '\0');
-  if (runs.tables) {
-    // Tables where they cost at most 1/8 more than the adaptive models
-    // (the corpus scans: 3-11% more, tables included). On regular meshes,
-    // whose runs repeat, the models learn the values down to a small
-    // fraction of a bit while a prefix code spends at least one bit on
-    // each (40-500% more): those are coded again without tables.
-    const size_t adaptive = runs.adaptive.finish().size();
-    if (block.size() > adaptive + adaptive / 8) {
-      CutHints again = hints;
-      again.runs = RunCoding::adaptive;
-      return encode_connectivity(mesh, out, again);
-    }
-  }
-  out.streams.topology = block + out.streams.topology;
-  if (c) {  // the stitch targets by candidates, as the file has them
-    out.distance_topology = std::move(out.streams.topology);
-    out.streams.topology = candidate_topology(*c);
-  }
-  st.bytes = out.streams.vertex_tree.size() + out.streams.triangle_tree.size() + out.streams.topology.size();
+  if (!stitches.empty()) ps.twin = g.twin;
+  ps.positions = P;
+  out.pending = std::move(pending);
+  // The streams now, unless the caller asked for the surface only (where
+  // the decoded faces are the layout's triangles: no polygons, no side
+  // faces).
+  if (hints.streams || st.polygons != 0 || st.side_faces != 0) return code_connectivity_streams(out);
   return Status::Ok();
+}
+
+Status code_connectivity_streams(ConnectivityEncoding& ce) {
+  if (!ce.pending) return Status::Ok();
+  const std::shared_ptr<PendingStreams> p = std::move(ce.pending);
+  ce.pending.reset();
+  return code_streams(*p, p->runs, ce);
 }
 
 }  // namespace tsm

@@ -237,11 +237,13 @@ Status anchor_step(const Mesh& mesh, const std::vector<uint32_t>& qin, const std
 }
 
 // The connectivity of a part with the given tree, then (with `anchors`)
-// the anchor step.
+// the anchor step; with `streams` false, the cut surface only where
+// encode_connectivity allows it (CutHints::streams).
 Status part_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
                          const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view,
-                         bool anchors = true) {
-  const CutHints hints = part_hints(mesh, qin, options, tree);
+                         bool anchors = true, bool streams = true) {
+  CutHints hints = part_hints(mesh, qin, options, tree);
+  hints.streams = streams;
   TSM_RETURN_IF_ERROR(encode_connectivity(mesh, ce, hints));
   view = own_view(ce, qin, is_ref);
   return anchors ? anchor_step(mesh, qin, is_ref, options.quantization_bits, hints, ce, view) : Status::Ok();
@@ -317,17 +319,20 @@ bool key_before(const CycleKey& a, const CycleKey& b) {
   return std::tie(a.vertex_tree, a.triangle_tree, a.topology) < std::tie(b.vertex_tree, b.triangle_tree, b.topology);
 }
 
-Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
-                              const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+// canonical_connectivity without the streams of the coding it settles on
+// where they are not coded yet: each round's cut surface is enough to find
+// its decoded faces, and only the last round's streams are in the file.
+Status canonical_surface(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                         const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
   const size_t n = mesh.vertex_count();
   std::vector<uint32_t> base;  // ids of the mesh `ce` codes -> the part's input ids (empty: the same)
   Mesh coded;                  // that mesh (faces only), once it is not `mesh`
   std::vector<uint32_t> q;
   std::vector<uint8_t> ref;
   // Codes a mesh whose ids are the part's input ids through `base`.
-  auto code = [&](const Mesh& faces, bool anchors = true) -> Status {
+  auto code = [&](const Mesh& faces, bool anchors = true, bool streams = true) -> Status {
     ce = ConnectivityEncoding();
-    if (base.empty()) return part_connectivity(faces, qin, is_ref, options, tree, ce, view, anchors);
+    if (base.empty()) return part_connectivity(faces, qin, is_ref, options, tree, ce, view, anchors, streams);
     q.resize(3 * n);
     for (size_t v = 0; v < n; ++v)
       for (int a = 0; a < 3; ++a) q[3 * v + a] = qin[3 * static_cast<size_t>(base[v]) + a];
@@ -335,7 +340,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       ref.resize(n);
       for (size_t v = 0; v < n; ++v) ref[v] = is_ref[base[v]];
     }
-    return part_connectivity(faces, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view);
+    return part_connectivity(faces, q, is_ref.empty() ? is_ref : ref, options, tree, ce, view, true, streams);
   };
   // Round 0 without its anchor step first. That step only orders the
   // vertices on no triangle (stably by anchor, then position), which no
@@ -346,7 +351,7 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
   // whole when its decoded self is the mesh itself, when side faces name
   // such vertices, and when round 0 is on a cycle (whose order compares
   // round 0's streams).
-  TSM_RETURN_IF_ERROR(code(mesh, false));
+  TSM_RETURN_IF_ERROR(code(mesh, false, false));
   if (tree.root_rule != 0 || ce.stats.stitches == 0)  // (root rules: only tried on parts without stitches)
     return anchor_step(mesh, qin, is_ref, options.quantization_bits, part_hints(mesh, qin, options, tree), ce,
                        view);
@@ -374,9 +379,10 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     if (!key.empty() && !in_anchor_order(ce, key)) order_off_triangles(qin, key, on_triangle, ce);
   }
   // Per round r: the mesh it coded (round 0: `mesh`, not copied), its
-  // streams and its base.
+  // streams (none where they were not coded: found again if a cycle needs
+  // them) and its base.
   std::vector<Mesh> coded_in;
-  std::vector<CycleKey> key_of;
+  std::vector<std::optional<CycleKey>> key_of;
   std::vector<std::vector<uint32_t>> base_of;
   auto coded_by = [&](size_t r) -> const Mesh& { return r == 0 ? mesh : coded_in[r - 1]; };
   const int rounds = canonical_rounds(mesh.face_count());
@@ -399,26 +405,34 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
       break;
     }
     if (round > 0) coded_in.push_back(std::move(coded));
-    key_of.push_back(cycle_key(ce));
+    // (Round 0 without its anchor step: its streams are not the ones a
+    // cycle compares.)
+    if (ce.pending || (round == 0 && !full_round0))
+      key_of.emplace_back();
+    else
+      key_of.push_back(cycle_key(ce));
     base_of.push_back(base);
     // Back at a mesh coded in round i: the cycle is rounds i..round.
     size_t i = 0;
     while (i <= static_cast<size_t>(round) && !same_faces(decoded, coded_by(i))) ++i;
     if (i <= static_cast<size_t>(round)) {
-      if (i == 0 && !full_round0) {  // round 0's streams with its anchor step, for the cycle's order
+      // The streams of the cycle's rounds that have none yet (round 0 with
+      // its anchor step), coded again for the cycle's order.
+      for (size_t k = i; k <= static_cast<size_t>(round); ++k) {
+        if (key_of[k]) continue;
         ConnectivityEncoding now_ce = std::move(ce);
         OwnView now_view = std::move(view);
         std::vector<uint32_t> now_base = std::move(base);
-        base.clear();
-        TSM_RETURN_IF_ERROR(code(mesh));
-        key_of[0] = cycle_key(ce);
+        base = base_of[k];
+        TSM_RETURN_IF_ERROR(code(coded_by(k)));
+        key_of[k] = cycle_key(ce);
         ce = std::move(now_ce);
         view = std::move(now_view);
         base = std::move(now_base);
       }
       size_t best = i;
       for (size_t k = i + 1; k <= static_cast<size_t>(round); ++k)
-        if (key_before(key_of[k], key_of[best])) best = k;
+        if (key_before(*key_of[k], *key_of[best])) best = k;
       if (best != static_cast<size_t>(round)) {  // (else `ce` is it)
         base = base_of[best];
         TSM_RETURN_IF_ERROR(code(coded_by(best)));
@@ -430,11 +444,17 @@ Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin
     base = std::move(next);
     coded = std::move(decoded);
     coded.positions.assign(3 * n, 0.0f);  // the coder reads the grid indices, not these
-    TSM_RETURN_IF_ERROR(code(coded));
+    TSM_RETURN_IF_ERROR(code(coded, true, false));
   }
   if (!base.empty())
     for (uint32_t& x : ce.vertex_order) x = base[x];  // back to the part's input ids
   return Status::Ok();
+}
+
+Status canonical_connectivity(const Mesh& mesh, const std::vector<uint32_t>& qin, const std::vector<uint8_t>& is_ref,
+                              const EncodeOptions& options, TreeChoice tree, ConnectivityEncoding& ce, OwnView& view) {
+  TSM_RETURN_IF_ERROR(canonical_surface(mesh, qin, is_ref, options, tree, ce, view));
+  return code_connectivity_streams(ce);
 }
 
 // The connectivity codings encode_part has tried for a part: a tree choice

@@ -108,13 +108,20 @@ void order_components(CutMesh& m, uint32_t count, uint32_t input_vertex_count) {
   // every vertex is taken) and its copy of smallest id there. Its members
   // by (input vertex, id) and a cursor past the taken ones: vertices are
   // only ever taken, so all keys together cost one pass over the members.
+  // That order in linear time: one stable counting sort of all members by
+  // input vertex (`member` lists each component's by id), each then put
+  // back in its component's range.
   std::vector<uint8_t> taken(input_vertex_count, 0);
-  std::vector<uint32_t> by_source(member);
+  std::vector<uint32_t> by_source(member.size());
+  {
+    std::vector<uint32_t> at(size_t{input_vertex_count} + 1, 0), sorted(member.size());
+    for (uint32_t v : member) ++at[m.source[v] + 1];
+    for (size_t s = 0; s < input_vertex_count; ++s) at[s + 1] += at[s];
+    for (uint32_t v : member) sorted[at[m.source[v]]++] = v;
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (uint32_t v : sorted) by_source[fill[m.vertex_component[v]]++] = v;
+  }
   std::vector<uint32_t> cursor(start.begin(), start.end() - 1);
-  for (uint32_t c = 0; c < count; ++c)
-    std::sort(by_source.begin() + start[c], by_source.begin() + start[c + 1], [&](uint32_t a, uint32_t b) {
-      return std::make_pair(m.source[a], a) < std::make_pair(m.source[b], b);
-    });
   auto key = [&](uint32_t c) {
     uint32_t& i = cursor[c];
     while (i < start[c + 1] && taken[m.source[by_source[i]]]) ++i;
