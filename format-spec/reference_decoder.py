@@ -3515,7 +3515,7 @@ def decode_order(payload, faces, positions):
     d = RangeDecoder(payload)
     vertex_pick = [[UIntModel() for _ in range(5)] for _ in range(2)]
     window_pick = [[UIntModel() for _ in range(5)] for _ in range(2)]
-    face_pick = [UIntModel() for _ in range(5)]
+    face_pick = [[UIntModel() for _ in range(5)] for _ in range(5)]
     turn = [UIntModel() for _ in range(2)]
     turn3 = {}
     vertex_jump, face_jump = SIntModel(), SIntModel()
@@ -3596,7 +3596,7 @@ def decode_order(payload, faces, positions):
             fcand = first + later
             if not fcand:
                 reject('order section: face %d: no unused face at its corner' % j)
-            q = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
+            q = face_pick[min(pick - 1, 4)][min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
             if q >= len(fcand):
                 reject('order section: face %d picks a face it does not have' % j)
             f, k = fcand[q]

@@ -11,7 +11,12 @@
 // (most recent first) and a pick from the unused faces at it (those sharing
 // an edge with the face before first), or an escape (a jump in face sweep
 // order: by the sweep position of their first-swept corner); then the turn
-// from that corner to the face's first.
+// from that corner to the face's first, for a triangle in the context of
+// its corners' labels (the lattice axis a marching-cubes vertex lies along,
+// which coordinates are the triangle's smallest, corners of the face
+// before). Vertex and window picks are coded in the context of whether
+// the vertex (face) before was a pick, face picks in that of the window
+// corner's place.
 #include "order_coding.hpp"
 
 #include <algorithm>
@@ -246,7 +251,8 @@ int median_edge_exponent(const Mesh& m, const std::vector<uint32_t>& nbr_start, 
 constexpr uint32_t kLabelBits = 6;
 
 struct OrderModels {
-  UIntModel vertex_pick[2][kPickContexts], window_pick[2][kPickContexts], face_pick[kPickContexts], turn[2];
+  UIntModel vertex_pick[2][kPickContexts], window_pick[2][kPickContexts], face_pick[kPickContexts][kPickContexts],
+      turn[2];
   SIntModel vertex_jump, face_jump;
   std::unordered_map<uint32_t, BitTreeModel<2>> turn3;  // by context, fresh on first use
 };
@@ -440,7 +446,8 @@ std::string encode_order_with(const Mesh& decoded, const std::vector<uint32_t>& 
       ctx.face_candidates(cand[at], prev, fc);
       size_t q = 0;
       while (fc[q].first != f) ++q;
-      if (fc.size() > 1) models.face_pick[pick_context(fc.size())].encode(e, static_cast<uint32_t>(q));
+      if (fc.size() > 1)
+        models.face_pick[pick_context(at)][pick_context(fc.size())].encode(e, static_cast<uint32_t>(q));
       k = fc[q].second;
     } else {
       models.face_jump.encode(
@@ -523,7 +530,7 @@ Status decode_order(std::string_view payload, Mesh& mesh) {
       ctx.face_candidates(cand[pick - 1], prev, fc);
       if (fc.empty()) return corrupt("face " + std::to_string(j) + ": no unused face at its corner");
       uint32_t q = 0;
-      if (fc.size() > 1) q = models.face_pick[pick_context(fc.size())].decode(d);
+      if (fc.size() > 1) q = models.face_pick[pick_context(pick - 1)][pick_context(fc.size())].decode(d);
       if (q >= fc.size()) return corrupt("face " + std::to_string(j) + " picks a face it does not have");
       f = fc[q].first;
       k = fc[q].second;
