@@ -3464,6 +3464,37 @@ class Sweep:
         return self.order[i]
 
 
+def lattice_axes(positions):
+    """§4.9: per vertex the one axis whose coordinate is on no lattice plane
+    while the other two are (a plane: a value that at least 4 times the mean
+    number of vertices per distinct value on that axis have), else 3."""
+    vc = len(positions)
+    on = [0] * vc
+    for a in range(3):
+        count = {}
+        for p in positions:
+            b = bits32(p[a])
+            count[b] = count.get(b, 0) + 1
+        for v, p in enumerate(positions):
+            if count[bits32(p[a])] * len(count) >= 4 * vc:
+                on[v] |= 1 << a
+    return [next((a for a in range(3) if on[v] == 7 & ~(1 << a)), 3) for v in range(vc)]
+
+
+def turn_context(c, k, prev, picked, axis, positions, detail):
+    """§4.9: the turn context of triangle c picked (or not) at corner k."""
+    ctx = 1 if picked else 0
+    for s in range(3):
+        x = c[(k + s) % 3]
+        low = 0
+        if detail:
+            for a in range(3):
+                v = positions[x][a]
+                low = low * 2 + (1 if all(v <= positions[y][a] for y in c) else 0)
+        ctx = (ctx << 6) | (axis[x] << 4) | (low << 1) | (1 if x in prev else 0)
+    return ctx
+
+
 def decode_order(payload, faces, positions):
     """§4.8: per input vertex its decoded vertex, per input face its decoded
     face and first corner."""
@@ -3482,14 +3513,16 @@ def decode_order(payload, faces, positions):
                 nbr[b].add(a)
     nbr = [sorted(x) for x in nbr]
     d = RangeDecoder(payload)
-    vertex_pick = [UIntModel() for _ in range(5)]
-    window_pick = [UIntModel() for _ in range(5)]
-    face_pick = [UIntModel() for _ in range(5)]
+    vertex_pick = [[UIntModel() for _ in range(5)] for _ in range(2)]
+    window_pick = [[UIntModel() for _ in range(5)] for _ in range(2)]
+    face_pick = [[UIntModel() for _ in range(5)] for _ in range(5)]
     turn = [UIntModel() for _ in range(2)]
+    turn3 = {}
     vertex_jump, face_jump = SIntModel(), SIntModel()
     used = [False] * vc
-    vertices, input_of = [], [0] * vc
+    vertices, input_of, picks = [], [0] * vc, []
     axes, slab = d.direct(3), d.direct(8) - 128
+    detail = d.direct(1)
     if axes > 5:
         reject('order section: sweep axes %d out of range' % axes)
     sweep = Sweep(positions, SWEEP_AXES[axes], slab)
@@ -3507,7 +3540,9 @@ def decode_order(payload, faces, positions):
                         dot += (positions[c][a] - positions[p][a]) * (positions[p][a] - positions[p2][a])
                     key.append((-dot if math.isfinite(dot) else math.inf, c))
                 cand = [c for _, c in sorted(key)]
-        pick = vertex_pick[min(len(cand), 4)].decode(d) if cand else 0
+        last = 1 if i and picks[-1] else 0
+        pick = vertex_pick[last][min(len(cand), 4)].decode(d) if cand else 0
+        picks.append(pick)
         if pick > len(cand):
             reject('order section: vertex %d picks a candidate it does not have' % i)
         if pick:
@@ -3532,7 +3567,8 @@ def decode_order(payload, faces, positions):
         for x in set(c):
             left[x] += 1
     taken = [False] * fc
-    order, rot, new_faces = [], [], []
+    order, rot, new_faces, fpicks = [], [], [], []
+    axis = lattice_axes(positions)
     for j in range(fc):
         cand = []                          # the window: corners of the last 16 faces
         for t in range(1, min(16, j) + 1):
@@ -3541,7 +3577,9 @@ def decode_order(payload, faces, positions):
                 x = g[(r + q) % len(g)]
                 if len(cand) < 64 and left[x] and x not in cand:
                     cand.append(x)
-        pick = window_pick[min(len(cand), 4)].decode(d) if cand else 0
+        last = 1 if j and fpicks[-1] else 0
+        pick = window_pick[last][min(len(cand), 4)].decode(d) if cand else 0
+        fpicks.append(pick)
         if pick > len(cand):
             reject('order section: face %d picks a corner it does not have' % j)
         if pick:
@@ -3558,7 +3596,7 @@ def decode_order(payload, faces, positions):
             fcand = first + later
             if not fcand:
                 reject('order section: face %d: no unused face at its corner' % j)
-            q = face_pick[min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
+            q = face_pick[min(pick - 1, 4)][min(len(fcand), 4)].decode(d) if len(fcand) > 1 else 0
             if q >= len(fcand):
                 reject('order section: face %d picks a face it does not have' % j)
             f, k = fcand[q]
@@ -3568,7 +3606,11 @@ def decode_order(payload, faces, positions):
                 reject('order section: face %d jumps past the unused faces' % j)
             f, k = fsweep.at_rank(r), 0
         c = faces[f]
-        t = turn[1 if pick else 0].decode(d) if len(c) > 1 else 0
+        if len(c) == 3:
+            ctx = turn_context(c, k, set(faces[order[-1]]) if j else set(), pick, axis, positions, detail)
+            t = turn3.setdefault(ctx, BitTree(2)).decode(d)
+        else:
+            t = turn[1 if pick else 0].decode(d) if len(c) > 1 else 0
         if t >= len(c):
             reject('order section: face %d turns past its corners' % j)
         taken[f] = True

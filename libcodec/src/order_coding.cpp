@@ -11,13 +11,19 @@
 // (most recent first) and a pick from the unused faces at it (those sharing
 // an edge with the face before first), or an escape (a jump in face sweep
 // order: by the sweep position of their first-swept corner); then the turn
-// from that corner to the face's first.
+// from that corner to the face's first, for a triangle in the context of
+// its corners' labels (the lattice axis a marching-cubes vertex lies along,
+// which coordinates are the triangle's smallest, corners of the face
+// before). Vertex and window picks are coded in the context of whether
+// the vertex (face) before was a pick, face picks in that of the window
+// corner's place.
 #include "order_coding.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <unordered_map>
 
 #include "connectivity.hpp"
 #include "range_coder.hpp"
@@ -240,10 +246,72 @@ int median_edge_exponent(const Mesh& m, const std::vector<uint32_t>& nbr_start, 
   return std::clamp(e, -kSlabExponentBias + 2, 127 - 2);
 }
 
+// A triangle's turn is coded in a context of its three corners' labels
+// (from the one it is picked at, 6 bits each) and whether it was picked.
+constexpr uint32_t kLabelBits = 6;
+
 struct OrderModels {
-  UIntModel vertex_pick[kPickContexts], window_pick[kPickContexts], face_pick[kPickContexts], turn[2];
+  UIntModel vertex_pick[2][kPickContexts], window_pick[2][kPickContexts], face_pick[kPickContexts][kPickContexts],
+      turn[2];
   SIntModel vertex_jump, face_jump;
+  std::unordered_map<uint32_t, BitTreeModel<2>> turn3;  // by context, fresh on first use
 };
+
+// Per decoded vertex, the lattice axis it lies along: a volume's marching
+// cubes put every vertex on a lattice edge, so two of its coordinates sit on
+// lattice planes, values that many vertices share. A coordinate is on a
+// plane when at least 4 times the mean number of vertices (per distinct value
+// on that axis) have it. The label is the one axis whose coordinate is not
+// on a plane, or 3 (none, or more than one).
+std::vector<uint8_t> lattice_axes(const Mesh& m) {
+  const size_t V = m.vertex_count();
+  std::vector<uint8_t> on(V, 0), out(V, 3);
+  std::vector<std::pair<uint32_t, uint32_t>> vals(V);
+  for (int a = 0; a < 3; ++a) {
+    for (uint32_t v = 0; v < V; ++v) {
+      uint32_t b;
+      std::memcpy(&b, &m.positions[3 * size_t{v} + static_cast<size_t>(a)], 4);
+      vals[v] = {b, v};
+    }
+    std::sort(vals.begin(), vals.end());
+    uint64_t distinct = 0;
+    for (size_t i = 0; i < V; ++i) distinct += i == 0 || vals[i].first != vals[i - 1].first;
+    for (size_t i = 0, j; i < V; i = j) {
+      for (j = i; j < V && vals[j].first == vals[i].first;) ++j;
+      if (uint64_t{j - i} * distinct >= 4 * uint64_t{V})
+        for (size_t k = i; k < j; ++k) on[vals[k].second] |= uint8_t(1u << a);
+    }
+  }
+  for (size_t v = 0; v < V; ++v)
+    for (uint8_t a = 0; a < 3; ++a)
+      if (on[v] == (7u & ~(1u << a))) out[v] = a;
+  return out;
+}
+
+// The turn context of triangle f picked (or not) at its corner k: per
+// corner from k on, its lattice axis (2 bits), with `detail` which of its
+// coordinates are the triangle's smallest on their axis (3 bits, else 0: a
+// marching-cubes triangle lists its corners by the cube edges they lie on),
+// and whether it is a corner of face `prev` (1 bit).
+uint32_t turn_context(const Mesh& m, const std::vector<uint8_t>& axis, uint32_t f, uint32_t k, uint32_t prev,
+                      bool picked, bool detail) {
+  const uint32_t* c = m.face(f);
+  const uint32_t* pc = prev == kNone ? nullptr : m.face(prev);
+  const uint32_t pn = prev == kNone ? 0 : m.face_size(prev);
+  const float* p = m.positions.data();
+  uint32_t ctx = picked;
+  for (uint32_t s = 0; s < 3; ++s) {
+    const uint32_t x = c[(k + s) % 3];
+    uint32_t low = 0;
+    for (size_t a = 0; a < 3 && detail; ++a) {
+      const float v = p[3 * size_t{x} + a];
+      low = low * 2 + (v <= p[3 * size_t{c[0]} + a] && v <= p[3 * size_t{c[1]} + a] && v <= p[3 * size_t{c[2]} + a]);
+    }
+    const uint32_t shared = pc && std::find(pc, pc + pn, x) != pc + pn;
+    ctx = (ctx << kLabelBits) | (uint32_t{axis[x]} << 4) | (low << 1) | shared;
+  }
+  return ctx;
+}
 
 uint32_t pick_context(size_t candidates) {
   return static_cast<uint32_t>(std::min<size_t>(candidates, kPickContexts - 1));
@@ -292,8 +360,12 @@ Status corrupt(const std::string& what) { return Status(ErrorCode::corrupt_data,
 
 }  // namespace
 
-std::string encode_order(const Mesh& decoded, const std::vector<uint32_t>& vertex_from,
-                         const std::vector<uint32_t>& face_from, const std::vector<uint32_t>& first_corner) {
+namespace {
+
+// The order stream with the turn contexts' detail on or off.
+std::string encode_order_with(const Mesh& decoded, const std::vector<uint32_t>& vertex_from,
+                              const std::vector<uint32_t>& face_from, const std::vector<uint32_t>& first_corner,
+                              bool detail) {
   const size_t V = decoded.vertex_count(), F = decoded.face_count();
   std::vector<uint32_t> faces(F), rot(F), vertices(V);  // input order -> decoded
   for (uint32_t f = 0; f < F; ++f) {
@@ -343,10 +415,11 @@ std::string encode_order(const Mesh& decoded, const std::vector<uint32_t>& verte
   }
   e.direct(static_cast<uint32_t>(best_axes), 3);
   e.direct(static_cast<uint32_t>(best_slab + kSlabExponentBias), 8);
+  e.direct(detail, 1);
   RankTree sweep(vertex_sweep(decoded, best_axes, best_slab));
   for (size_t i = 0; i < V; ++i) {
     const uint32_t v = vertices[i];
-    if (ncand[i]) models.vertex_pick[pick_context(ncand[i])].encode(e, pick[i]);
+    if (ncand[i]) models.vertex_pick[i && pick[i - 1]][pick_context(ncand[i])].encode(e, pick[i]);
     if (!pick[i])
       models.vertex_jump.encode(
           e, static_cast<int32_t>(int64_t{sweep.rank(v)} - (i ? int64_t{sweep.rank(vertices[i - 1])} : 0)));
@@ -355,27 +428,35 @@ std::string encode_order(const Mesh& decoded, const std::vector<uint32_t>& verte
   // Faces: a vertex of the window and a face at it, or a jump in face sweep
   // order; then the turn from that corner to the first.
   RankTree fsweep(face_sweep(decoded, sweep.at));
+  const std::vector<uint8_t> axis = lattice_axes(decoded);
   std::vector<uint32_t> left = unused_faces_per_vertex(decoded), stamp(V, 0), taken, taken_rot;
   std::vector<std::pair<uint32_t, uint32_t>> fc;
+  bool last_picked = false;  // the face before was picked from the window
   for (size_t j = 0; j < F; ++j) {
     const uint32_t f = faces[j], n = decoded.face_size(f), prev = j ? faces[j - 1] : kNone;
     window_candidates(decoded, taken, taken_rot, left, stamp, cand);
     size_t at = cand.size();
     for (size_t i = 0; i < cand.size() && at == cand.size(); ++i)
       if (std::find(decoded.face(f), decoded.face(f) + n, cand[i]) != decoded.face(f) + n) at = i;
-    if (!cand.empty()) models.window_pick[pick_context(cand.size())].encode(e, at < cand.size() ? uint32_t(at + 1) : 0);
+    if (!cand.empty())
+      models.window_pick[last_picked][pick_context(cand.size())].encode(e, at < cand.size() ? uint32_t(at + 1) : 0);
+    last_picked = at < cand.size();
     uint32_t k = 0;
     if (at < cand.size()) {
       ctx.face_candidates(cand[at], prev, fc);
       size_t q = 0;
       while (fc[q].first != f) ++q;
-      if (fc.size() > 1) models.face_pick[pick_context(fc.size())].encode(e, static_cast<uint32_t>(q));
+      if (fc.size() > 1)
+        models.face_pick[pick_context(at)][pick_context(fc.size())].encode(e, static_cast<uint32_t>(q));
       k = fc[q].second;
     } else {
       models.face_jump.encode(
           e, static_cast<int32_t>(int64_t{fsweep.rank(f)} - (prev == kNone ? 0 : int64_t{fsweep.rank(prev)})));
     }
-    if (n > 1) models.turn[at < cand.size()].encode(e, (rot[j] + n - k) % n);
+    if (n == 3)
+      models.turn3[turn_context(decoded, axis, f, k, prev, at < cand.size(), detail)].encode(e, (rot[j] + n - k) % n);
+    else if (n > 1)
+      models.turn[at < cand.size()].encode(e, (rot[j] + n - k) % n);
     ctx.face_used[f] = 1;
     fsweep.take(f);
     take_face(decoded, f, left);
@@ -385,6 +466,17 @@ std::string encode_order(const Mesh& decoded, const std::vector<uint32_t>& verte
   return e.finish();
 }
 
+}  // namespace
+
+// Both turn context sets are tried; the smaller stream is kept (the
+// detailed one pays on lattice meshes, dilutes the statistics elsewhere).
+std::string encode_order(const Mesh& decoded, const std::vector<uint32_t>& vertex_from,
+                         const std::vector<uint32_t>& face_from, const std::vector<uint32_t>& first_corner) {
+  std::string a = encode_order_with(decoded, vertex_from, face_from, first_corner, false);
+  std::string b = encode_order_with(decoded, vertex_from, face_from, first_corner, true);
+  return b.size() < a.size() ? b : a;
+}
+
 Status decode_order(std::string_view payload, Mesh& mesh) {
   const size_t V = mesh.vertex_count(), F = mesh.face_count();
   OrderContext ctx(mesh);
@@ -392,13 +484,15 @@ Status decode_order(std::string_view payload, Mesh& mesh) {
   RangeDecoder d(payload);
   std::vector<uint32_t> cand, faces(F), rot(F), vertices(V), input_of(V);
   const uint32_t axes = d.direct(3), slab = d.direct(8);
+  const bool detail = d.direct(1) != 0;
   if (axes >= kSweepAxes.size()) return corrupt("sweep axes " + std::to_string(axes) + " out of range");
+  bool last_picked = false;  // the vertex (face) before was a pick
   RankTree sweep(vertex_sweep(mesh, static_cast<int>(axes), static_cast<int>(slab) - kSlabExponentBias));
   for (size_t i = 0; i < V; ++i) {
     const uint32_t prev = i ? vertices[i - 1] : kNone, prev2 = i > 1 ? vertices[i - 2] : kNone;
     ctx.vertex_candidates(prev, prev2, cand);
     uint32_t pick = 0;
-    if (!cand.empty()) pick = models.vertex_pick[pick_context(cand.size())].decode(d);
+    if (!cand.empty()) pick = models.vertex_pick[last_picked][pick_context(cand.size())].decode(d);
     if (pick > cand.size()) return corrupt("vertex " + std::to_string(i) + " picks a candidate it does not have");
     uint32_t v;
     if (pick) {
@@ -410,30 +504,33 @@ Status decode_order(std::string_view payload, Mesh& mesh) {
       v = sweep.at_rank(static_cast<uint32_t>(r));
     }
     sweep.take(v);
+    last_picked = pick > 0;
     vertices[i] = v;
     input_of[v] = static_cast<uint32_t>(i);
     ctx.vertex_used[v] = 1;
     if (d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("cut off");
   }
   RankTree fsweep(face_sweep(mesh, sweep.at));
+  const std::vector<uint8_t> axis = lattice_axes(mesh);
   std::vector<uint32_t> left = unused_faces_per_vertex(mesh), stamp(V, 0), taken;
   taken.reserve(F);
   Mesh input;  // the faces decoded so far, on input ids
   input.indices.reserve(mesh.indices.size());
   input.face_offsets.reserve(F + 1);
   std::vector<std::pair<uint32_t, uint32_t>> fc;
+  last_picked = false;
   for (size_t j = 0; j < F; ++j) {
     const uint32_t prev = j ? faces[j - 1] : kNone;
     window_candidates(mesh, taken, rot, left, stamp, cand);
     uint32_t pick = 0;
-    if (!cand.empty()) pick = models.window_pick[pick_context(cand.size())].decode(d);
+    if (!cand.empty()) pick = models.window_pick[last_picked][pick_context(cand.size())].decode(d);
     if (pick > cand.size()) return corrupt("face " + std::to_string(j) + " picks a corner it does not have");
     uint32_t f, k = 0;
     if (pick) {
       ctx.face_candidates(cand[pick - 1], prev, fc);
       if (fc.empty()) return corrupt("face " + std::to_string(j) + ": no unused face at its corner");
       uint32_t q = 0;
-      if (fc.size() > 1) q = models.face_pick[pick_context(fc.size())].decode(d);
+      if (fc.size() > 1) q = models.face_pick[pick_context(pick - 1)][pick_context(fc.size())].decode(d);
       if (q >= fc.size()) return corrupt("face " + std::to_string(j) + " picks a face it does not have");
       f = fc[q].first;
       k = fc[q].second;
@@ -444,7 +541,9 @@ Status decode_order(std::string_view payload, Mesh& mesh) {
       f = fsweep.at_rank(static_cast<uint32_t>(r));
     }
     const uint32_t n = mesh.face_size(f);
-    const uint32_t t = n > 1 ? models.turn[pick > 0].decode(d) : 0;
+    const uint32_t t = n == 3  ? models.turn3[turn_context(mesh, axis, f, k, prev, pick > 0, detail)].decode(d)
+                       : n > 1 ? models.turn[pick > 0].decode(d)
+                               : 0;
     if (t >= n) return corrupt("face " + std::to_string(j) + " turns past its corners");
     faces[j] = f;
     rot[j] = (k + t) % n;
@@ -452,6 +551,7 @@ Status decode_order(std::string_view payload, Mesh& mesh) {
     fsweep.take(f);
     take_face(mesh, f, left);
     taken.push_back(f);
+    last_picked = pick > 0;
     for (uint32_t c = 0; c < n; ++c) input.indices.push_back(input_of[mesh.face(f)[(rot[j] + c) % n]]);
     input.face_offsets.push_back(static_cast<uint32_t>(input.indices.size()));
     if (d.overrun() > RangeDecoder::kMaxOverrun) return corrupt("cut off");
