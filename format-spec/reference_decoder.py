@@ -2203,6 +2203,8 @@ def predict_value(walk, item):
                     return vals[rc] if rc < r else None
                 sx, sy, n = walk.uv_triangles(f, i, known, across, sx, sy)
                 count += n
+            if count == 0:
+                sx, sy, count = pair_placement(walk, r, v)
             if count > 0:
                 return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
             return seam_transfer(walk, r, v)
@@ -2231,6 +2233,74 @@ def predict_value(walk, item):
             if x is not None:
                 return list(vals[x]), 0
     return list(walk.prev), 0
+
+
+def pair_placement(walk, r, v):
+    """§8.12 "Placement from two neighbours": vertex v (own rank r) that no
+    face's triangle places, from a = the first corner of its faces decoded
+    before it and b = the first after a (v's faces, then a's) not on the line
+    v-a, as the face (v, a, b) or (v, b, a), whichever agrees with v's normal.
+    Returns (sx, sy, count)."""
+    rank, q, faces = walk.rank, walk.q, walk.faces
+    pw = q[r]
+
+    def diff(x, y):
+        return [float(x[0] - y[0]), float(x[1] - y[1]), float(x[2] - y[2])]
+
+    def cross(e, g):
+        return [e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]]
+    n = [0.0, 0.0, 0.0]
+    ra = rb = NONE
+    cr = [0.0, 0.0, 0.0]
+
+    def second(fa, ra):
+        for c in fa:
+            rc = rank[c]
+            if c == v or rc == NONE or rc >= r or rc == ra:
+                continue
+            t = cross(diff(q[ra], pw), diff(q[rc], pw))
+            if t != [0.0, 0.0, 0.0]:
+                return rc, t
+        return NONE, None
+    for f, i in walk.around[v]:
+        fa = faces[f]
+        k = len(fa)
+        if k < 3:
+            continue
+        rn, rp = rank[fa[(i + 1) % k]], rank[fa[(i + k - 1) % k]]
+        if rn != NONE and rp != NONE:
+            t = cross(diff(q[rn], pw), diff(q[rp], pw))
+            n = [n[0] + t[0], n[1] + t[1], n[2] + t[2]]
+        if rb != NONE:
+            continue
+        if ra == NONE:
+            for m, c in enumerate(fa):
+                rc = rank[c]
+                if c != v and rc != NONE and rc < r:
+                    ra = rc
+                    rb, t = second(fa[m + 1:], ra)
+                    break
+        else:
+            rb, t = second(fa, ra)
+        if rb != NONE:
+            cr = t
+    if ra == NONE:
+        return 0.0, 0.0, 0
+    if rb == NONE:
+        for f, _ in walk.around[walk.own_vertex[ra]]:
+            rb, t = second(faces[f], ra)
+            if rb != NONE:
+                cr = t
+                break
+    if rb == NONE:
+        return 0.0, 0.0, 0
+    s = cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2]
+    if s == 0:
+        return 0.0, 0.0, 0
+    if s < 0:
+        ra, rb = rb, ra
+    x, y = uv_place(pw, q[ra], q[rb], walk.values[ra], walk.values[rb], None, None, walk.sigma)
+    return x, y, 1
 
 
 def first_known_corner(walk, v, r, at=None):

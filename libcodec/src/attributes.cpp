@@ -805,6 +805,7 @@ struct AttributeWalk {
               },
               sum);
         }
+        if (count == 0) count = pair_placement(v, r, sigma, x, sum, vertex_of);
         cls = placed(sum, count, pred);
       }
       SeamTransfer transfer;
@@ -822,6 +823,75 @@ struct AttributeWalk {
       if (predictor == 2) update_sigma(v, r, sigma, uv, x);
     }
     return true;
+  }
+  // Predictor 2 where no triangle of a face places vertex w = v (own rank
+  // r), FORMAT.md §8.12 "Placement from two neighbours": a = the first
+  // corner of w's faces (faces-around order, positions in order) decoded
+  // before it, b = the first such corner after a not on the line w-a (in
+  // w's faces, then in a's), and w is placed as the face (w, a, b) would
+  // place it, or (w, b, a): the order whose normal agrees with w's (the
+  // sum over its faces of (next - w) x (previous - w)). At the start of a
+  // chart, where a vertex has one decoded neighbour, this replaces the
+  // neighbour's value as the prediction. Adds the placement to `sum`;
+  // returns 1, or 0 when there is none.
+  int pair_placement(size_t v, uint32_t r, int sigma, const std::vector<int32_t>& x, double sum[2],
+                     const std::vector<uint32_t>& vertex_of) const {
+    const uint32_t* pw = &(*q)[3 * size_t{r}];
+    double n[3] = {0, 0, 0}, cross[3] = {0, 0, 0};
+    uint32_t ra = kNone, rb = kNone;
+    for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f), i = around->corner[j];
+      const uint32_t* c = faces.face(f);
+      if (k < 3) continue;
+      const uint32_t rn = rank[c[(i + 1) % k]], rp = rank[c[(i + k - 1) % k]];
+      if (rn != kNone && rp != kNone) {
+        double t[3];
+        corner_cross(rn, rp, pw, t);
+        for (int d = 0; d < 3; ++d) n[d] += t[d];
+      }
+      for (uint32_t m = 0; m < k && rb == kNone; ++m) {
+        const uint32_t rc = rank[c[m]];
+        if (c[m] == v || rc == kNone || rc >= r || rc == ra) continue;
+        if (ra == kNone) {
+          ra = rc;
+        } else {
+          corner_cross(ra, rc, pw, cross);
+          if (cross[0] != 0 || cross[1] != 0 || cross[2] != 0) rb = rc;
+        }
+      }
+    }
+    if (ra == kNone) return 0;
+    const uint32_t va = vertex_of[ra];
+    for (uint32_t j = around->start[va]; j < around->start[va + 1] && rb == kNone; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f);
+      const uint32_t* c = faces.face(f);
+      for (uint32_t m = 0; m < k && rb == kNone; ++m) {
+        const uint32_t rc = rank[c[m]];
+        if (c[m] == v || rc == kNone || rc >= r || rc == ra) continue;
+        corner_cross(ra, rc, pw, cross);
+        if (cross[0] != 0 || cross[1] != 0 || cross[2] != 0) rb = rc;
+      }
+    }
+    if (rb == kNone) return 0;
+    const double s = cross[0] * n[0] + cross[1] * n[1] + cross[2] * n[2];
+    if (s == 0) return 0;
+    if (s < 0) std::swap(ra, rb);
+    double p[2];
+    uv_from_triangle(pw, &(*q)[3 * size_t{ra}], &(*q)[3 * size_t{rb}], &x[2 * size_t{ra}], &x[2 * size_t{rb}], nullptr,
+                     nullptr, sigma, p);
+    sum[0] += p[0];
+    sum[1] += p[1];
+    return 1;
+  }
+  // (q[ra] - pw) x (q[rb] - pw), binary64 in the order FORMAT.md gives.
+  void corner_cross(uint32_t ra, uint32_t rb, const uint32_t* pw, double* out) const {
+    const uint32_t* pa = &(*q)[3 * size_t{ra}];
+    const uint32_t* pb = &(*q)[3 * size_t{rb}];
+    const double e[3] = {double(pa[0]) - pw[0], double(pa[1]) - pw[1], double(pa[2]) - pw[2]};
+    const double g[3] = {double(pb[0]) - pw[0], double(pb[1]) - pw[1], double(pb[2]) - pw[2]};
+    out[0] = e[1] * g[2] - e[2] * g[1];
+    out[1] = e[2] * g[0] - e[0] * g[2];
+    out[2] = e[0] * g[1] - e[1] * g[0];
   }
   // Predictor 2 where no triangle places vertex v (own rank r): the value
   // of the first corner of its faces (faces-around order, positions in
