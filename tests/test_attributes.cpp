@@ -543,7 +543,7 @@ Mesh rotated_charts(int n, int c) {
 
 }  // namespace
 
-// FORMAT.md §8.12 "Placement from two neighbours": where a chart starts, a
+// FORMAT.md §8.12 "Placement from two neighbours" (predictor 5): where a chart starts, a
 // vertex with decoded neighbours but no face holding two of them is placed
 // from two of them (the chart's turn and scale follow from them) instead of
 // taking a neighbour's value: small charts each turned their own way cost
