@@ -2099,6 +2099,8 @@ class AttrWalk:
         self.gnormal, self.stray = geometry_normals(faces, rank, q, h.bits, weights) if h.quant == 2 else (None, None)
         self.around = around            # predictor 2: faces_around()
         self.sigma = 1                  # predictor 2: the texture orientation so far
+        self.miss = [0, 0]              # predictor 5: recent misses, affine and conformal
+        self.placements = None          # predictor 5: this vertex's (affine, conformal)
         self.prev = [0] * h.ints()      # the previous value decoded (previous vertex / face / new or unused value)
         self.values = []                # integers of the values decoded so far (corner domain: the value list)
         self.alias = []                 # corner domain: per value, the earlier segment's value id it stands for, or None
@@ -2109,11 +2111,13 @@ class AttrWalk:
         self.visit = []                 # corner domain: the current face's visiting order
         self.cand = None                # corner domain: candidate value ids per part vertex
 
-    def uv_triangles(self, f, i, known, across, sx=0.0, sy=0.0):
+    def uv_triangles(self, f, i, known, across, sx=0.0, sy=0.0, conf=None):
         """§8.12 "Prediction at position i of face f": adds its placements to the
         running sum (sx, sy), side after side (the vertex domain carries one sum
         over all faces around the vertex, as attributes.cpp does: summing per
-        face first could round differently). Returns (sx, sy, count)."""
+        face first could round differently), and to `conf` (a list of two sums,
+        vertex domain) the same placements made without c (conformal).
+        Returns (sx, sy, count)."""
         fa = self.faces[f]
         k = len(fa)
         rank, q = self.rank, self.q
@@ -2151,6 +2155,11 @@ class AttrWalk:
             x, y = uv_place(q[rank[w]], q[rank[a]], q[rank[b]], ua, ub, pc, uc, self.sigma)
             sx += x
             sy += y
+            if conf is not None:
+                if pc is not None:
+                    x, y = uv_place(q[rank[w]], q[rank[a]], q[rank[b]], ua, ub, None, None, self.sigma)
+                conf[0] += x
+                conf[1] += y
             count += 1
         return sx, sy, count
 
@@ -2187,9 +2196,10 @@ def predict_value(walk, item):
             if walk.gnormal[r] is None:
                 return list(walk.prev), 2
             return list(walk.gnormal[r]) + walk.prev[2:], walk.stray[r]
-        if walk.predictor == 2:
+        if walk.predictor in (2, 5):
             rank, vals = walk.rank, walk.values
             sx = sy = 0.0
+            conf = [0.0, 0.0]
             count = 0
             for f, i in walk.around[v]:
                 fa = walk.faces[f]
@@ -2201,8 +2211,16 @@ def predict_value(walk, item):
                 def across(F, ja, jb, jc, ia, ib):
                     rc = rank[walk.faces[F][jc]]
                     return vals[rc] if rc < r else None
-                sx, sy, n = walk.uv_triangles(f, i, known, across, sx, sy)
+                sx, sy, n = walk.uv_triangles(f, i, known, across, sx, sy, conf)
                 count += n
+            if count == 0 and walk.predictor == 5:
+                sx, sy, count = pair_placement(walk, r, v)
+                conf = [sx, sy]
+            if count > 0 and walk.predictor == 5:            # "Affine or conformal"
+                affine = [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)]
+                conformal = [round_to_grid(conf[0] / count, h.bits), round_to_grid(conf[1] / count, h.bits)]
+                walk.placements = (affine, conformal)
+                return list(conformal if walk.miss[1] < walk.miss[0] else affine), min(count, 2)
             if count > 0:
                 return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
             return seam_transfer(walk, r, v)
@@ -2231,6 +2249,74 @@ def predict_value(walk, item):
             if x is not None:
                 return list(vals[x]), 0
     return list(walk.prev), 0
+
+
+def pair_placement(walk, r, v):
+    """§8.12 "Placement from two neighbours": vertex v (own rank r) that no
+    face's triangle places, from a = the first corner of its faces decoded
+    before it and b = the first after a (v's faces, then a's) not on the line
+    v-a, as the face (v, a, b) or (v, b, a), whichever agrees with v's normal.
+    Returns (sx, sy, count)."""
+    rank, q, faces = walk.rank, walk.q, walk.faces
+    pw = q[r]
+
+    def diff(x, y):
+        return [float(x[0] - y[0]), float(x[1] - y[1]), float(x[2] - y[2])]
+
+    def cross(e, g):
+        return [e[1] * g[2] - e[2] * g[1], e[2] * g[0] - e[0] * g[2], e[0] * g[1] - e[1] * g[0]]
+    n = [0.0, 0.0, 0.0]
+    ra = rb = NONE
+    cr = [0.0, 0.0, 0.0]
+
+    def second(fa, ra):
+        for c in fa:
+            rc = rank[c]
+            if c == v or rc == NONE or rc >= r or rc == ra:
+                continue
+            t = cross(diff(q[ra], pw), diff(q[rc], pw))
+            if t != [0.0, 0.0, 0.0]:
+                return rc, t
+        return NONE, None
+    for f, i in walk.around[v]:
+        fa = faces[f]
+        k = len(fa)
+        if k < 3:
+            continue
+        rn, rp = rank[fa[(i + 1) % k]], rank[fa[(i + k - 1) % k]]
+        if rn != NONE and rp != NONE:
+            t = cross(diff(q[rn], pw), diff(q[rp], pw))
+            n = [n[0] + t[0], n[1] + t[1], n[2] + t[2]]
+        if rb != NONE:
+            continue
+        if ra == NONE:
+            for m, c in enumerate(fa):
+                rc = rank[c]
+                if c != v and rc != NONE and rc < r:
+                    ra = rc
+                    rb, t = second(fa[m + 1:], ra)
+                    break
+        else:
+            rb, t = second(fa, ra)
+        if rb != NONE:
+            cr = t
+    if ra == NONE:
+        return 0.0, 0.0, 0
+    if rb == NONE:
+        for f, _ in walk.around[walk.own_vertex[ra]]:
+            rb, t = second(faces[f], ra)
+            if rb != NONE:
+                cr = t
+                break
+    if rb == NONE:
+        return 0.0, 0.0, 0
+    s = cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2]
+    if s == 0:
+        return 0.0, 0.0, 0
+    if s < 0:
+        ra, rb = rb, ra
+    x, y = uv_place(pw, q[ra], q[rb], walk.values[ra], walk.values[rb], None, None, walk.sigma)
+    return x, y, 1
 
 
 def first_known_corner(walk, v, r, at=None):
@@ -2336,6 +2422,8 @@ def predictor_allowed(h, pr):
         return h.domain in (0, 2) and h.quant == 2
     if pr == 2:
         return h.domain != 1 and h.quant == 1 and h.components == 2
+    if pr == 5:
+        return h.domain == 0 and h.quant == 1 and h.components == 2
     return False
 
 
@@ -2404,7 +2492,7 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             rank[v] = len(own_vertex)
             own_vertex.append(v)
     own = len(own_vertex)
-    around = faces_around(faces, len(glob)) if 2 in predictors else None
+    around = faces_around(faces, len(glob)) if 2 in predictors or 5 in predictors else None
     d = RangeDecoder(coded)
     out = []
     for i, (h, pr) in enumerate(zip(headers, predictors)):
@@ -2447,13 +2535,17 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                                 recent.remove(x)
                             recent.insert(0, list(x))
                             del recent[64:]
-                        if pr == 2:
+                        if pr in (2, 5):
                             for f, _ in around[own_vertex[r]]:
                                 fa = faces[f]
                                 if len(fa) >= 3 and all(rank[c] <= r for c in fa):
                                     walk.update_sigma([walk.values[rank[c]] for c in fa])
                         continue
+                walk.placements = None
                 if h.recent:                                 # a recent value, or decoded as usual
+                    if pr == 5:                              # the placements, for the misses below
+                        predict_value(walk, ('vertex', r, own_vertex[r]))
+                        walk.transfer = None
                     hit = m.recent_hit[hit_before].decode(d)
                     if hit > 1:
                         reject('attributes: vertex values of %r out of range' % h.name)
@@ -2473,7 +2565,10 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                     del recent[64:]
                 else:
                     x = decode_value(d, m, walk, ('vertex', r, own_vertex[r]))
-                if pr == 2:                                  # faces this vertex completes: sigma
+                if walk.placements is not None:              # "Affine or conformal": the misses
+                    for j, p in enumerate(walk.placements):
+                        walk.miss[j] += abs(x[0] - p[0]) + abs(x[1] - p[1]) - (walk.miss[j] >> 3)
+                if pr in (2, 5):                             # faces this vertex completes: sigma
                     for f, _ in around[own_vertex[r]]:
                         fa = faces[f]
                         if len(fa) >= 3 and all(rank[c] <= r for c in fa):

@@ -683,6 +683,12 @@ struct AttributeWalk {
   const std::vector<uint8_t>* ghas;
   const std::vector<uint32_t>* q = nullptr;  // own vertices' grid positions (predictor 2)
   const VertexFaces* around = nullptr;       // faces around each vertex (predictor 2)
+  // Predictor 5: the recent misses of the affine and of the
+  // conformal placements (FORMAT.md §8.12 "Affine or conformal").
+  int64_t err_affine = 0, err_conformal = 0;
+  static int64_t miss(const int32_t* x, const int32_t* p) {
+    return std::abs(int64_t{x[0]} - p[0]) + std::abs(int64_t{x[1]} - p[1]);
+  }
 
   // Predictor 2 for the value at position i of face f (vertex w): the mean
   // of the texture-space placements from the face's triangles (w, i+1, i+2)
@@ -691,9 +697,10 @@ struct AttributeWalk {
   // For each, the first face around a (in `around` order) other than f that
   // has the edge a-b and a third corner c, an own vertex other than w, whose
   // value `across(F, position of a, of b, of c in F, ia, ib)` gives, is the
-  // triangle across the edge.
+  // triangle across the edge. sum[0..1] gets the placements with c where
+  // found (affine), sum[2..3] the placements without c (conformal).
   template <class Known, class Across>
-  int uv_triangles(uint32_t f, uint32_t i, int sigma, Known known, Across across, double sum[2]) const {
+  int uv_triangles(uint32_t f, uint32_t i, int sigma, Known known, Across across, double sum[4]) const {
     const uint32_t k = faces.face_size(f);
     const uint32_t* c = faces.face(f);
     int count = 0;
@@ -729,10 +736,15 @@ struct AttributeWalk {
         if (uc) pc = &(*q)[3 * static_cast<size_t>(rank[cv])];
       }
       double p[2];
-      uv_from_triangle(&(*q)[3 * static_cast<size_t>(rank[w])], &(*q)[3 * static_cast<size_t>(rank[a])],
-                       &(*q)[3 * static_cast<size_t>(rank[b])], ua, ub, pc, uc, sigma, p);
+      const uint32_t* pw = &(*q)[3 * static_cast<size_t>(rank[w])];
+      const uint32_t* pa = &(*q)[3 * static_cast<size_t>(rank[a])];
+      const uint32_t* pb = &(*q)[3 * static_cast<size_t>(rank[b])];
+      uv_from_triangle(pw, pa, pb, ua, ub, pc, uc, sigma, p);
       sum[0] += p[0];
       sum[1] += p[1];
+      if (pc) uv_from_triangle(pw, pa, pb, ua, ub, nullptr, nullptr, sigma, p);
+      sum[2] += p[0];
+      sum[3] += p[1];
       ++count;
     }
     return count;
@@ -748,6 +760,10 @@ struct AttributeWalk {
     return std::min(count, 2);
   }
 
+  // Predictors 2 and 5 place texture coordinates from the geometry; 5
+  // chooses per vertex between the affine and the conformal placement.
+  static bool placement(int predictor) { return predictor == 2 || predictor == 5; }
+
   // Vertex values, own vertices in output order. `x`: 'ints' per own vertex.
   // With `recent` (predictor bit 5), a value may instead name one of the
   // last 64 distinct values (the encoder does when the prediction misses it).
@@ -759,7 +775,7 @@ struct AttributeWalk {
     std::vector<std::array<int32_t, 4>> list;  // recent values, most recent first
     uint32_t hit_before = 0, sibling_before = 0;
     std::vector<uint32_t> earlier;  // per own rank: the previous own vertex at its grid position, or kNone
-    if (siblings || predictor == 2) earlier_at_same_position(earlier);
+    if (siblings || placement(predictor)) earlier_at_same_position(earlier);
     std::vector<uint32_t> vertex_of;  // per own rank: its part vertex
     for (uint32_t v = 0; v < rank.size(); ++v)
       if (rank[v] != kNone) vertex_of.push_back(v);
@@ -774,21 +790,23 @@ struct AttributeWalk {
           const int32_t* xv = &x[n * static_cast<size_t>(r)];
           std::copy(xv, xv + n, prev);
           if (recent) touch_recent(list, xv);
-          if (predictor == 2) update_sigma(v, r, sigma, uv, x);
+          if (placement(predictor)) update_sigma(v, r, sigma, uv, x);
           continue;
         }
       }
       int32_t pred[4] = {prev[0], prev[1], prev[2], prev[3]};
+      int32_t affine[2] = {0, 0}, conformal[2] = {0, 0};  // predictor 2's two placements
+      int placements = 0;
       int cls = 0;
-      if (predictor == 1 || predictor >= 3) {
+      if (predictor == 1 || predictor == 3 || predictor == 4) {
         cls = (*ghas)[r] ? (*ghas)[r] - 1 : 2;  // how far its faces stray (geometry_normals)
         if ((*ghas)[r]) {
           pred[0] = (*gnormal)[2 * r];
           pred[1] = (*gnormal)[2 * r + 1];
         }
       }
-      if (predictor == 2) {
-        double sum[2] = {0, 0};
+      if (placement(predictor)) {
+        double sum[4] = {0, 0, 0, 0};
         int count = 0;
         for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
           const uint32_t f = around->face[j];
@@ -805,10 +823,17 @@ struct AttributeWalk {
               },
               sum);
         }
+        if (count == 0 && predictor == 5) count = pair_placement(v, r, sigma, x, sum, vertex_of);
         cls = placed(sum, count, pred);
+        if (predictor == 5 && count > 0) {  // the placement whose recent misses are smaller
+          placed(sum + 2, count, conformal);
+          std::copy_n(pred, 2, affine);
+          if (err_conformal < err_affine) std::copy_n(conformal, 2, pred);
+        }
+        placements = count;
       }
       SeamTransfer transfer;
-      if (predictor == 2 && cls == 0) {
+      if (placement(predictor) && cls == 0) {
         seam_transfer(v, r, earlier, vertex_of, x, pred, transfer);
         if (transfer.have) cls = 1;
       }
@@ -819,9 +844,81 @@ struct AttributeWalk {
         return false;
       }
       std::copy(xv, xv + n, prev);
-      if (predictor == 2) update_sigma(v, r, sigma, uv, x);
+      if (predictor == 5 && placements > 0) {
+        err_affine += miss(xv, affine) - (err_affine >> 3);
+        err_conformal += miss(xv, conformal) - (err_conformal >> 3);
+      }
+      if (placement(predictor)) update_sigma(v, r, sigma, uv, x);
     }
     return true;
+  }
+  // Predictor 5 where no triangle of a face places vertex w = v (own rank
+  // r), FORMAT.md §8.12 "Placement from two neighbours": a = the first
+  // corner of w's faces (faces-around order, positions in order) decoded
+  // before it, b = the first such corner after a not on the line w-a (in
+  // w's faces, then in a's), and w is placed as the face (w, a, b) would
+  // place it, or (w, b, a): the order whose normal agrees with w's (the
+  // sum over its faces of (next - w) x (previous - w)). At the start of a
+  // chart, where a vertex has one decoded neighbour, this replaces the
+  // neighbour's value as the prediction. Adds the placement to `sum`;
+  // returns 1, or 0 when there is none.
+  int pair_placement(size_t v, uint32_t r, int sigma, const std::vector<int32_t>& x, double sum[4],
+                     const std::vector<uint32_t>& vertex_of) const {
+    const uint32_t* pw = &(*q)[3 * size_t{r}];
+    double n[3] = {0, 0, 0}, cross[3] = {0, 0, 0};
+    uint32_t ra = kNone, rb = kNone;
+    for (uint32_t j = around->start[v]; j < around->start[v + 1]; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f), i = around->corner[j];
+      const uint32_t* c = faces.face(f);
+      if (k < 3) continue;
+      const uint32_t rn = rank[c[(i + 1) % k]], rp = rank[c[(i + k - 1) % k]];
+      if (rn != kNone && rp != kNone) {
+        double t[3];
+        corner_cross(rn, rp, pw, t);
+        for (int d = 0; d < 3; ++d) n[d] += t[d];
+      }
+      for (uint32_t m = 0; m < k && rb == kNone; ++m) {
+        const uint32_t rc = rank[c[m]];
+        if (c[m] == v || rc == kNone || rc >= r || rc == ra) continue;
+        if (ra == kNone) {
+          ra = rc;
+        } else {
+          corner_cross(ra, rc, pw, cross);
+          if (cross[0] != 0 || cross[1] != 0 || cross[2] != 0) rb = rc;
+        }
+      }
+    }
+    if (ra == kNone) return 0;
+    const uint32_t va = vertex_of[ra];
+    for (uint32_t j = around->start[va]; j < around->start[va + 1] && rb == kNone; ++j) {
+      const uint32_t f = around->face[j], k = faces.face_size(f);
+      const uint32_t* c = faces.face(f);
+      for (uint32_t m = 0; m < k && rb == kNone; ++m) {
+        const uint32_t rc = rank[c[m]];
+        if (c[m] == v || rc == kNone || rc >= r || rc == ra) continue;
+        corner_cross(ra, rc, pw, cross);
+        if (cross[0] != 0 || cross[1] != 0 || cross[2] != 0) rb = rc;
+      }
+    }
+    if (rb == kNone) return 0;
+    const double s = cross[0] * n[0] + cross[1] * n[1] + cross[2] * n[2];
+    if (s == 0) return 0;
+    if (s < 0) std::swap(ra, rb);
+    double p[2];
+    uv_from_triangle(pw, &(*q)[3 * size_t{ra}], &(*q)[3 * size_t{rb}], &x[2 * size_t{ra}], &x[2 * size_t{rb}], nullptr,
+                     nullptr, sigma, p);
+    for (int k = 0; k < 4; ++k) sum[k] += p[k % 2];
+    return 1;
+  }
+  // (q[ra] - pw) x (q[rb] - pw), binary64 in the order FORMAT.md gives.
+  void corner_cross(uint32_t ra, uint32_t rb, const uint32_t* pw, double* out) const {
+    const uint32_t* pa = &(*q)[3 * size_t{ra}];
+    const uint32_t* pb = &(*q)[3 * size_t{rb}];
+    const double e[3] = {double(pa[0]) - pw[0], double(pa[1]) - pw[1], double(pa[2]) - pw[2]};
+    const double g[3] = {double(pb[0]) - pw[0], double(pb[1]) - pw[1], double(pb[2]) - pw[2]};
+    out[0] = e[1] * g[2] - e[2] * g[1];
+    out[1] = e[2] * g[0] - e[0] * g[2];
+    out[2] = e[0] * g[1] - e[1] * g[0];
   }
   // Predictor 2 where no triangle places vertex v (own rank r): the value
   // of the first corner of its faces (faces-around order, positions in
@@ -1104,7 +1201,7 @@ struct AttributeWalk {
             pred[1] = (*gnormal)[2 * r + 1];
           }
           if (predictor == 2) {
-            double sum[2] = {0, 0};
+            double sum[4] = {0, 0, 0, 0};
             const uint32_t* off = faces.face_offsets.data();
             const int count = uv_triangles(
                 g, i, sigma,
@@ -1280,12 +1377,14 @@ namespace {
 // value; 1, 3 and 4 geometry normal weighted by area, by face, by angle
 // (octahedral vertex normals; 3 and 4 also corner normals, whose new values
 // predictor 0 predicts by area); 2 texture placement from the geometry
-// (two-component grid values per vertex or corner).
+// (two-component grid values per vertex or corner); 5 the same placement,
+// affine or conformal per vertex (two-component grid values per vertex).
 unsigned predictors_for(const AttributeHeader& h) {
   unsigned p = 1;
   if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::octahedral) p |= 2 | 8 | 16;
   if (h.domain == AttributeDomain::corner && h.quant == AttributeQuant::octahedral) p |= 8 | 16;
   if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
+  if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::grid && h.components == 2) p |= 32;
   return p;
 }
 
@@ -1358,7 +1457,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   VertexFaces around;
   bool need_around = false;
   for (size_t i = 0; i < headers.size(); ++i)
-    need_around = need_around || predictors_for(coded_header(headers[i], in.per_vertex >> i & 1)) & 4;
+    need_around = need_around || predictors_for(coded_header(headers[i], in.per_vertex >> i & 1)) & (4 | 32);
   if (need_around) around.build(faces, V);
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
@@ -1435,7 +1534,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       size = trial.e.finish().size();
       return true;
     };
-    for (int p = 0; p < 5 && choices != 1; ++p) {
+    for (int p = 0; p < 6 && choices != 1; ++p) {
       size_t size = 0;
       if (!(choices >> p & 1)) continue;
       if (!adaptive_size(p, size)) return Status(ErrorCode::internal, "attributes: values out of range");
@@ -1547,7 +1646,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       shared |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeSharedFlag);
     }
-    if (p > 4 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
+    if (p > 5 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
   if (in.per_vertex) *in.per_vertex = per_vertex;
@@ -1575,7 +1674,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (global[v] == kNone) rank[v] = own++;
   VertexFaces around;
   for (size_t i = 0; i < headers.size(); ++i)
-    if (predictor[i] == 2 && around.start.empty()) around.build(faces, V);
+    if ((predictor[i] == 2 || predictor[i] == 5) && around.start.empty()) around.build(faces, V);
   dec.d.init(coded);
   for (size_t i = 0; i < headers.size(); ++i) {
     const AttributeHeader& h = headers[i];
