@@ -3407,17 +3407,48 @@ def decode_loose(payload, level):
     if count + nfaces == 0 or count > most or nfaces > most or count + nfaces > most:
         reject('loose vertex or face count')
     d = RangeDecoder(stream)
-    axis = [SIntModel(3) for _ in range(3)]
+    anchor_model = UIntModel(2)
+    residual = [SIntModel(3) for _ in range(3)]
     qmax = (1 << level.h['bits']) - 1
-    prev = [0, 0, 0]
+    anchors = len(level.q)
+    points = []
+    anchor = 0
     for _ in range(count):
+        anchor += anchor_model.decode(d)
+        if anchor >= anchors:
+            reject("a loose vertex's anchor")
+        qa = level.q[anchor]
+        nrm = [0, 0, 0]                  # the anchor's face normal, exact integers
+        for f in level.vf[anchor]:
+            c = [level.q[w] for w in level.faces[f][:3]]
+            e1 = [c[1][k] - c[0][k] for k in range(3)]
+            e2 = [c[2][k] - c[0][k] for k in range(3)]
+            nrm[0] += e1[1] * e2[2] - e1[2] * e2[1]
+            nrm[1] += e1[2] * e2[0] - e1[0] * e2[2]
+            nrm[2] += e1[0] * e2[1] - e1[1] * e2[0]
+        shift = max(0, max(bit_length(abs(x)) for x in nrm) - 16)
+        nrm = [floordiv(x, 1 << shift) for x in nrm]
+        order = [0, 0, 0]
         for a in range(3):
-            prev[a] += axis[a].decode(d)
-            if not 0 <= prev[a] <= qmax:
+            order[sum(1 for b in range(3) if abs(nrm[b]) > abs(nrm[a]) or (abs(nrm[b]) == abs(nrm[a]) and b < a))] = a
+        g = [0, 0, 0]
+        e = [0, 0, 0]
+        for k in (1, 2, 0):
+            e[k] = residual[k].decode(d)
+            off = 0
+            n0 = nrm[order[0]]
+            if k == 0 and n0 != 0:
+                t = -(nrm[order[1]] * e[1] + nrm[order[2]] * e[2])
+                off = floordiv(2 * (-t if n0 < 0 else t) + abs(n0), 2 * abs(n0))
+                off = min(max(off, -qmax), qmax)
+            g[order[k]] = qa[order[k]] + off + e[k]
+            if not 0 <= g[order[k]] <= qmax:
                 reject('a loose vertex off the grid')
         if d.truncated():
             reject('loose vertices truncated')
-        level.add_point(prev)
+        points.append(g)
+    for g in points:
+        level.add_point(g)
     first, pick, far = UIntModel(2), [UIntModel(2), UIntModel(2)], [UIntModel(2), UIntModel(2)]
     n = len(level.q)
     a = 0

@@ -110,6 +110,30 @@ TEST(Progressive, LooseVerticesAfterTheBatches) {
   expect_round_trip(m, 3);
 }
 
+// A scan's vertices no face uses lie near its surface: each is coded from
+// its nearest level vertex (its anchor), in that vertex's tangent frame, so
+// it costs under 24 bits (about 20 here), which its grid index alone (on
+// two axes spread over the whole grid) would not.
+TEST(Progressive, LooseVerticesNearTheSurfaceAreCheap) {
+  tsm::Mesh m = icosphere(4);
+  const size_t n = m.vertex_count();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> jitter(-0.002f, 0.002f);
+  size_t added = 0;
+  for (size_t i = 0; i < n; i += 4, ++added)
+    m.add_vertex(m.positions[3 * i] + jitter(rng), m.positions[3 * i + 1] + jitter(rng),
+                 m.positions[3 * i + 2] + jitter(rng));
+  const std::string bytes = encode_progressive(m);
+  tsm::FileInfo fi;
+  ASSERT_TRUE(tsm::inspect(bytes, fi).ok());
+  uint64_t loose = 0;
+  for (const tsm::SectionInfo& s : fi.sections)
+    if (s.name == "loose") loose = s.stored_bytes;
+  ASSERT_GT(loose, 0u);
+  EXPECT_LT(loose * 8, added * 24) << loose << " bytes for " << added << " loose vertices";
+  expect_round_trip(m, 3);
+}
+
 TEST(Progressive, AttributesAreRefusedWithAReason) {
   tsm::Mesh m = icosphere(2);
   tsm::Attribute a;

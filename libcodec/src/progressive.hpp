@@ -53,6 +53,9 @@ class LevelMesh {
   int bits() const { return h_.quantization_bits; }
   const uint32_t* q(uint32_t v) const { return &q_[3 * size_t{v}]; }
   size_t face_uses(uint32_t v) const { return vf_[v].size(); }
+  // The sum over v's faces of (c1 - c0) x (c2 - c0), their first three
+  // corners' grid indices (exact in int64).
+  void face_normal(uint32_t v, int64_t n[3]) const;
   Mesh& mesh() { return *mesh_; }
   // The split coder's adaptive models: they carry over from batch to batch.
   std::shared_ptr<BatchModels>& models() { return models_; }
@@ -104,10 +107,15 @@ struct BatchLimits {
 // Decodes one refinement payload and applies it to `level`.
 Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimits& limits);
 
+// The order the loose section codes vertices no face uses in (FORMAT.md
+// §4.8): by their anchor (the nearest vertex of `level`), then grid index;
+// q: 3 grid indices per vertex. Returns indices into q.
+std::vector<uint32_t> loose_order(const LevelMesh& level, const std::vector<uint32_t>& q);
 // The loose section (id 13, FORMAT.md §4.8), after the last batch: vertices
-// no face uses (q: 3 grid indices per vertex, coded sorted; the caller
-// gives them sorted, so they get the next ids in its order), then the
-// triangles the levels left out (level ids), applied to `level`.
+// no face uses (q: 3 grid indices per vertex, in loose_order's order, so
+// they get the next ids in that order), each as a residual from its
+// anchor, then the triangles the levels left out (level ids), applied to
+// `level`.
 Status encode_loose(LevelMesh& level, std::vector<uint32_t> q, std::vector<std::array<uint32_t, 3>> faces,
                     std::string& out);
 Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimits& limits);

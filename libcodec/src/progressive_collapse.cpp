@@ -29,7 +29,7 @@ using Quadric = std::array<double, 10>;  // xx xy xz xw yy yz yw zz zw ww
 // length against its quadric error: short edges first keep the levels'
 // triangles regular (where the quadric is flat, e.g. a scan's cut bottom),
 // which makes the splits' residuals smaller.
-constexpr double kRegularity = 0.1;
+constexpr double kRegularity = 0.2;
 constexpr double kLength = 0.02;
 // The weight of a border edge's plane (through the edge, across its face)
 // per squared edge length.

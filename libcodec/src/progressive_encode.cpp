@@ -114,12 +114,14 @@ Status encode_progressive(const Mesh& input, const EncodeOptions& options, std::
     before = bh.error_after;
   }
   if (!plan.loose.empty() || !plan.left_out.empty()) {
-    // The loose vertices take the next ids in grid order (the plan lists
-    // them so), then the left-out triangles use the level's ids.
-    std::vector<uint32_t> lq;
-    for (uint32_t i : plan.loose) {
-      id[i] = static_cast<uint32_t>(level.vertex_count() + lq.size() / 3);
-      for (int a = 0; a < 3; ++a) lq.push_back(q[3 * size_t{i} + a]);
+    // The loose vertices take the next ids in the order the section codes
+    // them (loose_order), then the left-out triangles use the level's ids.
+    std::vector<uint32_t> plain, lq;
+    for (uint32_t i : plan.loose)
+      for (int a = 0; a < 3; ++a) plain.push_back(q[3 * size_t{i} + a]);
+    for (uint32_t k : loose_order(level, plain)) {
+      id[plan.loose[k]] = static_cast<uint32_t>(level.vertex_count() + lq.size() / 3);
+      for (int a = 0; a < 3; ++a) lq.push_back(plain[3 * size_t{k} + a]);
     }
     std::vector<std::array<uint32_t, 3>> faces;
     for (const auto& c : plan.left_out) {

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <unordered_map>
 
 #include "byte_io.hpp"
 #include "codec_shared.hpp"
@@ -319,6 +320,21 @@ void LevelMesh::neighbours(uint32_t v, std::vector<uint32_t>& out) const {
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
+void LevelMesh::face_normal(uint32_t v, int64_t n[3]) const {
+  n[0] = n[1] = n[2] = 0;
+  for (uint32_t f : vf_[v]) {
+    const uint32_t* c = mesh_->face(f);
+    int64_t e1[3], e2[3];
+    for (int a = 0; a < 3; ++a) {
+      e1[a] = int64_t{q(c[1])[a]} - int64_t{q(c[0])[a]};
+      e2[a] = int64_t{q(c[2])[a]} - int64_t{q(c[0])[a]};
+    }
+    n[0] += e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] += e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] += e1[0] * e2[1] - e1[1] * e2[0];
+  }
+}
+
 uint32_t LevelMesh::split(uint32_t v, const std::vector<uint32_t>& ring, uint32_t ia, uint32_t dist,
                           const uint32_t q[3]) {
   const uint32_t u = static_cast<uint32_t>(vertex_count());
@@ -503,6 +519,105 @@ Status decode_batch(std::string_view payload, LevelMesh& level, const BatchLimit
   return Status::Ok();
 }
 
+namespace {
+
+// The loose vertices' models (fresh per section): the anchor as a step
+// from the previous one's id, then the residuals from it (by axis rank).
+struct LooseVertexModels {
+  UIntModelT<2> anchor;
+  SIntModelT<3> residual[3];
+};
+
+// A loose vertex's frame at its anchor a (FORMAT.md §4.8): the axes ranked
+// by the anchor's face normal (scaled to at most 16 bits), and the offset
+// on the first that puts the vertex on the anchor's tangent plane (the
+// loose vertices of a scan lie near its surface).
+struct AnchorFrame {
+  int64_t n[3] = {0, 0, 0};
+  int order[3] = {0, 1, 2};
+  int64_t offset(int64_t e1, int64_t e2, int64_t qmax) const {
+    const int64_t n0 = n[order[0]];
+    if (n0 == 0) return 0;
+    const int64_t t = -(n[order[1]] * e1 + n[order[2]] * e2);
+    const int64_t m = n0 < 0 ? -n0 : n0;
+    return std::clamp<int64_t>(floor_div(2 * (n0 < 0 ? -t : t) + m, 2 * m), -qmax, qmax);
+  }
+};
+
+void anchor_frame(const LevelMesh& level, uint32_t a, AnchorFrame& f) {
+  level.face_normal(a, f.n);
+  int shift = 0;
+  for (int k = 0; k < 3; ++k)
+    shift = std::max(shift, bit_length(static_cast<uint64_t>(f.n[k] < 0 ? -f.n[k] : f.n[k])) - 16);
+  for (int k = 0; k < 3; ++k) f.n[k] = floor_div(f.n[k], int64_t{1} << shift);
+  const double d[3] = {static_cast<double>(f.n[0]), static_cast<double>(f.n[1]), static_cast<double>(f.n[2])};
+  axis_order(d, f.order);
+}
+
+// The encoder's anchor search: the level's vertices hashed by grid cell,
+// searched in growing shells of cells around a point.
+class LooseAnchors {
+ public:
+  explicit LooseAnchors(const LevelMesh& level) : level_(level) {
+    const size_t n = level.vertex_count();
+    uint32_t lo = 0xFFFFFFFFu, hi = 0;
+    for (uint32_t v = 0; v < n; ++v)
+      for (int a = 0; a < 3; ++a) lo = std::min(lo, level.q(v)[a]), hi = std::max(hi, level.q(v)[a]);
+    const double side = n == 0 ? 1.0 : static_cast<double>(hi - lo) / std::ceil(std::sqrt(static_cast<double>(n)));
+    cell_ = std::max<int64_t>(1, static_cast<int64_t>(side));
+    for (uint32_t v = 0; v < n; ++v) cells_[key(cell_of(level.q(v)))].push_back(v);
+  }
+  // The vertex nearest p (squared grid distance; ties: the least id).
+  uint32_t nearest(const uint32_t* p) const {
+    const std::array<int64_t, 3> c = cell_of(p);
+    uint64_t best = ~uint64_t{0};
+    uint32_t at = 0;
+    for (int64_t r = 0;; ++r) {
+      if (r > kShells) return brute(p);
+      for (int64_t i = -r; i <= r; ++i)
+        for (int64_t j = -r; j <= r; ++j)
+          for (int64_t k = -r; k <= r; ++k) {
+            if (std::max({std::abs(i), std::abs(j), std::abs(k)}) != r) continue;
+            auto it = cells_.find(key({c[0] + i, c[1] + j, c[2] + k}));
+            if (it == cells_.end()) continue;
+            for (uint32_t v : it->second) consider(p, v, best, at);
+          }
+      // Vertices of cells farther out lie at least r * cell + 1 away.
+      const uint64_t reach = static_cast<uint64_t>(r * cell_ + 1);
+      if (best < reach * reach) return at;
+    }
+  }
+
+ private:
+  static constexpr int64_t kShells = 8;
+  std::array<int64_t, 3> cell_of(const uint32_t* p) const {
+    return {int64_t{p[0]} / cell_, int64_t{p[1]} / cell_, int64_t{p[2]} / cell_};
+  }
+  static uint64_t key(const std::array<int64_t, 3>& c) {
+    return (static_cast<uint64_t>(c[0]) * 0x9E3779B97F4A7C15ull) ^ (static_cast<uint64_t>(c[1]) << 32) ^
+           (static_cast<uint64_t>(c[2]) * 0xC2B2AE3D27D4EB4Full);
+  }
+  void consider(const uint32_t* p, uint32_t v, uint64_t& best, uint32_t& at) const {
+    uint64_t d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int64_t d = int64_t{p[a]} - int64_t{level_.q(v)[a]};
+      d2 += static_cast<uint64_t>(d * d);
+    }
+    if (d2 < best || (d2 == best && v < at)) best = d2, at = v;
+  }
+  uint32_t brute(const uint32_t* p) const {
+    uint64_t best = ~uint64_t{0};
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < level_.vertex_count(); ++v) consider(p, v, best, at);
+    return at;
+  }
+  const LevelMesh& level_;
+  int64_t cell_ = 1;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
+}  // namespace
+
 // The left-out triangles' models (fresh per section): the first corner as
 // a step from the previous face's, the others as a pick among the first
 // corner's neighbours (the second's too, for the third), 0 = not there,
@@ -527,23 +642,42 @@ void pick_candidates(const LevelMesh& level, const uint32_t* c, int k, std::vect
             out.end());
 }
 
+std::vector<uint32_t> loose_order(const LevelMesh& level, const std::vector<uint32_t>& q) {
+  const size_t n = q.size() / 3;
+  const LooseAnchors anchors(level);
+  std::vector<std::array<uint32_t, 5>> keyed(n);  // anchor, grid index, position in q
+  for (size_t i = 0; i < n; ++i)
+    keyed[i] = {anchors.nearest(&q[3 * i]), q[3 * i], q[3 * i + 1], q[3 * i + 2], static_cast<uint32_t>(i)};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = keyed[i][4];
+  return order;
+}
+
 Status encode_loose(LevelMesh& level, std::vector<uint32_t> q, std::vector<std::array<uint32_t, 3>> faces,
                     std::string& out) {
   const size_t n = q.size() / 3;
-  std::vector<std::array<uint32_t, 3>> points(n);
-  for (size_t i = 0; i < n; ++i) points[i] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
-  if (!std::is_sorted(points.begin(), points.end()))
-    return Status(ErrorCode::internal, "progressive: loose vertices out of order");
-  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  const std::vector<uint32_t> order = loose_order(level, q);
+  for (size_t i = 0; i < n; ++i)
+    if (order[i] != i) return Status(ErrorCode::internal, "progressive: loose vertices out of order");
+  const LooseAnchors anchors(level);
+  LooseVertexModels m;
   RangeEncoder e;
-  uint32_t prev[3] = {0, 0, 0};
-  for (const auto& p : points) {
-    for (int a = 0; a < 3; ++a) {
-      m[a].encode(e, static_cast<int32_t>(int64_t{p[a]} - int64_t{prev[a]}));
-      prev[a] = p[a];
-    }
-    level.add_point(p.data());
+  const int64_t qmax = (int64_t{1} << level.bits()) - 1;
+  uint32_t previous_anchor = 0;
+  AnchorFrame frame;
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t* p = &q[3 * i];
+    const uint32_t a = anchors.nearest(p);
+    m.anchor.encode(e, a - previous_anchor);
+    if (i == 0 || a != previous_anchor) anchor_frame(level, a, frame);
+    previous_anchor = a;
+    int64_t r[3];
+    for (int k = 1; k < 3; ++k) r[k] = int64_t{p[frame.order[k]]} - int64_t{level.q(a)[frame.order[k]]};
+    r[0] = int64_t{p[frame.order[0]]} - int64_t{level.q(a)[frame.order[0]]} - frame.offset(r[1], r[2], qmax);
+    for (int k : {1, 2, 0}) m.residual[k].encode(e, static_cast<int32_t>(r[k]));
   }
+  for (size_t i = 0; i < n; ++i) level.add_point(&q[3 * i]);
   for (auto& f : faces) std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
   std::sort(faces.begin(), faces.end());
   auto fm = std::make_unique<LooseFaceModels>();
@@ -580,20 +714,35 @@ Status decode_loose(std::string_view payload, LevelMesh& level, const BatchLimit
   if ((limits.max_vertices && level.vertex_count() + n > limits.max_vertices) ||
       (limits.max_faces && level.mesh().face_count() + faces > limits.max_faces))
     return Status(ErrorCode::limit_exceeded, "loose section: the mesh would exceed the decoder's limits");
-  auto m = std::make_unique<SIntModelT<3>[]>(3);
+  LooseVertexModels m;
   RangeDecoder dec(stream);
   const int64_t qmax = (int64_t{1} << level.bits()) - 1;
-  int64_t prev[3] = {0, 0, 0};
+  const uint64_t anchors = level.vertex_count();
+  std::vector<uint32_t> points;
+  uint64_t at = 0;
+  uint32_t framed = 0;
+  AnchorFrame f;
   for (uint64_t i = 0; i < n; ++i) {
-    uint32_t q[3];
-    for (int a = 0; a < 3; ++a) {
-      prev[a] += m[a].decode(dec);
-      if (prev[a] < 0 || prev[a] > qmax) return corrupt("a loose vertex off the grid");
-      q[a] = static_cast<uint32_t>(prev[a]);
+    at += m.anchor.decode(dec);
+    if (at >= anchors) return corrupt("a loose vertex's anchor out of range");
+    const uint32_t anchor = static_cast<uint32_t>(at);
+    // Anchors never decrease: each one's faces are summed once (the work
+    // stays within the level's face corners, whatever the count).
+    if (i == 0 || anchor != framed) anchor_frame(level, anchor, f);
+    framed = anchor;
+    int64_t e[3] = {0, 0, 0};
+    uint32_t p[3];
+    for (int k : {1, 2, 0}) {
+      e[k] = m.residual[k].decode(dec);
+      const int64_t x =
+          int64_t{level.q(anchor)[f.order[k]]} + e[k] + (k == 0 ? f.offset(e[1], e[2], qmax) : int64_t{0});
+      if (x < 0 || x > qmax) return corrupt("a loose vertex off the grid");
+      p[f.order[k]] = static_cast<uint32_t>(x);
     }
     if (dec.overrun() > RangeDecoder::kMaxOverrun) return corrupt("the loose vertices' stream ends early");
-    level.add_point(q);
+    points.insert(points.end(), p, p + 3);
   }
+  for (uint64_t i = 0; i < n; ++i) level.add_point(&points[3 * i]);
   auto fm = std::make_unique<LooseFaceModels>();
   std::vector<uint32_t> cand;
   const uint64_t vertices = level.vertex_count();
