@@ -2224,6 +2224,9 @@ def predict_value(walk, item):
             if count > 0:
                 return [round_to_grid(sx / count, h.bits), round_to_grid(sy / count, h.bits)], min(count, 2)
             return seam_transfer(walk, r, v)
+        if walk.predictor == 6:                              # §8.12 "Tangents"
+            t = walk.tangent[r]
+            return (list(walk.prev), 1) if t is None else (list(t), 0)
         return list(walk.prev), 0
     if item[0] == 'corner' and h.quant == 2:
         r = walk.rank[item[2]]
@@ -2424,7 +2427,89 @@ def predictor_allowed(h, pr):
         return h.domain != 1 and h.quant == 1 and h.components == 2
     if pr == 5:
         return h.domain == 0 and h.quant == 1 and h.components == 2
+    if pr == 6:
+        return h.domain == 0 and h.quant == 1 and h.components == 4
     return False
+
+
+def corner_angle(e, f):
+    """§8.12 "Tangents": A(e, f), a corner's angle through Abramowitz and
+    Stegun 4.4.45 (no function a decoder could round differently)."""
+    ee = (e[0] * e[0] + e[1] * e[1]) + e[2] * e[2]
+    ff = (f[0] * f[0] + f[1] * f[1]) + f[2] * f[2]
+    if not (ee > 0 and ff > 0):
+        return 0.0
+    c = ((e[0] * f[0] + e[1] * f[1]) + e[2] * f[2]) / math.sqrt(ee * ff)
+    c = -1.0 if c < -1 else 1.0 if c > 1 else c
+    x = abs(c)
+    t = math.sqrt(1 - x) * (((-0.0187293 * x + 0.0742610) * x - 0.2121144) * x + 1.5707288)
+    return t if c >= 0 else 3.141592653589793 - t
+
+
+def tangent_add(d, n, g, s):
+    """§8.12 "Tangents": add(d, n, g, s)."""
+    k = (n[0] * d[0] + n[1] * d[1]) + n[2] * d[2]
+    t = [d[c] - n[c] * k for c in range(3)]
+    l2 = (t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]
+    if not l2 > 0:
+        return
+    f = g / math.sqrt(l2)
+    for c in range(3):
+        s[c] = s[c] + t[c] * f
+
+
+def tangent_predictions(h, faces, rank, q, normals, uvs):
+    """§8.12 "Tangents" (predictor 5): per own rank the predicted integers of
+    tangent attribute h, or None. normals: the normal source's values (floats),
+    uvs: the texcoord source's integers, both per own rank."""
+    own = len(q)
+    tu = [[0.0, 0.0, 0.0] for _ in range(own)]
+    tv = [[0.0, 0.0, 0.0] for _ in range(own)]
+    for f in faces:
+        if len(f) < 3 or any(rank[c] == NONE for c in f):
+            continue
+        for i in range(1, len(f) - 1):
+            r = [rank[f[0]], rank[f[i]], rank[f[i + 1]]]
+            p = [[float(x) for x in q[j]] for j in r]
+            u = [uvs[j] for j in r]
+            s1, t1 = float(u[1][0]) - u[0][0], float(u[1][1]) - u[0][1]
+            s2, t2 = float(u[2][0]) - u[0][0], float(u[2][1]) - u[0][1]
+            det = s1 * t2 - s2 * t1
+            if det == 0:
+                continue
+            sg = 1.0 if det > 0 else -1.0
+            du, dv = [], []
+            for a in range(3):
+                e1, e2 = p[1][a] - p[0][a], p[2][a] - p[0][a]
+                du.append((e1 * t2 - e2 * t1) * sg)
+                dv.append((e2 * s1 - e1 * s2) * sg)
+            for j in range(3):
+                px, py, pz = p[j], p[(j + 1) % 3], p[(j + 2) % 3]
+                g = corner_angle([py[a] - px[a] for a in range(3)], [pz[a] - px[a] for a in range(3)])
+                n = [float(x) for x in normals[r[j]]]
+                tangent_add(du, n, g, tu[r[j]])
+                tangent_add(dv, n, g, tv[r[j]])
+    step = h.extent / float((1 << h.bits) - 1) if h.extent > 0 else 0.0
+    top = (1 << h.bits) - 1
+
+    def grid(c, x):
+        if not step > 0:
+            return 0
+        return min(max(math.floor((x - float(h.origin[c])) / step + 0.5), 0), top)
+    out = []
+    for r in range(own):
+        n, u, v = [float(x) for x in normals[r]], tu[r], tv[r]
+        d = (n[0] * u[0] + n[1] * u[1]) + n[2] * u[2]
+        t = [u[c] - n[c] * d for c in range(3)]
+        l2 = (t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]
+        if not l2 > 0:
+            out.append(None)
+            continue
+        ln = math.sqrt(l2)
+        b = [n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]]
+        side = (b[0] * v[0] + b[1] * v[1]) + b[2] * v[2]
+        out.append([grid(c, t[c] / ln) for c in range(3)] + [grid(3, -1.0 if side < 0 else 1.0)])
+    return out
 
 
 def as_vertex(h):
@@ -2481,6 +2566,15 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
             reject('attributes: bad predictor')
         predictors.append(pr)
         tabled.append(t)
+    normal_src = texcoord_src = None                         # §8.12 "Tangents": the sources of predictor 6
+    for j, h in enumerate(headers):
+        if h.domain == 0 or h.per_vertex:
+            if normal_src is None and h.quant == 2:
+                normal_src = j
+            if texcoord_src is None and h.kind == 3:
+                texcoord_src = j
+    if 6 in predictors and (normal_src is None or texcoord_src is None):
+        reject('attributes: a tangent predicted without a normal and texture coordinates per vertex')
     tables = bits = None
     if any(tabled):                                          # §8.12.1
         tables, bits, p = read_tables(payload, p, 24 * A, 3 * A, 'attributes')
@@ -2494,13 +2588,17 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
     own = len(own_vertex)
     around = faces_around(faces, len(glob)) if 2 in predictors or 5 in predictors else None
     d = RangeDecoder(coded)
-    out = []
-    for i, (h, pr) in enumerate(zip(headers, predictors)):
+    out = [None] * A
+    order = [i for i in range(A) if predictors[i] != 6] + [i for i in range(A) if predictors[i] == 6]
+    for ai in order:                                         # §8.12: predictor 6's values come last
+        h, pr = headers[ai], predictors[ai]
         m = AttrModels()
         m.last_import = 0
-        if tabled[i]:                                        # §8.12.1: this attribute's contexts
-            m.table = (tables, bits, 24 * i)
+        if tabled[ai]:                                       # §8.12.1: this attribute's contexts
+            m.table = (tables, bits, 24 * ai)
         walk = AttrWalk(as_vertex(h) if h.per_vertex else h, pr, faces, rank, q, around)
+        if pr == 6:
+            walk.tangent = tangent_predictions(h, faces, rank, q, out[normal_src]['values'], out[texcoord_src]['ints'])
         indices = alias = None
         if h.per_vertex:                                     # each corner uses its vertex's value
             indices = [rank[c] for f in faces for c in f]
@@ -2612,8 +2710,8 @@ def decode_attributes(payload, faces, glob, q, segmented=False):
                 decode_value(d, m, walk, ('unused',))
         if d.truncated():
             reject('attributes: stream is truncated')
-        out.append({'header': h, 'predictor': pr, 'ints': walk.values, 'indices': indices, 'alias': alias,
-                    'values': [attribute_value(h, x) for x in walk.values]})
+        out[ai] = {'header': h, 'predictor': pr, 'ints': walk.values, 'indices': indices, 'alias': alias,
+                   'values': [attribute_value(h, x) for x in walk.values]}
     return out
 
 

@@ -502,6 +502,158 @@ int32_t round_to_grid(double x, int bits) {
   return static_cast<int32_t>(r < 0 ? 0 : r > top ? top : r);
 }
 
+// Predictor 6, tangents (FORMAT.md §8.12 "Tangents"): a glTF TANGENT (xyz
+// a unit vector along the texture's u direction on the surface, w = +-1 the
+// handedness of the bitangent) follows from the positions, the texture
+// coordinates and the normal, as MikkTSpace makes it: per triangle the
+// directions of increasing u and v (dP/du, dP/dv), summed at its corners,
+// dP/du projected orthogonal to the vertex's normal, and w the side of
+// n x t that dP/dv lies on. The attribute's values follow all others'
+// (its sources', which may come after it in header order).
+constexpr int kTangentPredictor = 6;
+
+// The attributes a tangent is predicted from (header indices, -1: none).
+struct TangentSources {
+  int normal = -1;    // the first attribute coded per vertex with octahedral normals
+  int texcoord = -1;  // the first attribute coded per vertex of kind texcoord
+};
+
+// `coded`: the headers as coded (a corner attribute coded per vertex with
+// domain vertex). Sources are never tangents themselves (3 or 2 components).
+TangentSources tangent_sources(const std::vector<AttributeHeader>& coded) {
+  TangentSources s;
+  for (size_t j = 0; j < coded.size(); ++j) {
+    const AttributeHeader& h = coded[j];
+    if (h.domain != AttributeDomain::vertex) continue;
+    if (s.normal < 0 && h.quant == AttributeQuant::octahedral) s.normal = static_cast<int>(j);
+    if (s.texcoord < 0 && h.kind == AttributeKind::texcoord) s.texcoord = static_cast<int>(j);
+  }
+  return s;
+}
+
+// Whether an attribute may be a tangent: 4 grid components per vertex.
+bool tangent_shaped(const AttributeHeader& h) {
+  return h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::grid && h.components == 4;
+}
+
+// Grid index of value v on component c (the encoder's rounding, clamped).
+int32_t tangent_grid_index(const AttributeHeader& h, uint32_t c, double v) {
+  const double step = grid_step(h);
+  if (!(step > 0)) return 0;
+  const double top = std::ldexp(1.0, h.bits) - 1;
+  const double x = std::floor((v - static_cast<double>(h.origin[c])) / step + 0.5);
+  return static_cast<int32_t>(x < 0 ? 0 : x > top ? top : x);
+}
+
+// Per own rank the normal of a tangent's normal source (decoded, binary64).
+std::vector<double> source_normals(const AttributeHeader& nh, const std::vector<int32_t>& normal) {
+  std::vector<double> n(3 * (normal.size() / 2));
+  for (size_t r = 0; r < normal.size() / 2; ++r) {
+    float f[3];
+    oct_decode(normal[2 * r], normal[2 * r + 1], nh.bits, f);
+    for (int a = 0; a < 3; ++a) n[3 * r + a] = f[a];
+  }
+  return n;
+}
+
+// The angle between edges a and b of a corner, its weight in a tangent:
+// acos of their cosine through Abramowitz and Stegun's 4.4.45 (within
+// 7e-5 of it), only +, -, x, / and sqrt, so that every decoder computes the
+// same bits; 0 for an edge of length 0.
+double corner_angle(const double* a, const double* b) {
+  const double aa = (a[0] * a[0] + a[1] * a[1]) + a[2] * a[2], bb = (b[0] * b[0] + b[1] * b[1]) + b[2] * b[2];
+  if (!(aa > 0 && bb > 0)) return 0;
+  double c = ((a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]) / std::sqrt(aa * bb);
+  c = c < -1 ? -1 : c > 1 ? 1 : c;
+  const double x = std::fabs(c);
+  const double t = std::sqrt(1 - x) * (((-0.0187293 * x + 0.0742610) * x - 0.2121144) * x + 1.5707288);
+  return c < 0 ? 3.141592653589793 - t : t;
+}
+
+// Adds vector d, projected orthogonal to unit-ish n and normalized, times w, to s.
+void add_projected(const double* d, const double* n, double w, double* s) {
+  const double k = (n[0] * d[0] + n[1] * d[1]) + n[2] * d[2];
+  const double t[3] = {d[0] - n[0] * k, d[1] - n[1] * k, d[2] - n[2] * k};
+  const double l2 = (t[0] * t[0] + t[1] * t[1]) + t[2] * t[2];
+  if (!(l2 > 0)) return;
+  const double f = w / std::sqrt(l2);
+  for (int a = 0; a < 3; ++a) s[a] += t[a] * f;
+}
+
+// The triangles of the fans of the faces whose corners are all own: at
+// each corner, their dP/du and dP/dv (oriented by the sign of the texture
+// triangle's area; a degenerate one adds nothing), projected orthogonal to
+// the corner's normal and normalized, times the corner's angle, add to the
+// sums `tu`, `tv` of its vertex (own rank).
+void tangent_sums(const Mesh& faces, const std::vector<uint32_t>& rank, const std::vector<uint32_t>& q,
+                  const std::vector<double>& normal, const std::vector<int32_t>& uv, std::vector<double>& tu,
+                  std::vector<double>& tv) {
+  tu.assign(q.size(), 0.0);
+  tv.assign(q.size(), 0.0);
+  for (size_t f = 0; f < faces.face_count(); ++f) {
+    const uint32_t k = faces.face_size(f);
+    const uint32_t* c = faces.face(f);
+    bool own = k >= 3;
+    for (uint32_t i = 0; i < k && own; ++i) own = rank[c[i]] != kNone;
+    if (!own) continue;
+    for (uint32_t i = 1; i + 1 < k; ++i) {
+      const uint32_t r[3] = {rank[c[0]], rank[c[i]], rank[c[i + 1]]};
+      const uint32_t* p[3] = {&q[3 * size_t{r[0]}], &q[3 * size_t{r[1]}], &q[3 * size_t{r[2]}]};
+      const int32_t *u0 = &uv[2 * size_t{r[0]}], *u1 = &uv[2 * size_t{r[1]}], *u2 = &uv[2 * size_t{r[2]}];
+      const double s1 = double(u1[0]) - u0[0], t1 = double(u1[1]) - u0[1];
+      const double s2 = double(u2[0]) - u0[0], t2 = double(u2[1]) - u0[1];
+      const double det = s1 * t2 - s2 * t1;
+      if (det == 0) continue;
+      const double sign = det > 0 ? 1 : -1;
+      double du[3], dv[3];
+      for (int a = 0; a < 3; ++a) {
+        const double e1 = double(p[1][a]) - p[0][a], e2 = double(p[2][a]) - p[0][a];
+        du[a] = (e1 * t2 - e2 * t1) * sign;
+        dv[a] = (e2 * s1 - e1 * s2) * sign;
+      }
+      for (int j = 0; j < 3; ++j) {
+        const uint32_t *pj = p[j], *pn = p[(j + 1) % 3], *pp = p[(j + 2) % 3];
+        const double ea[3] = {double(pn[0]) - pj[0], double(pn[1]) - pj[1], double(pn[2]) - pj[2]};
+        const double eb[3] = {double(pp[0]) - pj[0], double(pp[1]) - pj[1], double(pp[2]) - pj[2]};
+        const double w = corner_angle(ea, eb);
+        const double* n = &normal[3 * size_t{r[j]}];
+        add_projected(du, n, w, &tu[3 * size_t{r[j]}]);
+        add_projected(dv, n, w, &tv[3 * size_t{r[j]}]);
+      }
+    }
+  }
+}
+
+// Per own rank the predicted integers (4 each) of a tangent attribute `h`
+// from the normals' and texture coordinates' integers (own-rank order) and
+// the positions; has[r] = 0 where there is none (no texture area around the
+// vertex, or dP/du along the normal).
+void tangent_predictions(const AttributeHeader& h, const Mesh& faces, const std::vector<uint32_t>& rank,
+                         const std::vector<uint32_t>& q, const AttributeHeader& nh, const std::vector<int32_t>& normal,
+                         const std::vector<int32_t>& uv, std::vector<int32_t>& pred, std::vector<uint8_t>& has) {
+  const std::vector<double> normals = source_normals(nh, normal);
+  std::vector<double> tu, tv;
+  tangent_sums(faces, rank, q, normals, uv, tu, tv);
+  const size_t own = q.size() / 3;
+  pred.assign(4 * own, 0);
+  has.assign(own, 0);
+  for (size_t r = 0; r < own; ++r) {
+    const double* n = &normals[3 * r];
+    const double* u = &tu[3 * r];
+    const double* v = &tv[3 * r];
+    const double d = (n[0] * u[0] + n[1] * u[1]) + n[2] * u[2];
+    const double t[3] = {u[0] - n[0] * d, u[1] - n[1] * d, u[2] - n[2] * d};
+    const double l2 = (t[0] * t[0] + t[1] * t[1]) + t[2] * t[2];
+    if (!(l2 > 0)) continue;
+    const double len = std::sqrt(l2);
+    const double b[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
+    const double side = (b[0] * v[0] + b[1] * v[1]) + b[2] * v[2];
+    has[r] = 1;
+    for (uint32_t c = 0; c < 3; ++c) pred[4 * r + c] = tangent_grid_index(h, c, t[c] / len);
+    pred[4 * r + 3] = tangent_grid_index(h, 3, side < 0 ? -1.0 : 1.0);
+  }
+}
+
 // Faces around each part vertex (a face once per corner at the vertex).
 struct VertexFaces {
   std::vector<uint32_t> start, face, corner;  // corner: position in the face
@@ -689,6 +841,16 @@ struct AttributeWalk {
   static int64_t miss(const int32_t* x, const int32_t* p) {
     return std::abs(int64_t{x[0]} - p[0]) + std::abs(int64_t{x[1]} - p[1]);
   }
+  const std::vector<int32_t>* tangent = nullptr;      // predictor 6: per own rank the predicted integers
+  const std::vector<uint8_t>* tangent_has = nullptr;  // predictor 6: per own rank, 1 where predicted
+
+  // Predictor 6 at own rank r: the tangent predicted there (class 0), else
+  // the previous value (class 1).
+  int tangent_prediction(uint32_t r, int32_t* pred) const {
+    if (!(*tangent_has)[r]) return 1;
+    std::copy_n(&(*tangent)[4 * size_t{r}], 4, pred);
+    return 0;
+  }
 
   // Predictor 2 for the value at position i of face f (vertex w): the mean
   // of the texture-space placements from the face's triangles (w, i+1, i+2)
@@ -832,6 +994,7 @@ struct AttributeWalk {
         }
         placements = count;
       }
+      if (predictor == kTangentPredictor) cls = tangent_prediction(r, pred);
       SeamTransfer transfer;
       if (placement(predictor) && cls == 0) {
         seam_transfer(v, r, earlier, vertex_of, x, pred, transfer);
@@ -1385,6 +1548,7 @@ unsigned predictors_for(const AttributeHeader& h) {
   if (h.domain == AttributeDomain::corner && h.quant == AttributeQuant::octahedral) p |= 8 | 16;
   if (h.domain != AttributeDomain::face && h.quant == AttributeQuant::grid && h.components == 2) p |= 4;
   if (h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::grid && h.components == 2) p |= 32;
+  if (tangent_shaped(h)) p |= 1u << kTangentPredictor;  // with sources (tangent_sources)
   return p;
 }
 
@@ -1459,6 +1623,22 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   for (size_t i = 0; i < headers.size(); ++i)
     need_around = need_around || predictors_for(coded_header(headers[i], in.per_vertex >> i & 1)) & (4 | 32);
   if (need_around) around.build(faces, V);
+  // Predictor 6: the sources' integers per own rank, from the part's values.
+  std::vector<AttributeHeader> coded(headers.size());
+  for (size_t i = 0; i < headers.size(); ++i) coded[i] = coded_header(headers[i], in.per_vertex >> i & 1);
+  const TangentSources sources = tangent_sources(coded);
+  auto own_ints = [&](int j) {
+    const AttributeHeader& h = coded[static_cast<size_t>(j)];
+    const uint32_t n = int_components(h);
+    std::vector<int32_t> x(n * static_cast<size_t>(own));
+    for (size_t v = 0; v < V; ++v)
+      if (rank[v] != kNone)
+        to_ints(h, &part.attributes[static_cast<size_t>(j)].values[h.components * static_cast<size_t>(order[v])],
+                &x[n * rank[v]]);
+    return x;
+  };
+  std::vector<int32_t> tangent_pred;
+  std::vector<uint8_t> tangent_has;
   // One attribute's values into `enc` with `predictor`.
   std::vector<uint32_t>* own_values = nullptr;
   bool siblings = false;  // the attribute being coded names its siblings' values (predictor bit 6)
@@ -1472,6 +1652,12 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     const bool oct = h.quant == AttributeQuant::octahedral;
     if (oct) geometry_normals(faces, rank, *in.q, h.bits, normal_weights(predictor), gnormal, ghas);
     AttributeWalk<Enc> walk{h, vc, enc, faces, rank, oct ? &gnormal : nullptr, oct ? &ghas : nullptr, in.q, &around};
+    if (predictor == kTangentPredictor) {
+      tangent_predictions(h, faces, rank, *in.q, coded[static_cast<size_t>(sources.normal)], own_ints(sources.normal),
+                          own_ints(sources.texcoord), tangent_pred, tangent_has);
+      walk.tangent = &tangent_pred;
+      walk.tangent_has = &tangent_has;
+    }
     if (h.domain == AttributeDomain::vertex) {
       std::vector<int32_t> x(n * static_cast<size_t>(own));
       for (size_t v = 0; v < V; ++v)
@@ -1518,6 +1704,11 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
   BitWriter table_bits;
   std::vector<CodeLengths> table_lengths;  // every attribute's contexts once one has tables
   if (in.own_values) in.own_values->assign(headers.size(), {});
+  struct Deferred {
+    size_t i;
+    bool recent, siblings, shared;
+  };
+  std::vector<Deferred> deferred;  // predictor 6: coded after the other attributes
   for (size_t i = 0; i < headers.size(); ++i) {
     const bool per_vertex = in.per_vertex >> i & 1;
     const AttributeHeader h = coded_header(headers[i], per_vertex);
@@ -1534,9 +1725,10 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
       size = trial.e.finish().size();
       return true;
     };
-    for (int p = 0; p < 6 && choices != 1; ++p) {
+    for (int p = 0; p <= kTangentPredictor && choices != 1; ++p) {
       size_t size = 0;
       if (!(choices >> p & 1)) continue;
+      if (p == kTangentPredictor && (sources.normal < 0 || sources.texcoord < 0)) continue;
       if (!adaptive_size(p, size)) return Status(ErrorCode::internal, "attributes: values out of range");
       if (size < best) {
         best = size;
@@ -1567,7 +1759,7 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     }
     TableResiduals residuals;
     bool tables = false;
-    if (in.tables) {
+    if (in.tables && predictor != kTangentPredictor) {  // a tangent's values come last, range coded
       Enc trial;
       trial.tables = &residuals;
       if (!code(trial, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
@@ -1585,6 +1777,10 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
                               (per_vertex ? kAttributePerVertexFlag : 0) | (recent ? kAttributeRecentFlag : 0) |
                               (siblings ? kAttributeSiblingFlag : 0) | (shared ? kAttributeSharedFlag : 0)));
     own_values = in.own_values ? &(*in.own_values)[i] : nullptr;
+    if (predictor == kTangentPredictor) {  // coded after the others, with its choices
+      deferred.push_back({i, recent, siblings, shared});
+      continue;
+    }
     if (tables) {
       residuals.bits = &table_bits;
       enc.tables = &residuals;
@@ -1594,6 +1790,13 @@ Status encode_attributes(const std::vector<AttributeHeader>& headers, const Attr
     }
     if (!code(enc, i, predictor, recent)) return Status(ErrorCode::internal, "attributes: values out of range");
     enc.tables = nullptr;
+  }
+  for (const Deferred& d : deferred) {
+    siblings = d.siblings;
+    shared = d.shared;
+    own_values = nullptr;
+    if (!code(enc, d.i, kTangentPredictor, d.recent))
+      return Status(ErrorCode::internal, "attributes: values out of range");
   }
   if (!table_lengths.empty())  // §8.12.1: the bit stream's length, the tables, the bit stream
     body += write_table_block(table_lengths, 3 * static_cast<int>(headers.size()), table_bits.finish());
@@ -1646,9 +1849,22 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
       shared |= uint64_t{1} << i;
       p = static_cast<uint8_t>(p & ~kAttributeSharedFlag);
     }
-    if (p > 5 || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
+    if (p > kTangentPredictor || !(predictors_for(headers[i]) >> p & 1)) return corrupt("bad predictor");
     predictor[i] = p;
   }
+  // Predictor 6: its sources, and the attributes in the order their values
+  // come (a tangent's after all the others').
+  const TangentSources sources = tangent_sources(headers);
+  std::vector<size_t> coding_order;
+  for (int pass = 0; pass < 2; ++pass)
+    for (size_t i = 0; i < headers.size(); ++i)
+      if ((predictor[i] == kTangentPredictor) == (pass == 1)) coding_order.push_back(i);
+  if (std::find(predictor.begin(), predictor.end(), kTangentPredictor) != predictor.end() &&
+      (sources.normal < 0 || sources.texcoord < 0))
+    return corrupt("a tangent predicted without a normal and texture coordinates per vertex");
+  std::vector<std::vector<int32_t>> source_ints(headers.size());  // the sources' integers, own-rank order
+  std::vector<int32_t> tangent_pred;
+  std::vector<uint8_t> tangent_has;
   if (in.per_vertex) *in.per_vertex = per_vertex;
   // §8.12.1: with a table-coded attribute, the bit stream's
   // length, the tables of every attribute's contexts, the bit stream.
@@ -1664,7 +1880,7 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   }
   if (in.table_coded) *in.table_coded = static_cast<uint32_t>(std::count(tabled.begin(), tabled.end(), 1));
   if (in.header_bytes) *in.header_bytes = bytes.size() - r.remaining() - table_bytes;
-  if (in.costs) in.costs->clear();
+  if (in.costs) in.costs->assign(headers.size(), {});
   std::string_view coded;
   r.bytes(r.remaining(), coded);
   const size_t V = global.size();
@@ -1676,7 +1892,8 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
   for (size_t i = 0; i < headers.size(); ++i)
     if ((predictor[i] == 2 || predictor[i] == 5) && around.start.empty()) around.build(faces, V);
   dec.d.init(coded);
-  for (size_t i = 0; i < headers.size(); ++i) {
+  out.resize(headers.size());
+  for (size_t i : coding_order) {
     const AttributeHeader& h = headers[i];
     dec.base = tabled[i] ? kAttributeTableContexts * static_cast<int>(i) : -1;
     const uint64_t bits_before = 8 * dec.d.bytes_read() + dec.bits.bits_read();
@@ -1696,6 +1913,13 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
                             h.quant == AttributeQuant::octahedral ? &gh : nullptr,
                             in.q,
                             &around};
+    if (predictor[i] == kTangentPredictor) {
+      tangent_predictions(h, faces, rank, *in.q, headers[static_cast<size_t>(sources.normal)],
+                          source_ints[static_cast<size_t>(sources.normal)],
+                          source_ints[static_cast<size_t>(sources.texcoord)], tangent_pred, tangent_has);
+      walk.tangent = &tangent_pred;
+      walk.tangent_has = &tangent_has;
+    }
     Attribute a;
     a.name = h.name;
     a.kind = h.kind;
@@ -1731,12 +1955,13 @@ Status decode_attributes(std::string_view bytes, const AttributePart& in, std::v
     if (dec.bad_code) return corrupt("a residual of '" + h.name + "' is a code word no table has");
     if (dec.bits.overrun()) return corrupt("the table-coded bit stream is truncated");
     if (in.costs) {
-      in.costs->push_back({h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before});
-      in.costs->back().header.domain = a.domain;
+      (*in.costs)[i] = {h, tabled[i] != 0, 8 * dec.d.bytes_read() + dec.bits.bits_read() - bits_before};
+      (*in.costs)[i].header.domain = a.domain;
     }
+    if (static_cast<int>(i) == sources.normal || static_cast<int>(i) == sources.texcoord) source_ints[i] = x;
     a.values.resize(static_cast<size_t>(h.components) * (x.size() / n));
     for (size_t j = 0; j < x.size() / n; ++j) from_ints(h, &x[n * j], &a.values[h.components * j]);
-    out.push_back(std::move(a));
+    out[i] = std::move(a);
   }
   return Status::Ok();
 }
