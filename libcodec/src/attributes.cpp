@@ -536,11 +536,10 @@ bool tangent_shaped(const AttributeHeader& h) {
   return h.domain == AttributeDomain::vertex && h.quant == AttributeQuant::grid && h.components == 4;
 }
 
-// Grid index of value v on component c (the encoder's rounding, clamped).
-int32_t tangent_grid_index(const AttributeHeader& h, uint32_t c, double v) {
-  const double step = grid_step(h);
+// Grid index of value v on component c (the encoder's rounding, clamped),
+// for a grid of `step` (0: every value is index 0) and largest index `top`.
+int32_t tangent_grid_index(const AttributeHeader& h, double step, double top, uint32_t c, double v) {
   if (!(step > 0)) return 0;
-  const double top = std::ldexp(1.0, h.bits) - 1;
   const double x = std::floor((v - static_cast<double>(h.origin[c])) / step + 0.5);
   return static_cast<int32_t>(x < 0 ? 0 : x > top ? top : x);
 }
@@ -637,6 +636,7 @@ void tangent_predictions(const AttributeHeader& h, const Mesh& faces, const std:
   const size_t own = q.size() / 3;
   pred.assign(4 * own, 0);
   has.assign(own, 0);
+  const double step = grid_step(h), top = std::ldexp(1.0, h.bits) - 1;
   for (size_t r = 0; r < own; ++r) {
     const double* n = &normals[3 * r];
     const double* u = &tu[3 * r];
@@ -649,8 +649,8 @@ void tangent_predictions(const AttributeHeader& h, const Mesh& faces, const std:
     const double b[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
     const double side = (b[0] * v[0] + b[1] * v[1]) + b[2] * v[2];
     has[r] = 1;
-    for (uint32_t c = 0; c < 3; ++c) pred[4 * r + c] = tangent_grid_index(h, c, t[c] / len);
-    pred[4 * r + 3] = tangent_grid_index(h, 3, side < 0 ? -1.0 : 1.0);
+    for (uint32_t c = 0; c < 3; ++c) pred[4 * r + c] = tangent_grid_index(h, step, top, c, t[c] / len);
+    pred[4 * r + 3] = tangent_grid_index(h, step, top, 3, side < 0 ? -1.0 : 1.0);
   }
 }
 
