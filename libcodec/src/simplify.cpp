@@ -337,7 +337,15 @@ class Simplifier {
   // inequality a point p is within d(p, T) + tri_err_[T] of the original.
   std::vector<double> tri_err_;
   std::vector<uint32_t> ring_;        // the triangles around the edge tried, before the collapse
-  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
+  // Original triangles of the changed triangles' pieces (the first 64): their
+  // corners, and their boxes grown by E (a triangle whose corners are all
+  // within E of one lies inside its grown box: a test of six comparisons
+  // before any distance).
+  struct LocalOrig {
+    Vec3 p[3], lo, hi;
+  };
+  std::vector<LocalOrig> local_orig_;
+  void add_local_orig(uint32_t o);
   std::vector<uint8_t> local_tried_;  // per new_tris_ entry: small enough to be within E of one of them
   double longest_orig_edge_ = 0;
   std::vector<uint32_t> orig_mark_;  // per original triangle: orig_mark_gen_ when in local_orig_
@@ -879,18 +887,30 @@ double Simplifier::leaf_bound(const Vec3 p[3], const Near n[3]) const {
 // err gets its largest corner distance.
 bool Simplifier::near_local_original(uint32_t t, double& err) {
   const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
-  for (uint32_t o : local_orig_) {
-    const Vec3 oa = orig_.corner(o, 0), ob = orig_.corner(o, 1), oc = orig_.corner(o, 2);
-    double worst = geom::point_triangle_dist2(a, oa, ob, oc);
+  const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
+  const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
+  for (const LocalOrig& o : local_orig_) {
+    if (lo.x < o.lo.x || lo.y < o.lo.y || lo.z < o.lo.z || hi.x > o.hi.x || hi.y > o.hi.y || hi.z > o.hi.z) continue;
+    double worst = geom::point_triangle_dist2(a, o.p[0], o.p[1], o.p[2]);
     if (worst > e2_) continue;
-    worst = std::max(worst, geom::point_triangle_dist2(b, oa, ob, oc));
+    worst = std::max(worst, geom::point_triangle_dist2(b, o.p[0], o.p[1], o.p[2]));
     if (worst > e2_) continue;
-    worst = std::max(worst, geom::point_triangle_dist2(c, oa, ob, oc));
+    worst = std::max(worst, geom::point_triangle_dist2(c, o.p[0], o.p[1], o.p[2]));
     if (worst > e2_) continue;
     err = std::sqrt(worst);
     return true;
   }
   return false;
+}
+
+void Simplifier::add_local_orig(uint32_t o) {
+  const Vec3 a = orig_.corner(o, 0), b = orig_.corner(o, 1), c = orig_.corner(o, 2);
+  // Grown a little more than E: the box test only skips what the distances
+  // would refuse.
+  const double g = std::sqrt(e2_) * (1 + 1e-9);
+  local_orig_.push_back({{a, b, c},
+                         {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g},
+                         {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g}});
 }
 
 // The new triangle t within E of the original; err gets the bound proved.
@@ -994,7 +1014,7 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
       if (orig_mark_[o] == orig_mark_gen_) continue;
       if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
-      local_orig_.push_back(o);
+      add_local_orig(o);
     }
   for (size_t i = 0; i < new_tris_.size(); ++i)
     if (!(local_tried_[i] && near_local_original(new_tris_[i], new_err_[i])) &&
