@@ -75,7 +75,16 @@ struct Quadric {
   }
 };
 
-Vec3 to_float(Vec3 p) { return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)}; }
+// x rounded to the nearest float, through a volatile: GCC 12's SLP
+// vectorizer folds a pair of adjacent double -> float -> double round trips
+// into plain copies (x and y came back unrounded), and a vertex written as
+// floats would then differ from the position its bound was proven for.
+double round_to_float(double x) {
+  volatile float f = static_cast<float>(x);
+  return f;
+}
+
+Vec3 to_float(Vec3 p) { return {round_to_float(p.x), round_to_float(p.y), round_to_float(p.z)}; }
 
 double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
   return std::max({geom::length(b - a), geom::length(c - b), geom::length(a - c)});
@@ -336,7 +345,7 @@ class Simplifier {
   // points to the original (0 for an original triangle). By the triangle
   // inequality a point p is within d(p, T) + tri_err_[T] of the original.
   std::vector<double> tri_err_;
-  std::vector<uint32_t> ring_;        // the triangles around the edge tried, before the collapse
+  std::vector<uint32_t> ring_;  // the triangles around the edge tried, before the collapse
   // Original triangles of the changed triangles' pieces (the first 64): their
   // corners, and their boxes grown by E (a triangle whose corners are all
   // within E of one lies inside its grown box: a test of six comparisons
@@ -908,9 +917,10 @@ void Simplifier::add_local_orig(uint32_t o) {
   // Grown a little more than E: the box test only skips what the distances
   // would refuse.
   const double g = std::sqrt(e2_) * (1 + 1e-9);
-  local_orig_.push_back({{a, b, c},
-                         {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g},
-                         {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g}});
+  local_orig_.push_back(
+      {{a, b, c},
+       {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g},
+       {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g}});
 }
 
 // The new triangle t within E of the original; err gets the bound proved.
@@ -1294,8 +1304,13 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
   report.collapses = collapses_;
   report.rejected = rejected_;
   report.locked_vertices = locked_count_;
-  for (uint32_t t = 0; t < tri_.size(); ++t)
-    if (tri_alive_[t]) report.result_error = std::max(report.result_error, tri_err_[t]);
+  report.face_error.clear();
+  if (bounded_)
+    for (uint32_t t = 0; t < tri_.size(); ++t)
+      if (tri_alive_[t]) {
+        report.face_error.push_back(tri_err_[t]);
+        report.result_error = std::max(report.result_error, tri_err_[t]);
+      }
   return Status::Ok();
 }
 
