@@ -349,12 +349,15 @@ class Simplifier {
   // Original triangles of the changed triangles' pieces (the first 64): their
   // corners, and their boxes grown by E (a triangle whose corners are all
   // within E of one lies inside its grown box: a test of six comparisons
-  // before any distance).
+  // before any distance), read when first needed (most attempts stop at
+  // one of the first few).
   struct LocalOrig {
+    uint32_t o;
+    bool ready;
     Vec3 p[3], lo, hi;
   };
   std::vector<LocalOrig> local_orig_;
-  void add_local_orig(uint32_t o);
+  void fill_local_orig(LocalOrig& l) const;
   std::vector<uint8_t> local_tried_;  // per new_tris_ entry: small enough to be within E of one of them
   double longest_orig_edge_ = 0;
   std::vector<uint32_t> orig_mark_;  // per original triangle: orig_mark_gen_ when in local_orig_
@@ -560,8 +563,11 @@ void Simplifier::init_quadrics() {
     q.add_plane(n, -geom::dot(n, a), len / 2);
     for (uint32_t w : c) quad_[w].add(q);
     // Boundary edges: a plane through the edge, perpendicular to the triangle.
+    // (Both ends of a boundary edge are kBoundary, found by find_locked: the
+    // triangles around the others are not searched.)
     for (int k = 0; k < 3; ++k) {
       const uint32_t p = c[k], r = c[(k + 1) % 3];
+      if (!(flags_[p] & flags_[r] & kBoundary)) continue;
       int count = 0;
       for (uint32_t s : vtris_[p])
         for (int j = 0; j < 3; ++j)
@@ -898,7 +904,8 @@ bool Simplifier::near_local_original(uint32_t t, double& err) {
   const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
   const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
   const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
-  for (const LocalOrig& o : local_orig_) {
+  for (LocalOrig& o : local_orig_) {
+    if (!o.ready) fill_local_orig(o);
     if (lo.x < o.lo.x || lo.y < o.lo.y || lo.z < o.lo.z || hi.x > o.hi.x || hi.y > o.hi.y || hi.z > o.hi.z) continue;
     double worst = geom::point_triangle_dist2(a, o.p[0], o.p[1], o.p[2]);
     if (worst > e2_) continue;
@@ -912,15 +919,15 @@ bool Simplifier::near_local_original(uint32_t t, double& err) {
   return false;
 }
 
-void Simplifier::add_local_orig(uint32_t o) {
-  const Vec3 a = orig_.corner(o, 0), b = orig_.corner(o, 1), c = orig_.corner(o, 2);
+void Simplifier::fill_local_orig(LocalOrig& l) const {
+  const Vec3 a = orig_.corner(l.o, 0), b = orig_.corner(l.o, 1), c = orig_.corner(l.o, 2);
   // Grown a little more than E: the box test only skips what the distances
   // would refuse.
   const double g = std::sqrt(e2_) * (1 + 1e-9);
-  local_orig_.push_back(
-      {{a, b, c},
-       {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g},
-       {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g}});
+  l.p[0] = a, l.p[1] = b, l.p[2] = c;
+  l.lo = {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g};
+  l.hi = {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g};
+  l.ready = true;
 }
 
 // The new triangle t within E of the original; err gets the bound proved.
@@ -1024,7 +1031,7 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
       if (orig_mark_[o] == orig_mark_gen_) continue;
       if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
-      add_local_orig(o);
+      local_orig_.push_back({o, false, {}, {}, {}});
     }
   for (size_t i = 0; i < new_tris_.size(); ++i)
     if (!(local_tried_[i] && near_local_original(new_tris_[i], new_err_[i])) &&
