@@ -75,7 +75,16 @@ struct Quadric {
   }
 };
 
-Vec3 to_float(Vec3 p) { return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)}; }
+// x rounded to the nearest float, through a volatile: GCC 12's SLP
+// vectorizer folds a pair of adjacent double -> float -> double round trips
+// into plain copies (x and y came back unrounded), and a vertex written as
+// floats would then differ from the position its bound was proven for.
+double round_to_float(double x) {
+  volatile float f = static_cast<float>(x);
+  return f;
+}
+
+Vec3 to_float(Vec3 p) { return {round_to_float(p.x), round_to_float(p.y), round_to_float(p.z)}; }
 
 double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
   return std::max({geom::length(b - a), geom::length(c - b), geom::length(a - c)});
@@ -336,8 +345,19 @@ class Simplifier {
   // points to the original (0 for an original triangle). By the triangle
   // inequality a point p is within d(p, T) + tri_err_[T] of the original.
   std::vector<double> tri_err_;
-  std::vector<uint32_t> ring_;        // the triangles around the edge tried, before the collapse
-  std::vector<uint32_t> local_orig_;  // original triangles of the changed triangles' pieces (the first 64)
+  std::vector<uint32_t> ring_;  // the triangles around the edge tried, before the collapse
+  // Original triangles of the changed triangles' pieces (the first 64): their
+  // corners, and their boxes grown by E (a triangle whose corners are all
+  // within E of one lies inside its grown box: a test of six comparisons
+  // before any distance), read when first needed (most attempts stop at
+  // one of the first few).
+  struct LocalOrig {
+    uint32_t o;
+    bool ready;
+    Vec3 p[3], lo, hi;
+  };
+  std::vector<LocalOrig> local_orig_;
+  void fill_local_orig(LocalOrig& l) const;
   std::vector<uint8_t> local_tried_;  // per new_tris_ entry: small enough to be within E of one of them
   double longest_orig_edge_ = 0;
   std::vector<uint32_t> orig_mark_;  // per original triangle: orig_mark_gen_ when in local_orig_
@@ -543,8 +563,11 @@ void Simplifier::init_quadrics() {
     q.add_plane(n, -geom::dot(n, a), len / 2);
     for (uint32_t w : c) quad_[w].add(q);
     // Boundary edges: a plane through the edge, perpendicular to the triangle.
+    // (Both ends of a boundary edge are kBoundary, found by find_locked: the
+    // triangles around the others are not searched.)
     for (int k = 0; k < 3; ++k) {
       const uint32_t p = c[k], r = c[(k + 1) % 3];
+      if (!(flags_[p] & flags_[r] & kBoundary)) continue;
       int count = 0;
       for (uint32_t s : vtris_[p])
         for (int j = 0; j < 3; ++j)
@@ -879,18 +902,32 @@ double Simplifier::leaf_bound(const Vec3 p[3], const Near n[3]) const {
 // err gets its largest corner distance.
 bool Simplifier::near_local_original(uint32_t t, double& err) {
   const Vec3 a = new_corner(t, 0), b = new_corner(t, 1), c = new_corner(t, 2);
-  for (uint32_t o : local_orig_) {
-    const Vec3 oa = orig_.corner(o, 0), ob = orig_.corner(o, 1), oc = orig_.corner(o, 2);
-    double worst = geom::point_triangle_dist2(a, oa, ob, oc);
+  const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
+  const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
+  for (LocalOrig& o : local_orig_) {
+    if (!o.ready) fill_local_orig(o);
+    if (lo.x < o.lo.x || lo.y < o.lo.y || lo.z < o.lo.z || hi.x > o.hi.x || hi.y > o.hi.y || hi.z > o.hi.z) continue;
+    double worst = geom::point_triangle_dist2(a, o.p[0], o.p[1], o.p[2]);
     if (worst > e2_) continue;
-    worst = std::max(worst, geom::point_triangle_dist2(b, oa, ob, oc));
+    worst = std::max(worst, geom::point_triangle_dist2(b, o.p[0], o.p[1], o.p[2]));
     if (worst > e2_) continue;
-    worst = std::max(worst, geom::point_triangle_dist2(c, oa, ob, oc));
+    worst = std::max(worst, geom::point_triangle_dist2(c, o.p[0], o.p[1], o.p[2]));
     if (worst > e2_) continue;
     err = std::sqrt(worst);
     return true;
   }
   return false;
+}
+
+void Simplifier::fill_local_orig(LocalOrig& l) const {
+  const Vec3 a = orig_.corner(l.o, 0), b = orig_.corner(l.o, 1), c = orig_.corner(l.o, 2);
+  // Grown a little more than E: the box test only skips what the distances
+  // would refuse.
+  const double g = std::sqrt(e2_) * (1 + 1e-9);
+  l.p[0] = a, l.p[1] = b, l.p[2] = c;
+  l.lo = {std::min({a.x, b.x, c.x}) - g, std::min({a.y, b.y, c.y}) - g, std::min({a.z, b.z, c.z}) - g};
+  l.hi = {std::max({a.x, b.x, c.x}) + g, std::max({a.y, b.y, c.y}) + g, std::max({a.z, b.z, c.z}) + g};
+  l.ready = true;
 }
 
 // The new triangle t within E of the original; err gets the bound proved.
@@ -994,7 +1031,7 @@ bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint3
       if (orig_mark_[o] == orig_mark_gen_) continue;
       if (local_orig_.size() >= 64) break;
       orig_mark_[o] = orig_mark_gen_;
-      local_orig_.push_back(o);
+      local_orig_.push_back({o, false, {}, {}, {}});
     }
   for (size_t i = 0; i < new_tris_.size(); ++i)
     if (!(local_tried_[i] && near_local_original(new_tris_[i], new_err_[i])) &&
@@ -1274,8 +1311,13 @@ Status Simplifier::run(Mesh& out, SimplifyReport& report) {
   report.collapses = collapses_;
   report.rejected = rejected_;
   report.locked_vertices = locked_count_;
-  for (uint32_t t = 0; t < tri_.size(); ++t)
-    if (tri_alive_[t]) report.result_error = std::max(report.result_error, tri_err_[t]);
+  report.face_error.clear();
+  if (bounded_)
+    for (uint32_t t = 0; t < tri_.size(); ++t)
+      if (tri_alive_[t]) {
+        report.face_error.push_back(tri_err_[t]);
+        report.result_error = std::max(report.result_error, tri_err_[t]);
+      }
   return Status::Ok();
 }
 

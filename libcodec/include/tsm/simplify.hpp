@@ -11,6 +11,7 @@
 // guaranteed within it, up to float rounding of the input).
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "tsm/mesh.hpp"
 #include "tsm/status.hpp"
@@ -39,6 +40,10 @@ struct SimplifyReport {
   // result to the input (<= max_error; 0 when nothing moved). The other
   // direction is proven within max_error.
   double result_error = 0;
+  // With max_error: per triangle of the result (in its face order), the
+  // bound proven of the distance from any of its points to the input (their
+  // largest is result_error).
+  std::vector<double> face_error;
 };
 
 // Simplifies `in` into `out` (triangles; polygons are split as fans first).
