@@ -92,7 +92,10 @@ TriangleBvh::TriangleBvh(const TriangleSet& set) : set_(set) {
   for (size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
       const Vec3 c = set.corner(order_[i], k);
-      const float f[3] = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
+      // Through volatile floats: GCC 12's SLP vectorizer may fold adjacent
+      // double -> float -> double round trips into copies, and a corner that
+      // is not a float would then pass the test below.
+      const volatile float f[3] = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
       if (f[0] != c.x || f[1] != c.y || f[2] != c.z) {
         float_corners_.clear();  // not exact as floats: the doubles are read instead
         float_corners_.shrink_to_fit();
