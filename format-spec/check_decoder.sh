@@ -125,6 +125,7 @@ corpus_case check keep_order_dragon "$dragon" 11 6 0 --keep-order
 # progressive files (§4.8): the base mesh, then batches of vertex splits and the loose vertices
 check progressive_irregular "$work/irregular.obj" 12 6 0 --progressive
 check progressive_mixed "$work/mixed.obj" 12 6 0 --progressive
+check progressive_loose "$work/loose.obj" 12 6 0 --progressive  # 150 loose vertices
 corpus_case check progressive_dragon "$dragon" 11 6 0 --progressive
 # lossless files (§5.1): the exact grid and its exceptions
 check lossless_mixed "$work/mixed.obj" "" 6 0 --lossless

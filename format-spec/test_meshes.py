@@ -13,6 +13,9 @@
                 split along random diagonals, then 2,000 random edge flips:
                 irregular valences, so at level 0 its run values take tables
                 (mode 1, §8.3.1), which the forged cases then damage
+  loose.obj     irregular(20) and 150 vertices no face uses, scattered just
+                off the sheet: in a progressive file they fill the loose
+                section (§4.8), each coded from its nearest level vertex
   fan.obj       a fan of 300 triangles around a wavy rim: the rim is a path of
                 the vertex tree whose coordinates follow a linear recurrence,
                 so at -l 9 the ancestor predictor (K = 3 or 4) wins
@@ -139,6 +142,18 @@ def irregular(n=30, flips=2000, seed=5):
             for k in range(3):
                 he[f[k], f[(k + 1) % 3]] = idx
         keys += [(c, d), (d, c)]
+    return V, F
+
+
+def loose(n=20, extra=150, seed=9):
+    """irregular(n) and `extra` vertices no face uses, each just off the
+    sheet (within half a grid cell of it)."""
+    import random
+    rng = random.Random(seed)
+    V, F = irregular(n, flips=600, seed=seed)
+    for _ in range(extra):
+        x, y = rng.uniform(0, n - 1), rng.uniform(0, n - 1)
+        V.append((x, y, 3 * math.sin(x / 7.0) * math.cos(y / 9.0) + rng.uniform(-.5, .5)))
     return V, F
 
 
@@ -872,6 +887,7 @@ def main():
     write_obj(os.path.join(out, 'lattice.obj'), *lattice())
     write_obj(os.path.join(out, 'fan.obj'), *fan())
     write_obj(os.path.join(out, 'irregular.obj'), *irregular())
+    write_obj(os.path.join(out, 'loose.obj'), *loose())
     write_obj(os.path.join(out, 'box.obj'), *box())
     write_obj(os.path.join(out, 'double_sided.obj'), *double_sided(*mixed(16, 30)))
     unused_vt(os.path.join(out, 'unused_vt.obj'))
