@@ -1968,7 +1968,7 @@ std::string encode_geometry(const GeometryLayout& g, const std::vector<uint32_t>
   // parts: 2CylinderEngine's 8,618-vertex primitives, 3% smaller with it);
   // on the scans it won nowhere (5-10% larger than the surface predictors)
   // and costs a pass of its own for the weights.
-    int32_t gate_lsq[3], gate_est[3];
+  int32_t gate_lsq[3], gate_est[3];
   if (level >= 3 && (adaptive_search || !st.lattice.empty())) {
     fit_alphas(g, q, bits, Predictor::gate, gate_lsq, gate_est, &order);
     consider(Predictor::gate, 0, st.lattice, gate_est);

@@ -75,17 +75,6 @@ struct Quadric {
   }
 };
 
-// x rounded to the nearest float, through a volatile: GCC 12's SLP
-// vectorizer folds a pair of adjacent double -> float -> double round trips
-// into plain copies (x and y came back unrounded), and a vertex written as
-// floats would then differ from the position its bound was proven for.
-double round_to_float(double x) {
-  volatile float f = static_cast<float>(x);
-  return f;
-}
-
-Vec3 to_float(Vec3 p) { return {round_to_float(p.x), round_to_float(p.y), round_to_float(p.z)}; }
-
 double longest_edge(Vec3 a, Vec3 b, Vec3 c) {
   return std::max({geom::length(b - a), geom::length(c - b), geom::length(a - c)});
 }
@@ -991,7 +980,7 @@ bool Simplifier::within_original_rec(const Vec3 p[3], Near n[3], uint32_t depth,
 
 // Collapse u into v placed at x: flips, degeneracy and the bound.
 bool Simplifier::attempt(uint32_t u, uint32_t v, Vec3 x, const std::vector<uint32_t>& edge_tris) {
-  cu_ = u, cv_ = v, cx_ = to_float(x);
+  cu_ = u, cv_ = v, cx_ = geom::to_float(x);
   const bool moved = !(cx_.x == pos_[v].x && cx_.y == pos_[v].y && cx_.z == pos_[v].z);
   changed_.clear();
   new_tris_.clear();

@@ -12,6 +12,15 @@ namespace tsm::geom {
 double length(Vec3 a) { return std::sqrt(dot(a, a)); }
 Vec3 lerp(Vec3 a, Vec3 b, double t) { return a + (b - a) * t; }
 
+namespace {
+double round_to_float(double x) {
+  volatile float f = static_cast<float>(x);
+  return f;
+}
+}  // namespace
+
+Vec3 to_float(Vec3 p) { return {round_to_float(p.x), round_to_float(p.y), round_to_float(p.z)}; }
+
 double point_triangle_dist2(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = dot(ab, ap), d2 = dot(ac, ap);
@@ -91,17 +100,14 @@ TriangleBvh::TriangleBvh(const TriangleSet& set) : set_(set) {
   float_corners_.resize(9 * n);
   for (size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
-      const Vec3 c = set.corner(order_[i], k);
-      // Through volatile floats: GCC 12's SLP vectorizer may fold adjacent
-      // double -> float -> double round trips into copies, and a corner that
-      // is not a float would then pass the test below.
-      const volatile float f[3] = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
-      if (f[0] != c.x || f[1] != c.y || f[2] != c.z) {
+      const Vec3 c = set.corner(order_[i], k), r = to_float(c);
+      if (r.x != c.x || r.y != c.y || r.z != c.z) {
         float_corners_.clear();  // not exact as floats: the doubles are read instead
         float_corners_.shrink_to_fit();
         return;
       }
-      for (int a = 0; a < 3; ++a) float_corners_[9 * i + 3 * k + a] = f[a];
+      float* f = &float_corners_[9 * i + 3 * k];
+      f[0] = static_cast<float>(r.x), f[1] = static_cast<float>(r.y), f[2] = static_cast<float>(r.z);
     }
 }
 

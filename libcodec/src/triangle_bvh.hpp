@@ -19,6 +19,11 @@ inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 double length(Vec3 a);
 Vec3 lerp(Vec3 a, Vec3 b, double t);
+// Each coordinate rounded to the nearest float. Through a volatile: GCC 12's
+// SLP vectorizer folds adjacent double -> float -> double round trips into
+// plain copies (x and y came back unrounded), so a point written as floats
+// would differ from the one a bound was proven for.
+Vec3 to_float(Vec3 p);
 
 // Squared distance from p to the triangle (a, b, c) (degenerate ones too).
 double point_triangle_dist2(Vec3 p, Vec3 a, Vec3 b, Vec3 c);
