@@ -175,7 +175,6 @@ struct PendingStreams {
   std::vector<uint32_t> pos_of;              // cut-mesh vertex -> pre-order position
   TopologyTail tail;
   std::vector<uint32_t> cut_corner, twin;    // with stitches: candidate_topology's cut surface
-  uint32_t positions = 0;
 };
 
 namespace {
@@ -296,7 +295,7 @@ Status code_streams(const PendingStreams& p, RunCoding run_coding, ConnectivityE
   if (cand) {  // the stitch targets by candidates, as the file has them
     cand->corner = p.cut_corner;
     cand->twin = p.twin;
-    cand->positions = p.positions;
+    cand->positions = static_cast<uint32_t>(p.f.order.size());
     cand->tail = p.tail;
     out.distance_topology = std::move(out.streams.topology);
     out.streams.topology = candidate_topology(*cand);
@@ -519,7 +518,6 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
   st.side_faces = prep.side_faces.size();
   st.polygons = prep.polygon_count;
   if (!stitches.empty()) ps.twin = g.twin;
-  ps.positions = P;
   out.pending = std::move(pending);
   // The streams now, unless the caller asked for the surface only (where
   // the decoded faces are the layout's triangles: no polygons, no side
@@ -531,7 +529,6 @@ Status encode_connectivity(const Mesh& mesh, ConnectivityEncoding& out, const Cu
 Status code_connectivity_streams(ConnectivityEncoding& ce) {
   if (!ce.pending) return Status::Ok();
   const std::shared_ptr<PendingStreams> p = std::move(ce.pending);
-  ce.pending.reset();
   return code_streams(*p, p->runs, ce);
 }
 
