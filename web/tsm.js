@@ -119,6 +119,25 @@ export async function loadTsm(options = {}) {
 // What a core module's call hands back when it reached a path only the full module has.
 const NEEDS_FULL = Symbol('needs the full module');
 
+// What decode(), feed() and finish() throw while a file needs the full module and it is not loaded.
+function needsFullError() {
+  const e = new TsmError(ErrorCode.UNSUPPORTED,
+    'this file needs the full decoder module (tsm_decoder_full.wasm): await loadFull() first, or use decodeAsync');
+  e.needsFull = true;
+  return e;
+}
+
+// run(); when it throws needsFull: the full module loaded (once), then retry().
+async function withFull(dec, run, retry) {
+  try {
+    return run();
+  } catch (e) {
+    if (!e.needsFull) throw e;
+    await dec.loadFull();
+    return retry();
+  }
+}
+
 export class TsmDecoder {
   constructor(mod, loadFull) {
     this.mod = mod;
@@ -150,17 +169,13 @@ export class TsmDecoder {
     // Once loaded, the full module decodes everything (the core would only repeat its work on files it lacks a path for).
     if (this.full) return this.full.decode(bytes, options);
     const r = this.guard(() => this.decodeNow(bytes, options));
-    return r === NEEDS_FULL ? this.fullDecoder().decode(bytes, options) : r;
+    if (r === NEEDS_FULL) throw needsFullError();
+    return r;
   }
 
   /** decode(), loading the full module first when the file needs it. */
-  async decodeAsync(bytes, options) {
-    try {
-      return this.decode(bytes, options);
-    } catch (e) {
-      if (!e.needsFull) throw e;
-      return (await this.loadFull()).decode(bytes, options);
-    }
+  decodeAsync(bytes, options) {
+    return withFull(this, () => this.decode(bytes, options), () => this.full.decode(bytes, options));
   }
 
   /** Loads the full module (once); decode() then handles every file. */
@@ -173,10 +188,7 @@ export class TsmDecoder {
   // The full module's decoder; throws (needsFull) while it is not loaded.
   fullDecoder() {
     if (this.full) return this.full;
-    const e = new TsmError(ErrorCode.UNSUPPORTED,
-      'this file needs the full decoder module (tsm_decoder_full.wasm): await loadFull() first, or use decodeAsync');
-    e.needsFull = true;
-    throw e;
+    throw needsFullError();
   }
 
   // Whether the last call into a core module reached a path it lacks (clears the flag).
@@ -414,25 +426,13 @@ export class TsmStream {
   }
 
   /** feed(), loading the full module when the file needs it. */
-  async feedAsync(chunk) {
-    try {
-      return this.feed(chunk);
-    } catch (e) {
-      if (!e.needsFull) throw e;
-      await this.dec.loadFull();
-      return this.toFull();
-    }
+  feedAsync(chunk) {
+    return withFull(this.dec, () => this.feed(chunk), () => this.toFull());
   }
 
   /** finish(), loading the full module when the file needs it. */
-  async finishAsync() {
-    try {
-      return this.finish();
-    } catch (e) {
-      if (!e.needsFull) throw e;
-      await this.dec.loadFull();
-      return this.toFull();
-    }
+  finishAsync() {
+    return withFull(this.dec, () => this.finish(), () => this.toFull());
   }
 
   // Hands the stream to the full module: a stream of its own is fed the
